@@ -1,0 +1,54 @@
+#pragma once
+// The interface a bus adapter implements (CANopen, EtherCAT, PROFINET, the in-process sim bus).
+// A Bus owns its transport and its protocol engines and exposes one AxisController per axis.
+// The cycle thread calls receive() at the start of a cycle, lets the controllers run, then calls
+// transmit(). Those two calls are the cyclic path: no heap allocation, lock, logging or blocking.
+#include <cstddef>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+#include "core/axis_controller.hpp"
+#include "core/clock.hpp"
+
+namespace drivegate::core {
+
+// Raised by open() (never by the cyclic calls) with a message a person can act on.
+class BusError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct BusCounters {
+  std::uint64_t frames_sent = 0;
+  std::uint64_t frames_received = 0;
+  std::uint64_t frames_lost = 0;     // expected but not received in time
+  std::uint64_t frames_dropped = 0;  // malformed or unexpected, counted and ignored
+  std::uint64_t errors = 0;          // bus errors (error frames, working-counter errors, ...)
+};
+
+class Bus {
+ public:
+  virtual ~Bus() = default;
+
+  [[nodiscard]] virtual std::string_view name() const noexcept = 0;
+  [[nodiscard]] virtual std::string_view type() const noexcept = 0;
+
+  // Open the transport and prepare the engines. May throw BusError.
+  virtual void open(TimePoint now) = 0;
+  // Release the transport. Called after the axes have been disabled.
+  virtual void close() noexcept = 0;
+
+  [[nodiscard]] virtual std::size_t axis_count() const noexcept = 0;
+  [[nodiscard]] virtual AxisController& controller(std::size_t axis) noexcept = 0;
+  [[nodiscard]] virtual LinkState link_state(std::size_t axis) const noexcept = 0;
+
+  // Cyclic path.
+  virtual void receive(TimePoint now) noexcept = 0;
+  virtual void transmit(TimePoint now) noexcept = 0;
+
+  [[nodiscard]] virtual BusCounters counters() const noexcept = 0;
+};
+
+}  // namespace drivegate::core

@@ -1,0 +1,75 @@
+#pragma once
+// A string with a fixed capacity stored inline, so that replies, events and snapshots can cross
+// the cycle-thread boundary without touching the heap. Text longer than the capacity is cut at a
+// character boundary and ends in "..." so that a truncation is visible, never silent.
+#include <algorithm>
+#include <array>
+#include <cstddef>
+#include <cstdio>
+#include <string>
+#include <string_view>
+
+namespace drivegate::core {
+
+template <std::size_t N>
+class FixedString {
+  static_assert(N >= 4, "FixedString needs room for at least a few characters");
+
+ public:
+  constexpr FixedString() noexcept = default;
+  FixedString(std::string_view s) noexcept { assign(s); }  // NOLINT(google-explicit-constructor)
+
+  void assign(std::string_view s) noexcept {
+    if (s.size() <= N) {
+      std::copy(s.begin(), s.end(), data_.begin());
+      size_ = s.size();
+    } else {
+      std::size_t keep = N - 3;
+      // Do not cut a UTF-8 sequence in half.
+      while (keep > 0 && (static_cast<unsigned char>(s[keep]) & 0xC0U) == 0x80U) --keep;
+      std::copy(s.begin(), s.begin() + static_cast<std::ptrdiff_t>(keep), data_.begin());
+      std::copy_n("...", 3, data_.begin() + static_cast<std::ptrdiff_t>(keep));
+      size_ = keep + 3;
+    }
+    data_[size_] = '\0';
+  }
+
+  // printf-style formatting into the inline buffer (no heap). Truncates like assign().
+  template <typename... Args>
+  void format(const char* fmt, Args... args) noexcept {
+    std::array<char, N + 1> tmp{};
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wformat-nonliteral"
+    const int n = std::snprintf(tmp.data(), tmp.size(), fmt, args...);
+#pragma GCC diagnostic pop
+    if (n < 0) {
+      clear();
+      return;
+    }
+    if (static_cast<std::size_t>(n) <= N) {
+      assign(std::string_view(tmp.data(), static_cast<std::size_t>(n)));
+    } else {
+      assign(std::string_view(tmp.data(), N));
+      std::copy_n("...", 3, data_.begin() + static_cast<std::ptrdiff_t>(N - 3));
+    }
+  }
+
+  void clear() noexcept {
+    size_ = 0;
+    data_[0] = '\0';
+  }
+  [[nodiscard]] std::string_view view() const noexcept { return {data_.data(), size_}; }
+  [[nodiscard]] std::string str() const { return std::string(view()); }
+  [[nodiscard]] const char* c_str() const noexcept { return data_.data(); }
+  [[nodiscard]] std::size_t size() const noexcept { return size_; }
+  [[nodiscard]] bool empty() const noexcept { return size_ == 0; }
+  static constexpr std::size_t capacity() noexcept { return N; }
+
+  friend bool operator==(const FixedString& a, std::string_view b) noexcept { return a.view() == b; }
+
+ private:
+  std::array<char, N + 1> data_{};
+  std::size_t size_ = 0;
+};
+
+}  // namespace drivegate::core

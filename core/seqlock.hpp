@@ -1,0 +1,57 @@
+#pragma once
+// Single-writer seqlock for snapshots (DESIGN.md §3): the cycle thread writes an axis or bus
+// snapshot every cycle without waiting; readers on the control plane retry until they get a
+// consistent copy. T must be trivially copyable; the payload is copied word by word through
+// relaxed atomics so that the concurrent copy is not a data race in the C++ memory model.
+#include <array>
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <type_traits>
+
+namespace drivegate::core {
+
+template <typename T>
+class Seqlock {
+  static_assert(std::is_trivially_copyable_v<T>, "Seqlock payload must be trivially copyable");
+  static constexpr std::size_t kWords = (sizeof(T) + sizeof(std::uint64_t) - 1) / sizeof(std::uint64_t);
+
+ public:
+  Seqlock() noexcept { store(T{}); }
+
+  // Writer (one thread only). Never blocks.
+  void store(const T& value) noexcept {
+    std::array<std::uint64_t, kWords> words{};
+    std::memcpy(words.data(), &value, sizeof(T));
+    const std::uint64_t s = seq_.load(std::memory_order_relaxed);
+    seq_.store(s + 1, std::memory_order_relaxed);
+    std::atomic_thread_fence(std::memory_order_release);
+    for (std::size_t i = 0; i < kWords; ++i) data_[i].store(words[i], std::memory_order_relaxed);
+    seq_.store(s + 2, std::memory_order_release);
+  }
+
+  // Reader (any thread). Retries while a write is in progress.
+  [[nodiscard]] T load() const noexcept {
+    std::array<std::uint64_t, kWords> words{};
+    for (;;) {
+      const std::uint64_t s1 = seq_.load(std::memory_order_acquire);
+      if (s1 & 1U) continue;
+      for (std::size_t i = 0; i < kWords; ++i) words[i] = data_[i].load(std::memory_order_relaxed);
+      std::atomic_thread_fence(std::memory_order_acquire);
+      if (seq_.load(std::memory_order_relaxed) == s1) break;
+    }
+    T out;
+    std::memcpy(&out, words.data(), sizeof(T));
+    return out;
+  }
+
+  // Number of completed writes; lets a reader see whether anything new arrived.
+  [[nodiscard]] std::uint64_t version() const noexcept { return seq_.load(std::memory_order_acquire) / 2; }
+
+ private:
+  std::atomic<std::uint64_t> seq_{0};
+  std::array<std::atomic<std::uint64_t>, kWords> data_{};
+};
+
+}  // namespace drivegate::core

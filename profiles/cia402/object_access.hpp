@@ -1,0 +1,46 @@
+#pragma once
+// How the CiA 402 profile reaches a drive's objects, whatever the bus (DESIGN.md §2 rule 3):
+// a cyclic process image (CANopen PDOs, EtherCAT PDOs) and acyclic requests (CANopen SDO, CoE
+// mailbox). The bus adapter implements it; the profile never sees frames.
+//
+// All calls happen on the bus' cycle thread and must not allocate or block.
+#include <cstdint>
+
+#include "profiles/cia402/objects.hpp"
+
+namespace drivegate::cia402 {
+
+using RequestId = std::uint32_t;
+inline constexpr RequestId kNoRequest = 0;
+
+enum class RequestState : std::uint8_t { Pending, Done, Failed, Unknown };
+
+struct RequestResult {
+  RequestState state = RequestState::Unknown;
+  std::int64_t value = 0;        // read result (sign-extended per the object's type)
+  std::uint32_t abort_code = 0;  // CiA 301 SDO abort code or CoE equivalent when Failed
+};
+
+class ObjectAccess {
+ public:
+  virtual ~ObjectAccess() = default;
+
+  // --- Cyclic process image ---
+  // True when the object travels in the cyclic image (either direction).
+  [[nodiscard]] virtual bool mapped(ObjectId id) const noexcept = 0;
+  // Latest value received from the drive for a mapped input object (statusword, actuals, ...).
+  [[nodiscard]] virtual std::int64_t read(ObjectId id) const noexcept = 0;
+  // Value for a mapped output object; sent with the next cycle's outputs.
+  virtual void write(ObjectId id, std::int64_t value) noexcept = 0;
+  // True when the inputs were refreshed by the drive during the current cycle.
+  [[nodiscard]] virtual bool inputs_fresh() const noexcept = 0;
+
+  // --- Acyclic requests ---
+  // Returns kNoRequest when the adapter's request queue is full (try again next cycle).
+  virtual RequestId submit_read(ObjectDef def) noexcept = 0;
+  virtual RequestId submit_write(ObjectDef def, std::int64_t value) noexcept = 0;
+  // Done/Failed results are reported once and then forgotten (later polls say Unknown).
+  virtual RequestResult poll(RequestId id) noexcept = 0;
+};
+
+}  // namespace drivegate::cia402
