@@ -15,6 +15,7 @@ class ControllerSink {
   virtual void completed(CommandId id) noexcept = 0;
   virtual void failed(CommandId id, std::string_view reason) noexcept = 0;
   virtual void event(EventKind kind, std::uint32_t code, std::string_view text) noexcept = 0;
+  virtual void parameter_done(const ParamReply& reply) noexcept = 0;
 
  protected:
   ~ControllerSink() = default;
@@ -39,6 +40,10 @@ class AxisController {
 
   // A set-point for the cyclic mode the axis is in (ip/csp/csv/cst). Ignored in other modes.
   virtual void setpoint(const DriveSetpoint& sp, TimePoint now) noexcept = 0;
+
+  // Read or write one object acyclically. An accepted request later gets exactly one
+  // ControllerSink::parameter_done() with the same id.
+  virtual Admission parameter(const ParamRequest& req, TimePoint now) noexcept = 0;
 
   // One cycle: read the inputs the bus delivered, advance state machines and handshakes, write
   // the outputs the bus will send.

@@ -135,7 +135,30 @@ struct Event {
   std::int64_t stamp_ns = 0;
 };
 
+// Parameter access by object index/sub-index (CiA 402 drives) for the DDS parameter topic.
+struct ParamRequest {
+  CommandId id = 0;
+  AxisIndex axis = kNoAxis;
+  bool write = false;
+  std::uint16_t index = 0;
+  std::uint8_t sub = 0;
+  std::uint8_t size = 4;  // bytes: 1, 2 or 4
+  bool is_signed = false;
+  std::int64_t value = 0;  // write value
+};
+
+struct ParamReply {
+  CommandId id = 0;
+  AxisIndex axis = kNoAxis;
+  bool ok = false;
+  std::int64_t value = 0;        // read result
+  std::uint32_t error_code = 0;  // e.g. CiA 301 SDO abort code
+  Text error;                    // in words
+};
+
 static_assert(std::is_trivially_copyable_v<Command>);
+static_assert(std::is_trivially_copyable_v<ParamRequest>);
+static_assert(std::is_trivially_copyable_v<ParamReply>);
 static_assert(std::is_trivially_copyable_v<AxisSnapshot>);
 static_assert(std::is_trivially_copyable_v<Reply>);
 static_assert(std::is_trivially_copyable_v<Event>);

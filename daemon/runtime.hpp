@@ -1,0 +1,87 @@
+#pragma once
+// What the control plane (the DDS bridge) sees of a running gateway. The implementation owns the
+// buses and their cycle threads; this interface hides them behind axis ids (an index into axes()).
+//
+// Threading: all submit_*() calls must come from ONE thread (the bridge thread): they feed
+// single-producer queues. snapshot(), bus_status() and drain() are for that same thread too.
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "core/axis_types.hpp"
+#include "core/bus.hpp"
+#include "core/command.hpp"
+
+namespace drivegate::daemon {
+
+struct AxisInfo {
+  std::string name;
+  std::string bus;
+  std::string device;
+  std::string unit;  // user unit of positions
+  core::ModeSet modes;
+};
+
+struct BusStatus {
+  std::string name;
+  std::string type;
+  bool running = false;
+  bool healthy = false;  // cycle thread alive and keeping its schedule
+  std::int64_t period_ns = 0;           // configured
+  std::int64_t achieved_period_ns = 0;  // measured mean over the last status interval
+  std::int64_t lateness_p50_ns = 0;
+  std::int64_t lateness_p99_ns = 0;
+  std::int64_t lateness_max_ns = 0;
+  std::uint64_t cycles = 0;
+  std::uint64_t overruns = 0;
+  core::BusCounters counters;
+};
+
+// Outputs of the cycle threads, with axis ids translated to global ones (index into axes()).
+struct GlobalReply {
+  std::size_t axis_id = 0;
+  core::Reply reply;
+};
+struct GlobalEvent {
+  std::size_t axis_id = SIZE_MAX;  // SIZE_MAX: the event is about a bus, see bus
+  std::string bus;
+  core::Event event;
+};
+struct GlobalParamReply {
+  std::size_t axis_id = 0;
+  core::ParamReply reply;
+};
+struct Outbox {
+  std::vector<GlobalReply> replies;
+  std::vector<GlobalEvent> events;
+  std::vector<GlobalParamReply> param_replies;
+  void clear() {
+    replies.clear();
+    events.clear();
+    param_replies.clear();
+  }
+};
+
+class Runtime {
+ public:
+  virtual ~Runtime() = default;
+  [[nodiscard]] virtual const std::string& gateway_name() const noexcept = 0;
+  [[nodiscard]] virtual std::span<const AxisInfo> axes() const noexcept = 0;
+
+  // Commands get their reply (Accepted/Rejected, later Completed/Failed) through drain(), with the
+  // same command id. Return false when the axis' queue is full (the caller rejects the command).
+  virtual bool submit_command(std::size_t axis_id, const core::Command& cmd) = 0;
+  virtual bool submit_setpoint(std::size_t axis_id, const core::Setpoint& sp) = 0;
+  virtual bool submit_parameter(std::size_t axis_id, const core::ParamRequest& req) = 0;
+
+  [[nodiscard]] virtual core::AxisSnapshot snapshot(std::size_t axis_id) const = 0;
+  [[nodiscard]] virtual std::size_t bus_count() const noexcept = 0;
+  [[nodiscard]] virtual BusStatus bus_status(std::size_t bus) const = 0;
+
+  // Appends everything the cycle threads produced since the last call.
+  virtual void drain(Outbox& out) = 0;
+};
+
+}  // namespace drivegate::daemon
