@@ -87,7 +87,8 @@ constexpr bool mode_is_cyclic(Mode m) noexcept {
          m == Mode::CyclicTorque;
 }
 
-// Names as they appear in YAML, on DDS and in the CLI.
+// Names as they appear in YAML, on DDS and in the CLI. The views refer to string literals, so
+// .data() is null-terminated and usable with printf-style formatting without a copy.
 std::string_view to_string(AxisState s) noexcept;
 std::string_view to_string(LinkState s) noexcept;
 std::string_view to_string(Mode m) noexcept;

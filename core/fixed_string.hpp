@@ -4,6 +4,7 @@
 // character boundary and ends in "..." so that a truncation is visible, never silent.
 #include <algorithm>
 #include <array>
+#include <cstdarg>
 #include <cstddef>
 #include <cstdio>
 #include <string>
@@ -34,14 +35,18 @@ class FixedString {
     data_[size_] = '\0';
   }
 
-  // printf-style formatting into the inline buffer (no heap). Truncates like assign().
-  template <typename... Args>
-  void format(const char* fmt, Args... args) noexcept {
+  // printf-style formatting into the inline buffer (no heap). Truncates like assign(). The
+  // format attribute lets the compiler check arguments against the format at every call site.
+  __attribute__((format(printf, 2, 3))) void format(const char* fmt, ...) noexcept {
+    va_list args;
+    va_start(args, fmt);
+    vformat(fmt, args);
+    va_end(args);
+  }
+
+  __attribute__((format(printf, 2, 0))) void vformat(const char* fmt, va_list args) noexcept {
     std::array<char, N + 1> tmp{};
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wformat-nonliteral"
-    const int n = std::snprintf(tmp.data(), tmp.size(), fmt, args...);
-#pragma GCC diagnostic pop
+    const int n = std::vsnprintf(tmp.data(), tmp.size(), fmt, args);
     if (n < 0) {
       clear();
       return;

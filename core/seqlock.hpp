@@ -42,7 +42,7 @@ class Seqlock {
       if (seq_.load(std::memory_order_relaxed) == s1) break;
     }
     T out;
-    std::memcpy(&out, words.data(), sizeof(T));
+    std::memcpy(static_cast<void*>(&out), words.data(), sizeof(T));
     return out;
   }
 

@@ -1,0 +1,79 @@
+#pragma once
+// Runs one axis on its bus' cycle thread: validates and converts commands (the one place where
+// user units become drive units and back), hands them to the profile controller, turns the
+// controller's outcomes into replies and events, enforces the command timeout of live modes
+// (DESIGN.md §4 safety rules) and builds the axis snapshot. Nothing here allocates.
+#include <cstdint>
+
+#include "core/axis_controller.hpp"
+#include "core/axis_spec.hpp"
+#include "core/command.hpp"
+
+namespace drivegate::core {
+
+// Where an axis runner puts what it produces. Implemented by BusRunner with lock-free queues.
+class RunnerOutput {
+ public:
+  virtual void reply(const Reply& r) noexcept = 0;
+  virtual void event(const Event& e) noexcept = 0;
+  virtual void parameter_reply(const ParamReply& r) noexcept = 0;
+
+ protected:
+  ~RunnerOutput() = default;
+};
+
+// Commands the gateway issues itself (command timeout, shutdown) carry ids with this bit set;
+// their outcomes produce no reply.
+inline constexpr CommandId kInternalCommandBit = CommandId{1} << 63;
+constexpr bool is_internal(CommandId id) noexcept { return (id & kInternalCommandBit) != 0; }
+
+class AxisRunner final : private ControllerSink {
+ public:
+  AxisRunner(AxisIndex index, const AxisSpec& spec, AxisController& controller) noexcept;
+
+  void command(const Command& cmd, TimePoint now, RunnerOutput& out) noexcept;
+  void setpoint(const Setpoint& sp, TimePoint now, RunnerOutput& out) noexcept;
+  void parameter(const ParamRequest& req, TimePoint now, RunnerOutput& out) noexcept;
+
+  // One cycle, after the bus delivered inputs and before it sends outputs.
+  void update(TimePoint now, LinkState link, RunnerOutput& out) noexcept;
+
+  [[nodiscard]] const AxisSnapshot& snapshot() const noexcept { return snapshot_; }
+  [[nodiscard]] const AxisSpec& spec() const noexcept { return spec_; }
+  [[nodiscard]] std::uint64_t rejected_setpoints() const noexcept { return rejected_setpoints_; }
+
+ private:
+  // ControllerSink
+  void completed(CommandId id) noexcept override;
+  void failed(CommandId id, std::string_view reason) noexcept override;
+  void event(EventKind kind, std::uint32_t code, std::string_view text) noexcept override;
+  void parameter_done(const ParamReply& reply) noexcept override;
+
+  void send_reply(CommandId id, ReplyStatus status, std::string_view reason) noexcept;
+  void emit(EventKind kind, std::uint32_t code, std::string_view text) noexcept;
+  void check_command_timeout(TimePoint now) noexcept;
+  void build_snapshot(TimePoint now, LinkState link) noexcept;
+
+  AxisIndex index_;
+  const AxisSpec& spec_;
+  AxisController& controller_;
+  RunnerOutput* out_ = nullptr;  // valid during a call from the cycle thread
+  TimePoint now_{};
+
+  // Command timeout bookkeeping: armed when a live-source command or set-point was accepted.
+  bool live_armed_ = false;
+  TimePoint last_activity_{};
+  CommandId next_internal_ = kInternalCommandBit | 1;
+
+  LinkState last_link_ = LinkState::Offline;
+  AxisState last_state_ = AxisState::Unknown;
+  Mode last_mode_ = Mode::None;
+  CommandId active_command_ = 0;
+  CommandId submitting_ = 0;    // id inside controller_.submit(), for inline completion
+  bool accepted_sent_ = false;  // Accepted already queued for submitting_
+  std::uint64_t cycle_ = 0;
+  std::uint64_t rejected_setpoints_ = 0;
+  AxisSnapshot snapshot_;
+};
+
+}  // namespace drivegate::core

@@ -1,0 +1,66 @@
+#pragma once
+// One bus' cyclic work and its boundary with the control plane (DESIGN.md §3). The control plane
+// pushes commands, set-points and parameter requests into bounded lock-free queues and reads axis
+// snapshots through seqlocks; the cycle thread calls cycle() once per period and pushes replies,
+// events and parameter replies back. cycle() never allocates, locks, logs or blocks.
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "core/axis_runner.hpp"
+#include "core/axis_spec.hpp"
+#include "core/bus.hpp"
+#include "core/seqlock.hpp"
+#include "core/spsc_queue.hpp"
+
+namespace drivegate::core {
+
+class BusRunner final : private RunnerOutput {
+ public:
+  // `specs[i]` describes `bus.controller(i)`. Both must outlive the runner.
+  BusRunner(Bus& bus, const std::vector<AxisSpec>& specs);
+
+  // --- Control plane (one producer thread for the inbound queues) ---
+  bool push_command(const Command& cmd) noexcept { return commands_.push(cmd); }
+  bool push_setpoint(const Setpoint& sp) noexcept { return setpoints_.push(sp); }
+  bool push_parameter(const ParamRequest& req) noexcept { return params_.push(req); }
+  // One consumer thread for the outbound queues.
+  bool pop_reply(Reply& r) noexcept { return replies_.pop(r); }
+  bool pop_event(Event& e) noexcept { return events_.pop(e); }
+  bool pop_parameter_reply(ParamReply& r) noexcept { return param_replies_.pop(r); }
+  // Any thread.
+  [[nodiscard]] AxisSnapshot snapshot(std::size_t axis) const noexcept { return snapshots_[axis].load(); }
+  [[nodiscard]] std::size_t axis_count() const noexcept { return axes_.size(); }
+  [[nodiscard]] Bus& bus() noexcept { return bus_; }
+  // Outbound items lost because the control plane did not drain in time.
+  [[nodiscard]] std::uint64_t dropped_outputs() const noexcept { return dropped_.load(std::memory_order_relaxed); }
+
+  // --- Cycle thread ---
+  void cycle(TimePoint now) noexcept;
+
+ private:
+  void reply(const Reply& r) noexcept override;
+  void event(const Event& e) noexcept override;
+  void parameter_reply(const ParamReply& r) noexcept override;
+
+  // Per cycle, at most this many inbound items are taken so one burst cannot stretch a cycle.
+  static constexpr std::size_t kMaxCommandsPerCycle = 16;
+  static constexpr std::size_t kMaxSetpointsPerCycle = 256;
+  static constexpr std::size_t kMaxParamsPerCycle = 8;
+
+  Bus& bus_;
+  std::vector<AxisRunner> axes_;
+  std::unique_ptr<Seqlock<AxisSnapshot>[]> snapshots_;
+
+  SpscQueue<Command, 64> commands_;
+  SpscQueue<Setpoint, 256> setpoints_;
+  SpscQueue<ParamRequest, 32> params_;
+  SpscQueue<Reply, 256> replies_;
+  SpscQueue<Event, 256> events_;
+  SpscQueue<ParamReply, 32> param_replies_;
+  std::atomic<std::uint64_t> dropped_{0};
+};
+
+}  // namespace drivegate::core

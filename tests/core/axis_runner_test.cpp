@@ -1,0 +1,257 @@
+#include "core/axis_runner.hpp"
+
+#include <gtest/gtest.h>
+
+#include <vector>
+
+#include "core/bus_runner.hpp"
+#include "tests/core/test_spec.hpp"
+#include "tests/support/alloc_counter.hpp"
+
+using namespace drivegate::core;
+using namespace std::chrono_literals;
+
+namespace {
+
+// A controller that records what it is asked and completes commands when told to.
+class FakeController final : public AxisController {
+ public:
+  FakeController() { submitted.reserve(64); }  // the fake must not allocate in the cycle either
+  Admission submit(const DriveCommand& cmd, TimePoint, ControllerSink& sink) noexcept override {
+    submitted.push_back(cmd);
+    if (refuse) return Admission::reject("axis is in fault: send fault_reset first");
+    if (complete_inline) sink.completed(cmd.id);
+    if (cmd.kind == CommandKind::Velocity) fb.mode = Mode::ProfileVelocity;
+    return Admission::accept();
+  }
+  void setpoint(const DriveSetpoint& sp, TimePoint) noexcept override { last_setpoint = sp; ++setpoints; }
+  Admission parameter(const ParamRequest&, TimePoint) noexcept override { return Admission::reject("no"); }
+  void update(TimePoint, ControllerSink& sink) noexcept override {
+    if (complete_next != 0) {
+      sink.completed(complete_next);
+      complete_next = 0;
+    }
+  }
+  void link_lost(TimePoint, ControllerSink&) noexcept override { ++link_losses; }
+  const DriveFeedback& feedback() const noexcept override { return fb; }
+
+  DriveFeedback fb;
+  std::vector<DriveCommand> submitted;
+  DriveSetpoint last_setpoint;
+  int setpoints = 0;
+  int link_losses = 0;
+  bool refuse = false;
+  bool complete_inline = false;
+  CommandId complete_next = 0;
+};
+
+class Recorder final : public RunnerOutput {
+ public:
+  void reply(const Reply& r) noexcept override { replies.push_back(r); }
+  void event(const Event& e) noexcept override { events.push_back(e); }
+  void parameter_reply(const ParamReply& r) noexcept override { params.push_back(r); }
+  std::vector<Reply> replies;
+  std::vector<Event> events;
+  std::vector<ParamReply> params;
+  bool has_event(EventKind k) const {
+    for (const auto& e : events)
+      if (e.kind == k) return true;
+    return false;
+  }
+};
+
+struct RunnerFixture : ::testing::Test {
+  RunnerFixture() {
+    ctl.fb.valid = true;
+    ctl.fb.state = AxisState::OperationEnabled;
+    runner.update(now, LinkState::Operational, out);
+  }
+  AxisSpec spec = drivegate::test::linear_axis_spec();
+  FakeController ctl;
+  AxisRunner runner{0, spec, ctl};
+  Recorder out;
+  TimePoint now{1s};
+};
+
+Command cmd(CommandId id, CommandKind kind) {
+  Command c;
+  c.id = id;
+  c.axis = 0;
+  c.kind = kind;
+  return c;
+}
+
+}  // namespace
+
+TEST_F(RunnerFixture, AcceptedThenCompletedExactlyOnce) {
+  auto c = cmd(5, CommandKind::Move);
+  c.position = 10;
+  runner.command(c, now, out);
+  ASSERT_EQ(out.replies.size(), 1u);
+  EXPECT_EQ(out.replies[0].status, ReplyStatus::Accepted);
+  EXPECT_EQ(ctl.submitted.back().target_position, 10000);
+  EXPECT_EQ(runner.snapshot().active_command, 0u);  // snapshot is built on update
+  ctl.complete_next = 5;
+  runner.update(now + 1ms, LinkState::Operational, out);
+  ASSERT_EQ(out.replies.size(), 2u);
+  EXPECT_EQ(out.replies[1].status, ReplyStatus::Completed);
+  EXPECT_EQ(out.replies[1].id, 5u);
+}
+
+TEST_F(RunnerFixture, InlineCompletionStillRepliesAcceptedFirst) {
+  ctl.complete_inline = true;
+  runner.command(cmd(9, CommandKind::Resume), now, out);
+  ASSERT_EQ(out.replies.size(), 2u);
+  EXPECT_EQ(out.replies[0].status, ReplyStatus::Accepted);
+  EXPECT_EQ(out.replies[1].status, ReplyStatus::Completed);
+}
+
+TEST_F(RunnerFixture, ControllerRefusalBecomesRejectedWithItsReason) {
+  ctl.refuse = true;
+  runner.command(cmd(3, CommandKind::Enable), now, out);
+  ASSERT_EQ(out.replies.size(), 1u);
+  EXPECT_EQ(out.replies[0].status, ReplyStatus::Rejected);
+  EXPECT_EQ(out.replies[0].reason.view(), "axis is in fault: send fault_reset first");
+}
+
+TEST_F(RunnerFixture, CommandsAreRejectedWhileTheLinkIsDown) {
+  runner.update(now, LinkState::Lost, out);
+  EXPECT_EQ(ctl.link_losses, 1);
+  EXPECT_TRUE(out.has_event(EventKind::LinkChanged));
+  runner.command(cmd(4, CommandKind::Enable), now, out);
+  ASSERT_EQ(out.replies.size(), 1u);
+  EXPECT_EQ(out.replies[0].status, ReplyStatus::Rejected);
+  EXPECT_NE(out.replies[0].reason.view().find("link is lost"), std::string_view::npos);
+  EXPECT_TRUE(ctl.submitted.empty());
+}
+
+TEST_F(RunnerFixture, SilenceAfterVelocityCommandStopsTheAxis) {
+  auto v = cmd(11, CommandKind::Velocity);
+  v.velocity = 20;
+  runner.command(v, now, out);
+  ASSERT_EQ(ctl.submitted.size(), 1u);
+  // Set-points keep it alive.
+  for (int i = 1; i <= 5; ++i) {
+    Setpoint sp;
+    sp.axis = 0;
+    sp.velocity = 20;
+    runner.setpoint(sp, now + i * 50ms, out);
+    runner.update(now + i * 50ms, LinkState::Operational, out);
+  }
+  EXPECT_EQ(ctl.submitted.size(), 1u);
+  EXPECT_EQ(ctl.last_setpoint.velocity, 20000);
+  // Then silence: after 100 ms the runner issues a quick stop of its own, without a reply.
+  runner.update(now + 250ms + 90ms, LinkState::Operational, out);
+  EXPECT_EQ(ctl.submitted.size(), 1u);
+  runner.update(now + 250ms + 101ms, LinkState::Operational, out);
+  ASSERT_EQ(ctl.submitted.size(), 2u);
+  EXPECT_EQ(ctl.submitted[1].kind, CommandKind::QuickStop);
+  EXPECT_TRUE(is_internal(ctl.submitted[1].id));
+  EXPECT_TRUE(out.has_event(EventKind::CommandTimeout));
+  // Only once.
+  runner.update(now + 2s, LinkState::Operational, out);
+  EXPECT_EQ(ctl.submitted.size(), 2u);
+}
+
+TEST_F(RunnerFixture, PositionModesHaveNoCommandTimeout) {
+  auto m = cmd(12, CommandKind::Move);
+  m.position = 100;
+  runner.command(m, now, out);
+  runner.update(now + 10s, LinkState::Operational, out);
+  EXPECT_EQ(ctl.submitted.size(), 1u);
+}
+
+TEST_F(RunnerFixture, HaltIsUsedWhenConfigured) {
+  spec.timeout_stop = TimeoutStop::Halt;
+  auto v = cmd(13, CommandKind::Velocity);
+  v.velocity = 5;
+  runner.command(v, now, out);
+  runner.update(now + 1s, LinkState::Operational, out);
+  ASSERT_EQ(ctl.submitted.size(), 2u);
+  EXPECT_EQ(ctl.submitted[1].kind, CommandKind::Stop);
+}
+
+TEST_F(RunnerFixture, SnapshotIsInUserUnits) {
+  ctl.fb.position = 12345;
+  ctl.fb.velocity = -2000;
+  ctl.fb.torque = 250;
+  runner.update(now, LinkState::Operational, out);
+  EXPECT_DOUBLE_EQ(runner.snapshot().position, 12.345);
+  EXPECT_DOUBLE_EQ(runner.snapshot().velocity, -2.0);
+  EXPECT_DOUBLE_EQ(runner.snapshot().torque, 25.0);
+  EXPECT_EQ(runner.snapshot().state, AxisState::OperationEnabled);
+}
+
+namespace {
+class FakeBus final : public Bus {
+ public:
+  std::string_view name() const noexcept override { return "fake"; }
+  std::string_view type() const noexcept override { return "fake"; }
+  void open(TimePoint) override {}
+  void close() noexcept override {}
+  std::size_t axis_count() const noexcept override { return 2; }
+  AxisController& controller(std::size_t i) noexcept override { return ctl[i]; }
+  LinkState link_state(std::size_t) const noexcept override { return LinkState::Operational; }
+  void receive(TimePoint) noexcept override { ++receives; }
+  void transmit(TimePoint) noexcept override { ++transmits; }
+  BusCounters counters() const noexcept override { return {}; }
+  FakeController ctl[2];
+  int receives = 0;
+  int transmits = 0;
+};
+}  // namespace
+
+TEST(BusRunner, RoutesCommandsAndRepliesAndNeverAllocatesInTheCycle) {
+  FakeBus bus;
+  for (auto& c : bus.ctl) {
+    c.fb.valid = true;
+    c.fb.state = AxisState::SwitchOnDisabled;
+  }
+  std::vector<AxisSpec> specs{drivegate::test::linear_axis_spec(), drivegate::test::linear_axis_spec()};
+  specs[1].name = "y";
+  BusRunner runner(bus, specs);
+  TimePoint t{1s};
+  runner.cycle(t);  // link up
+
+  Command c = cmd(21, CommandKind::Enable);
+  c.axis = 1;
+  ASSERT_TRUE(runner.push_command(c));
+  Command bad = cmd(22, CommandKind::Move);
+  bad.axis = 0;
+  bad.position = std::numeric_limits<double>::quiet_NaN();
+  ASSERT_TRUE(runner.push_command(bad));
+  Setpoint sp;
+  sp.axis = 0;
+  ASSERT_TRUE(runner.push_setpoint(sp));
+
+  std::size_t allocations = 0;
+  {
+    drivegate::test::AllocationScope scope;
+    for (int i = 0; i < 1000; ++i) {
+      t += 1ms;
+      runner.cycle(t);
+    }
+    allocations = scope.count();
+  }
+  EXPECT_EQ(allocations, 0u);
+  EXPECT_EQ(bus.receives, 1001);
+  EXPECT_EQ(bus.transmits, 1001);
+  ASSERT_EQ(bus.ctl[1].submitted.size(), 1u);
+  EXPECT_EQ(bus.ctl[1].submitted[0].kind, CommandKind::Enable);
+  EXPECT_TRUE(bus.ctl[0].submitted.empty());
+
+  std::vector<Reply> replies;
+  Reply r;
+  while (runner.pop_reply(r)) replies.push_back(r);
+  ASSERT_EQ(replies.size(), 2u);
+  EXPECT_EQ(replies[0].id, 21u);
+  EXPECT_EQ(replies[0].axis, 1);
+  EXPECT_EQ(replies[0].status, ReplyStatus::Accepted);
+  EXPECT_EQ(replies[1].id, 22u);
+  EXPECT_EQ(replies[1].status, ReplyStatus::Rejected);
+  EXPECT_EQ(runner.snapshot(1).cycle, 1001u);
+  Event e;
+  bool saw_link = false;
+  while (runner.pop_event(e)) saw_link = saw_link || e.kind == EventKind::LinkChanged;
+  EXPECT_TRUE(saw_link);
+}
