@@ -1,0 +1,89 @@
+#pragma once
+// The simulated drive's object dictionary: typed entries keyed by ObjectId with access rights, an
+// optional min/max and a default. Storage is one vector reserved at construction and kept sorted,
+// so lookups (binary search) and reads/writes never allocate and are cheap enough for every cycle.
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "profiles/cia402/objects.hpp"
+
+namespace drivegate::cia402::sim {
+
+enum class Access : std::uint8_t { ReadOnly, ReadWrite, WriteOnly };
+
+// CiA 301 SDO abort codes the dictionary and the drive model report.
+namespace abort_code {
+inline constexpr std::uint32_t kNone = 0;
+inline constexpr std::uint32_t kTimeout = 0x05040000;
+inline constexpr std::uint32_t kWriteOnly = 0x06010001;  // attempt to read a write-only object
+inline constexpr std::uint32_t kReadOnly = 0x06010002;   // attempt to write a read-only object
+inline constexpr std::uint32_t kNoObject = 0x06020000;
+inline constexpr std::uint32_t kTypeMismatch = 0x06070010;  // data type / length does not match
+inline constexpr std::uint32_t kNoSubIndex = 0x06090011;
+inline constexpr std::uint32_t kValueRange = 0x06090030;
+inline constexpr std::uint32_t kValueTooHigh = 0x06090031;
+inline constexpr std::uint32_t kValueTooLow = 0x06090032;
+inline constexpr std::uint32_t kStatePrevents = 0x08000022;
+}  // namespace abort_code
+
+struct ObjectEntry {
+  ObjectId id;
+  DataType type = DataType::U32;
+  Access access = Access::ReadWrite;
+  std::int64_t value = 0;
+  std::int64_t default_value = 0;
+  std::int64_t min = 0;  // effective bounds: the type's range narrowed by the optional min/max
+  std::int64_t max = 0;
+};
+
+struct ReadResult {
+  std::uint32_t abort_code = abort_code::kNone;
+  std::int64_t value = 0;
+};
+
+// Smallest and largest value a CiA data type holds.
+std::int64_t type_min(DataType t) noexcept;
+std::int64_t type_max(DataType t) noexcept;
+
+class ObjectDictionary {
+ public:
+  // Reserves room for `capacity` entries; add() beyond that fails instead of reallocating.
+  explicit ObjectDictionary(std::size_t capacity);
+
+  // Construction phase (allocation-free as well, but not meant for the cycle). Returns false for a
+  // duplicate id, a full dictionary, a default outside the bounds or min > max.
+  bool add(ObjectDef def, Access access, std::int64_t default_value, std::optional<std::int64_t> min = std::nullopt,
+           std::optional<std::int64_t> max = std::nullopt);
+
+  // Raw value regardless of access rights (the drive's own view). nullopt when the object is absent.
+  [[nodiscard]] std::optional<std::int64_t> get(ObjectId id) const noexcept;
+  [[nodiscard]] std::optional<DataType> type_of(ObjectId id) const noexcept;
+  [[nodiscard]] std::optional<Access> access_of(ObjectId id) const noexcept;
+
+  // A master's write: checks existence, access and range. Returns 0 or a CiA 301 abort code.
+  std::uint32_t set(ObjectId id, std::int64_t value) noexcept;
+  // A master's read: checks existence and access.
+  [[nodiscard]] ReadResult read(ObjectId id) const noexcept;
+
+  // The drive's own update of an object (statusword, actuals): ignores access, clamps to the
+  // entry's bounds so a value never wraps. Returns false when the object is absent or was clamped.
+  bool store(ObjectId id, std::int64_t value) noexcept;
+
+  // Back to the defaults (power cycle).
+  void reset_to_defaults() noexcept;
+
+  // The abort code a lookup of an absent object gets: object vs. sub-index does not exist.
+  [[nodiscard]] std::uint32_t missing_code(ObjectId id) const noexcept;
+
+  [[nodiscard]] std::size_t size() const noexcept { return entries_.size(); }
+
+ private:
+  [[nodiscard]] const ObjectEntry* find(ObjectId id) const noexcept;
+  ObjectEntry* find(ObjectId id) noexcept;
+
+  std::vector<ObjectEntry> entries_;  // sorted by ObjectId::key()
+};
+
+}  // namespace drivegate::cia402::sim
