@@ -1,0 +1,280 @@
+// Cia402Master: construction, command admission and bookkeeping, set-points, parameters, link loss.
+#include "profiles/cia402/cia402_master.hpp"
+
+#include <cstdint>
+
+#include "profiles/cia402/controlword.hpp"
+#include "profiles/cia402/op_modes.hpp"
+
+namespace drivegate::cia402 {
+
+using core::Admission;
+using core::AxisState;
+using core::CommandKind;
+using core::Mode;
+
+namespace {
+
+bool in_fault(AxisState s) noexcept { return s == AxisState::Fault || s == AxisState::FaultReactionActive; }
+
+std::string_view mode_name(Mode m) noexcept { return m == Mode::None ? std::string_view("none") : core::mode_short_name(m); }
+
+DataType param_type(std::uint8_t size, bool is_signed) noexcept {
+  switch (size) {
+    case 1: return is_signed ? DataType::I8 : DataType::U8;
+    case 2: return is_signed ? DataType::I16 : DataType::U16;
+    default: return is_signed ? DataType::I32 : DataType::U32;
+  }
+}
+
+bool fits(std::int64_t value, std::uint8_t size, bool is_signed) noexcept {
+  const unsigned bits = 8U * size;
+  if (is_signed) {
+    const std::int64_t max = (std::int64_t{1} << (bits - 1)) - 1;
+    return value >= -max - 1 && value <= max;
+  }
+  return value >= 0 && value <= (std::int64_t{1} << bits) - 1;
+}
+
+}  // namespace
+
+Cia402Master::Cia402Master(ObjectAccess& io, const MasterSettings& settings) noexcept
+    : io_(io), settings_(settings), device_(settings.enable_step_timeout) {}
+
+Mode Cia402Master::motion_mode(const core::DriveCommand& cmd) const noexcept {
+  switch (cmd.kind) {
+    case CommandKind::Move: return Mode::ProfilePosition;
+    case CommandKind::Velocity: return cmd.mode == Mode::Velocity ? Mode::Velocity : Mode::ProfileVelocity;
+    case CommandKind::Torque: return Mode::ProfileTorque;
+    case CommandKind::Home: return Mode::Homing;
+    case CommandKind::Stop: return from_op_mode(display_mode_);
+    default: return cmd.mode;
+  }
+}
+
+bool Cia402Master::at_standstill() const noexcept {
+  if (state_ != AxisState::OperationEnabled && state_ != AxisState::QuickStopActive) return true;  // no torque
+  const ObjectId vel = from_op_mode(display_mode_) == Mode::Velocity ? obj::kVlVelocityActual.id : obj::kVelocityActual.id;
+  if (io_.mapped(vel)) {
+    const std::int64_t v = io_.read(vel);
+    return v >= -settings_.standstill_velocity && v <= settings_.standstill_velocity;
+  }
+  // No velocity in the image: the best the drive tells us is "target reached" (SW bit 10).
+  return (statusword_ & (1U << 10)) != 0;
+}
+
+Admission Cia402Master::admit_motion(const core::DriveCommand& cmd, Mode mode) const noexcept {
+  Admission no;
+  no.accepted = false;
+  if (in_fault(state_)) return Admission::reject("axis is in fault: send fault_reset first");
+  if (!to_op_mode(mode)) {
+    no.reason.format("mode %s is not a CiA 402 mode", mode_name(mode).data());
+    return no;
+  }
+  if (cmd.kind != CommandKind::SetMode) {
+    if (cmd.mode != Mode::None && cmd.mode != mode && cmd.kind != CommandKind::Stop) {
+      no.reason.format("%s runs in %s, not in %s", core::to_string(cmd.kind).data(), mode_name(mode).data(),
+                       mode_name(cmd.mode).data());
+      return no;
+    }
+    if (state_ == AxisState::QuickStopActive) return Admission::reject("axis is in quick stop: send enable first");
+    if (state_ != AxisState::OperationEnabled) return Admission::reject("axis is not enabled: send enable first");
+    if (mode == Mode::Velocity && cmd.kind == CommandKind::Velocity &&
+        (cmd.target_velocity < INT16_MIN || cmd.target_velocity > INT16_MAX)) {
+      // 6042h is INTEGER16 [NORD digest §5.2]; clamping would move at a speed nobody asked for.
+      no.reason.format("velocity %d does not fit vl target 6042h (INTEGER16)", static_cast<int>(cmd.target_velocity));
+      return no;
+    }
+  }
+  const Mode drive_mode = from_op_mode(display_mode_);
+  if (mode != drive_mode && !at_standstill()) {
+    // Mode changes only at standstill [AKD digest §3.6 WARNING].
+    no.reason.format("axis is moving: stop it before changing mode from %s to %s", mode_name(drive_mode).data(),
+                     mode_name(mode).data());
+    return no;
+  }
+  return Admission::accept();
+}
+
+void Cia402Master::fail_slot(Slot& slot, std::string_view reason, core::ControllerSink& sink) noexcept {
+  if (!slot.active) return;
+  slot.active = false;
+  sink.failed(slot.id, reason);
+}
+
+void Cia402Master::complete_slot(Slot& slot, core::ControllerSink& sink) noexcept {
+  if (!slot.active) return;
+  slot.active = false;
+  sink.completed(slot.id);
+}
+
+void Cia402Master::abort_slot(Slot& slot, const core::DriveCommand& by, core::ControllerSink& sink) noexcept {
+  if (!slot.active) return;
+  core::Text reason;
+  if (slot.kind == by.kind) {
+    reason.format("superseded by command %llu", static_cast<unsigned long long>(by.id));
+  } else {
+    reason.format("aborted by %s command %llu", core::to_string(by.kind).data(), static_cast<unsigned long long>(by.id));
+  }
+  fail_slot(slot, reason.view(), sink);
+}
+
+Admission Cia402Master::submit(const core::DriveCommand& cmd, core::TimePoint now, core::ControllerSink& sink) noexcept {
+  if (!status_valid_) return Admission::reject("no status from the drive yet: wait for the link to come up");
+  const Slot incoming{true, cmd.id, cmd.kind};
+  switch (cmd.kind) {
+    case CommandKind::Enable:
+      if (in_fault(state_)) return Admission::reject("axis is in fault: send fault_reset first");
+      abort_slot(device_slot_, cmd, sink);
+      device_.start(DeviceGoal::Enable, state_, now);
+      device_slot_ = incoming;
+      restart_cyclic_hold();
+      return Admission::accept();
+
+    case CommandKind::Disable:
+    case CommandKind::QuickStop:
+      abort_slot(device_slot_, cmd, sink);
+      abort_slot(motion_.slot, cmd, sink);
+      abort_slot(halt_slot_, cmd, sink);
+      mode_switching_ = false;
+      bit4_ = false;
+      halt_ = false;
+      device_.start(cmd.kind == CommandKind::Disable ? DeviceGoal::Disable : DeviceGoal::QuickStop, state_, now);
+      device_slot_ = incoming;
+      return Admission::accept();
+
+    case CommandKind::FaultReset:
+      abort_slot(device_slot_, cmd, sink);
+      if (!in_fault(state_)) {
+        sink.completed(cmd.id);  // nothing to reset
+        return Admission::accept();
+      }
+      device_.start(DeviceGoal::FaultReset, state_, now);
+      device_slot_ = incoming;
+      return Admission::accept();
+
+    case CommandKind::Halt:
+      if (in_fault(state_)) return Admission::reject("axis is in fault: send fault_reset first");
+      if (state_ != AxisState::OperationEnabled) return Admission::reject("axis is not enabled: send enable first");
+      abort_slot(halt_slot_, cmd, sink);
+      halt_ = true;
+      halt_settle_until_ = cycle_ + settings_.settle_cycles;
+      halt_slot_ = incoming;
+      return Admission::accept();
+
+    case CommandKind::Resume:
+      abort_slot(halt_slot_, cmd, sink);
+      halt_ = false;
+      sink.completed(cmd.id);
+      return Admission::accept();
+
+    case CommandKind::RunBlock:
+      return Admission::reject("run_block is a PROFIdrive command: CiA 402 drives have no traversing blocks");
+
+    case CommandKind::Stop:
+      if (state_ != AxisState::OperationEnabled) {
+        sink.completed(cmd.id);  // without operation enabled the drive produces no motion to stop
+        return Admission::accept();
+      }
+      break;
+    case CommandKind::SetMode:
+    case CommandKind::Move:
+    case CommandKind::Velocity:
+    case CommandKind::Torque:
+    case CommandKind::Home:
+      break;
+  }
+
+  const Mode mode = motion_mode(cmd);
+  const Admission admission = admit_motion(cmd, mode);
+  if (!admission.accepted) return admission;
+  abort_slot(motion_.slot, cmd, sink);
+  if (cmd.kind != CommandKind::SetMode && cmd.kind != CommandKind::Stop) {
+    abort_slot(halt_slot_, cmd, sink);  // a new motion command implies resume
+    halt_ = false;
+  }
+  start_motion(cmd, mode, now);
+  return Admission::accept();
+}
+
+void Cia402Master::setpoint(const core::DriveSetpoint& sp, core::TimePoint /*now*/) noexcept {
+  const Mode mode = from_op_mode(display_mode_);
+  if (!core::mode_is_cyclic(mode) || state_ != AxisState::OperationEnabled || mode_switching_) return;
+  ObjectId target{};
+  std::int64_t value = 0;
+  switch (mode) {
+    case Mode::InterpolatedPosition: target = obj::kIpDataRecord.id; value = sp.position; break;
+    case Mode::CyclicPosition: target = obj::kTargetPosition.id; value = sp.position; break;
+    case Mode::CyclicVelocity: target = obj::kTargetVelocity.id; value = sp.velocity; break;
+    default: target = obj::kTargetTorque.id; value = sp.torque; break;
+  }
+  if (!io_.mapped(target)) {
+    ++dropped_setpoints_;  // a cyclic set-point over acyclic requests would arrive too late to matter
+    return;
+  }
+  io_.write(target, value);
+  cyclic_has_setpoint_ = true;
+}
+
+Admission Cia402Master::parameter(const core::ParamRequest& req, core::TimePoint /*now*/) noexcept {
+  Admission no;
+  no.accepted = false;
+  if (req.size != 1 && req.size != 2 && req.size != 4) {
+    no.reason.format("object size %u is not supported: use 1, 2 or 4 bytes", static_cast<unsigned>(req.size));
+    return no;
+  }
+  if (req.write && !fits(req.value, req.size, req.is_signed)) {
+    no.reason.format("value %lld does not fit in a %u-byte %s object", static_cast<long long>(req.value),
+                     static_cast<unsigned>(req.size), req.is_signed ? "signed" : "unsigned");
+    return no;
+  }
+  for (auto& p : params_) {
+    if (p.active) continue;
+    p = PendingParam{true, req, ObjectDef{{req.index, req.sub}, param_type(req.size, req.is_signed)}, kNoRequest};
+    return Admission::accept();
+  }
+  no.reason.format("%zu parameter requests already in flight for this axis: try again later", params_.size());
+  return no;
+}
+
+void Cia402Master::link_lost(core::TimePoint /*now*/, core::ControllerSink& sink) noexcept {
+  constexpr std::string_view kLost = "link to drive lost";
+  fail_slot(device_slot_, kLost, sink);
+  fail_slot(motion_.slot, kLost, sink);
+  fail_slot(halt_slot_, kLost, sink);
+  for (auto& p : params_) {
+    if (!p.active) continue;
+    p.active = false;
+    core::ParamReply reply;
+    reply.id = p.req.id;
+    reply.axis = p.req.axis;
+    reply.error = kLost;
+    sink.parameter_done(reply);
+  }
+  // Forget the drive; it comes back disabled (DESIGN.md §4 safety rules).
+  device_.reset();
+  status_valid_ = false;
+  status_read_ = kNoRequest;
+  state_ = AxisState::Unknown;
+  display_known_ = false;
+  display_read_ = kNoRequest;
+  mode_switching_ = false;
+  mode_out_valid_ = false;
+  bit4_ = false;
+  pp_bits_ = 0;
+  halt_ = false;
+  cw_write_ = kNoRequest;
+  cw_written_valid_ = false;
+  fault_event_pending_ = false;
+  fault_read_ = kNoRequest;
+  homed_ = false;
+  last_warning_ = false;
+  last_remote_ = true;
+  flags_seen_ = false;
+  restart_cyclic_hold();
+  last_cw_ = cw::kDisableVoltage;
+  if (io_.mapped(obj::kControlword.id)) io_.write(obj::kControlword.id, cw::kDisableVoltage);
+  fb_ = core::DriveFeedback{};
+}
+
+}  // namespace drivegate::cia402

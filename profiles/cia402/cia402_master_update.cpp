@@ -1,0 +1,280 @@
+// Cia402Master: the cycle. Inputs, state tracking and events, device control, outputs, parameters,
+// feedback.
+#include <chrono>
+
+#include "profiles/cia402/cia402_master.hpp"
+#include "profiles/cia402/controlword.hpp"
+#include "profiles/cia402/op_modes.hpp"
+#include "profiles/cia402/sdo_abort.hpp"
+#include "profiles/cia402/statusword.hpp"
+
+namespace drivegate::cia402 {
+
+using core::AxisState;
+using core::EventKind;
+using core::Mode;
+
+namespace {
+
+bool in_fault(AxisState s) noexcept { return s == AxisState::Fault || s == AxisState::FaultReactionActive; }
+
+// Keeps one acyclic read of `def` in flight; true (and `value` set) when one came back.
+bool poll_read(ObjectAccess& io, RequestId& request, ObjectDef def, std::int64_t& value) noexcept {
+  if (request == kNoRequest) {
+    request = io.submit_read(def);
+    return false;
+  }
+  const RequestResult r = io.poll(request);
+  if (r.state == RequestState::Pending) return false;
+  request = kNoRequest;
+  if (r.state != RequestState::Done) return false;  // retried next cycle
+  value = r.value;
+  return true;
+}
+
+}  // namespace
+
+void Cia402Master::update(core::TimePoint now, core::ControllerSink& sink) noexcept {
+  ++cycle_;
+  read_inputs();
+  if (status_valid_) {
+    track_state(now, sink);
+    track_fault_code(sink);
+    run_device(now, sink);
+    run_motion(now, sink);
+    run_halt(sink);
+    hold_cyclic();
+  }
+  write_outputs();
+  run_parameters(sink);
+  fill_feedback();
+}
+
+void Cia402Master::read_inputs() noexcept {
+  std::int64_t value = 0;
+  if (io_.mapped(obj::kStatusword.id)) {
+    if (io_.inputs_fresh()) {
+      statusword_ = static_cast<std::uint16_t>(io_.read(obj::kStatusword.id));
+      status_valid_ = true;
+    }
+  } else if (poll_read(io_, status_read_, obj::kStatusword, value)) {
+    statusword_ = static_cast<std::uint16_t>(value);
+    status_valid_ = true;
+  }
+  if (io_.mapped(obj::kModesOfOperationDisplay.id)) {
+    if (io_.inputs_fresh()) {
+      display_mode_ = static_cast<std::int8_t>(io_.read(obj::kModesOfOperationDisplay.id));
+      display_known_ = true;
+    }
+  } else if ((!display_known_ || mode_switching_) &&
+             poll_read(io_, display_read_, obj::kModesOfOperationDisplay, value)) {
+    display_mode_ = static_cast<std::int8_t>(value);
+    display_known_ = true;
+  }
+}
+
+void Cia402Master::track_state(core::TimePoint /*now*/, core::ControllerSink& sink) noexcept {
+  const AxisState s = decode_state(statusword_);
+  const StatusFlags flags = decode_flags(statusword_);
+  const Mode mode_before = fb_.mode;
+  const Mode mode_now = display_known_ ? from_op_mode(display_mode_) : Mode::None;
+  if (display_known_ && mode_now != mode_before) {
+    sink.event(EventKind::ModeChanged, static_cast<std::uint32_t>(static_cast<std::uint8_t>(display_mode_)),
+               mode_now == Mode::None ? std::string_view("none or manufacturer mode") : core::to_string(mode_now));
+  }
+
+  if (s != state_) {
+    const AxisState prev = state_;
+    state_ = s;
+    sink.event(EventKind::StateChanged, static_cast<std::uint32_t>(s), core::to_string(s));
+    if (in_fault(s) && !in_fault(prev)) {
+      core::Text reason;
+      if (io_.mapped(obj::kErrorCode.id)) {
+        const auto code = static_cast<std::uint16_t>(io_.read(obj::kErrorCode.id));
+        const std::string_view text = error_code_text(code, vendor_faults_);  // vendor text: not NUL-terminated
+        reason.format("drive fault 0x%04X: %.*s", static_cast<unsigned>(code), static_cast<int>(text.size()), text.data());
+      } else {
+        reason.assign("drive went to fault");
+      }
+      fail_slot(motion_.slot, reason.view(), sink);
+      fail_slot(halt_slot_, reason.view(), sink);
+      if (device_slot_.kind != core::CommandKind::FaultReset) {
+        fail_slot(device_slot_, reason.view(), sink);
+        device_.hold(cw::kDisableVoltage);  // never re-enable by itself after the reset
+      }
+      mode_switching_ = false;
+      bit4_ = false;
+      halt_ = false;
+      fault_event_pending_ = true;
+      fault_read_ = kNoRequest;
+    } else if (in_fault(prev) && !in_fault(s) && prev != AxisState::Unknown) {
+      fault_event_pending_ = false;
+      fb_.fault_code = 0;
+      fb_.fault_text.clear();
+      sink.event(EventKind::FaultCleared, 0, "fault cleared");
+    } else if (prev == AxisState::OperationEnabled && !device_slot_.active) {
+      // Not commanded: hardware enable lost, local control, or a drive-side stop.
+      core::Text reason;
+      reason.format("drive left operation enabled on its own (now %s): hardware enable lost?", core::to_string(s).data());
+      if (motion_.slot.kind != core::CommandKind::SetMode) fail_slot(motion_.slot, reason.view(), sink);
+      fail_slot(halt_slot_, reason.view(), sink);
+      device_.hold(cw::kDisableVoltage);
+      bit4_ = false;
+      halt_ = false;
+    }
+  }
+
+  if (flags_seen_ && flags.warning != last_warning_) {
+    sink.event(EventKind::Warning, flags.warning ? 1U : 0U,
+               flags.warning ? "drive reports a warning (statusword bit 7)" : "drive warning cleared");
+  }
+  if (flags_seen_ && flags.remote != last_remote_) {
+    sink.event(EventKind::Info, flags.remote ? 1U : 0U,
+               flags.remote ? "drive back under bus control (statusword bit 9 remote)"
+                            : "drive taken over locally (statusword bit 9 remote = 0)");
+  }
+  last_warning_ = flags.warning;
+  last_remote_ = flags.remote;
+  flags_seen_ = true;
+}
+
+void Cia402Master::track_fault_code(core::ControllerSink& sink) noexcept {
+  if (!fault_event_pending_) return;
+  std::uint16_t code = 0;
+  if (io_.mapped(obj::kErrorCode.id)) {
+    code = static_cast<std::uint16_t>(io_.read(obj::kErrorCode.id));
+  } else {
+    if (fault_read_ == kNoRequest) {
+      fault_read_ = io_.submit_read(obj::kErrorCode);
+      return;
+    }
+    const RequestResult r = io_.poll(fault_read_);
+    if (r.state == RequestState::Pending) return;
+    fault_read_ = kNoRequest;
+    if (r.state != RequestState::Done) {
+      // Some drives have no 603Fh (NORD digest §9): report the fault without a code.
+      fault_event_pending_ = false;
+      fb_.fault_code = 0;
+      fb_.fault_text.format("drive fault (603Fh unreadable: %s)", sdo_abort_text(r.abort_code).data());
+      sink.event(EventKind::Fault, 0, fb_.fault_text.view());
+      return;
+    }
+    code = static_cast<std::uint16_t>(r.value);
+  }
+  fault_event_pending_ = false;
+  fb_.fault_code = code;
+  fb_.fault_text.assign(error_code_text(code, vendor_faults_));
+  sink.event(EventKind::Fault, code, fb_.fault_text.view());
+}
+
+void Cia402Master::run_device(core::TimePoint now, core::ControllerSink& sink) noexcept {
+  const DeviceProgress p = device_.step(state_, now);
+  if (p == DeviceProgress::Done) {
+    complete_slot(device_slot_, sink);
+  } else if (p == DeviceProgress::Failed) {
+    fail_slot(device_slot_, device_.failure().view(), sink);
+  }
+}
+
+void Cia402Master::write_outputs() noexcept {
+  std::uint16_t cw = device_.controlword();
+  if (status_valid_ && state_ == AxisState::OperationEnabled && (cw & cw::kDeviceControlMask) == cw::kEnableOperation) {
+    switch (from_op_mode(display_mode_)) {
+      case Mode::ProfilePosition:
+        if (bit4_) cw = static_cast<std::uint16_t>(cw | cw::kNewSetpoint | pp_bits_);
+        break;
+      case Mode::Homing:
+        if (bit4_) cw = static_cast<std::uint16_t>(cw | cw::kHomingStart);
+        break;
+      case Mode::InterpolatedPosition:
+        if (!mode_switching_) cw = static_cast<std::uint16_t>(cw | cw::kEnableInterpolation);
+        break;
+      case Mode::Velocity:
+        cw = static_cast<std::uint16_t>(cw | cw::kVlRunBits);  // 0x007F [NORD digest §5.2]
+        break;
+      default: break;
+    }
+    if (halt_) cw = static_cast<std::uint16_t>(cw | cw::kHalt);
+  }
+
+  if (!mode_out_valid_ && display_known_) {
+    mode_out_ = display_mode_;  // mirror until a mode is chosen: a mapped 6060h must hold a valid mode
+    mode_out_valid_ = true;
+  }
+  if (mode_out_valid_ && io_.mapped(obj::kModesOfOperation.id)) io_.write(obj::kModesOfOperation.id, mode_out_);
+
+  fb_.controlword = cw;
+  if (io_.mapped(obj::kControlword.id)) {
+    io_.write(obj::kControlword.id, cw);
+    last_cw_ = cw;
+    return;
+  }
+  // Controlword over acyclic writes: one in flight, the latest value follows when it is done.
+  if (cw_write_ != kNoRequest) {
+    const RequestResult r = io_.poll(cw_write_);
+    if (r.state == RequestState::Pending) return;
+    cw_write_ = kNoRequest;
+    cw_written_valid_ = r.state == RequestState::Done;
+    if (cw_written_valid_) {
+      cw_written_ = cw_inflight_;
+      last_cw_ = cw_inflight_;
+    }
+  }
+  if (!cw_written_valid_ || cw != cw_written_) {
+    cw_write_ = io_.submit_write(obj::kControlword, cw);
+    cw_inflight_ = cw;
+  }
+}
+
+void Cia402Master::run_parameters(core::ControllerSink& sink) noexcept {
+  for (auto& p : params_) {
+    if (!p.active) continue;
+    if (p.request == kNoRequest) {
+      p.request = p.req.write ? io_.submit_write(p.def, p.req.value) : io_.submit_read(p.def);
+      continue;  // kNoRequest again: the adapter's queue is full, retry next cycle
+    }
+    const RequestResult r = io_.poll(p.request);
+    if (r.state == RequestState::Pending) continue;
+    core::ParamReply reply;
+    reply.id = p.req.id;
+    reply.axis = p.req.axis;
+    if (r.state == RequestState::Done) {
+      reply.ok = true;
+      reply.value = p.req.write ? p.req.value : r.value;
+    } else if (r.state == RequestState::Failed) {
+      reply.error_code = r.abort_code;
+      reply.error.format("%04Xh:%02X: %s (abort code 0x%08X)", static_cast<unsigned>(p.def.id.index),
+                         static_cast<unsigned>(p.def.id.sub), sdo_abort_text(r.abort_code).data(),
+                         static_cast<unsigned>(r.abort_code));
+    } else {
+      reply.error.assign("request lost by the bus adapter");
+    }
+    p.active = false;
+    sink.parameter_done(reply);
+  }
+}
+
+void Cia402Master::fill_feedback() noexcept {
+  fb_.valid = status_valid_;
+  fb_.state = status_valid_ ? state_ : AxisState::Unknown;
+  fb_.mode = display_known_ ? from_op_mode(display_mode_) : Mode::None;
+  fb_.statusword = statusword_;
+  const auto read_if = [this](ObjectId id, std::int64_t fallback) {
+    return io_.mapped(id) ? io_.read(id) : fallback;
+  };
+  fb_.position = static_cast<std::int32_t>(read_if(obj::kPositionActual.id, fb_.position));
+  const ObjectId vel = fb_.mode == Mode::Velocity ? obj::kVlVelocityActual.id : obj::kVelocityActual.id;
+  fb_.velocity = static_cast<std::int32_t>(read_if(vel, fb_.velocity));
+  fb_.torque = static_cast<std::int16_t>(read_if(obj::kTorqueActual.id, fb_.torque));
+  const StatusFlags f = decode_flags(statusword_);
+  fb_.target_reached = f.target_reached;
+  fb_.homed = homed_ || (fb_.mode == Mode::Homing && f.bit12 && !f.bit13);
+  fb_.following_error = f.bit13 && fb_.mode != Mode::Homing;
+  fb_.warning = f.warning;
+  fb_.internal_limit = f.internal_limit;
+  fb_.halted = halt_;
+  fb_.stopping = state_ == AxisState::QuickStopActive || (halt_ && !f.target_reached) ||
+                 (motion_.slot.active && motion_.slot.kind == core::CommandKind::Stop);
+}
+
+}  // namespace drivegate::cia402

@@ -1,0 +1,37 @@
+#pragma once
+// What the CiA 402 master needs to know about its axis besides the drive itself: timeouts and the
+// few device-dependent choices. Built from the axis spec before the cycle thread starts.
+#include <chrono>
+#include <cstdint>
+
+#include "core/axis_spec.hpp"
+#include "core/clock.hpp"
+
+namespace drivegate::cia402 {
+
+struct MasterSettings {
+  core::Duration enable_step_timeout = std::chrono::seconds(2);  // per state-machine step, and fault reset
+  core::Duration mode_confirm_timeout = std::chrono::milliseconds(500);  // 6061h must echo 6060h
+  core::Duration setpoint_ack_timeout = std::chrono::milliseconds(500);  // pp SW bit 12 handshake
+  core::Duration homing_timeout = std::chrono::seconds(60);
+  // |velocity actual| at or below this counts as standstill for mode changes [AKD digest §3.6].
+  std::int32_t standstill_velocity = 0;
+  // Status words received within this many cycles after a new target was handed over may still
+  // carry the previous target's "reached" bit; completion ignores them.
+  std::uint32_t settle_cycles = 2;
+  // Profile torque: wait for SW bit 10 "target torque reached" (CiA 402, NORD digest §5.4). Drives
+  // without it complete the torque command once 6071h was written.
+  bool torque_reached_bit = true;
+  // vl has no target-reached bit on NORD [NORD digest §5.2]: done when |6044h - 6042h| <= this
+  // (only when 6044h is mapped; otherwise done once 6042h was written).
+  std::int32_t vl_velocity_window = 5;
+};
+
+inline MasterSettings settings_from(const core::AxisSpec& spec) {
+  MasterSettings s;
+  s.enable_step_timeout = spec.enable_step_timeout;
+  s.homing_timeout = spec.homing.timeout;
+  return s;
+}
+
+}  // namespace drivegate::cia402

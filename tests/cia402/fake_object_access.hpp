@@ -1,0 +1,126 @@
+#pragma once
+// A scripted stand-in for a bus adapter: a small object dictionary (some objects "mapped" into the
+// cyclic image), acyclic requests that finish after a set number of polls, and per-object aborts.
+// Fixed-size storage so that it allocates nothing while the master runs (alloc test).
+#include <array>
+#include <cstddef>
+#include <cstdint>
+
+#include "profiles/cia402/object_access.hpp"
+
+namespace drivegate::cia402::test {
+
+class FakeObjectAccess final : public ObjectAccess {
+ public:
+  struct Logged {
+    ObjectId id;
+    std::int64_t value;
+  };
+
+  void map(ObjectId id) noexcept { slot(id).mapped = true; }
+  void unmap(ObjectId id) noexcept { slot(id).mapped = false; }
+  void set(ObjectId id, std::int64_t v) noexcept { slot(id).value = v; }
+  [[nodiscard]] std::int64_t value(ObjectId id) const noexcept {
+    for (const auto& o : objects_) {
+      if (o.used && o.id == id) return o.value;
+    }
+    return 0;
+  }
+  void abort_on(ObjectId id, std::uint32_t code) noexcept { slot(id).abort = code; }
+  void set_latency(int polls) noexcept { latency_ = polls; }
+  void set_queue_full(bool full) noexcept { queue_full_ = full; }
+  void set_fresh(bool fresh) noexcept { fresh_ = fresh; }
+
+  // Acyclic writes in the order they were submitted (kept up to kLog entries).
+  [[nodiscard]] std::size_t acyclic_writes() const noexcept { return log_count_; }
+  [[nodiscard]] const Logged& acyclic_write(std::size_t i) const noexcept { return log_[i]; }
+  [[nodiscard]] std::size_t acyclic_reads() const noexcept { return reads_; }
+  [[nodiscard]] std::size_t pending_requests() const noexcept {
+    std::size_t n = 0;
+    for (const auto& r : requests_) n += r.used ? 1U : 0U;
+    return n;
+  }
+
+  bool mapped(ObjectId id) const noexcept override {
+    for (const auto& o : objects_) {
+      if (o.used && o.id == id) return o.mapped;
+    }
+    return false;
+  }
+  std::int64_t read(ObjectId id) const noexcept override { return value(id); }
+  void write(ObjectId id, std::int64_t v) noexcept override { set(id, v); }
+  bool inputs_fresh() const noexcept override { return fresh_; }
+
+  RequestId submit_read(ObjectDef def) noexcept override {
+    ++reads_;
+    return add_request(def, false, 0);
+  }
+  RequestId submit_write(ObjectDef def, std::int64_t v) noexcept override {
+    const RequestId id = add_request(def, true, v);
+    if (id != kNoRequest && log_count_ < log_.size()) log_[log_count_++] = Logged{def.id, v};
+    return id;
+  }
+  RequestResult poll(RequestId id) noexcept override {
+    for (auto& r : requests_) {
+      if (!r.used || r.id != id) continue;
+      if (--r.polls_left > 0) return {RequestState::Pending, 0, 0};
+      r.used = false;
+      Object& o = slot(r.def.id);
+      if (o.abort != 0) return {RequestState::Failed, 0, o.abort};
+      if (r.write) o.value = r.value;
+      return {RequestState::Done, o.value, 0};
+    }
+    return {RequestState::Unknown, 0, 0};
+  }
+
+ private:
+  struct Object {
+    bool used = false;
+    ObjectId id{};
+    std::int64_t value = 0;
+    bool mapped = false;
+    std::uint32_t abort = 0;
+  };
+  struct Request {
+    bool used = false;
+    RequestId id = kNoRequest;
+    ObjectDef def{};
+    bool write = false;
+    std::int64_t value = 0;
+    int polls_left = 0;
+  };
+
+  Object& slot(ObjectId id) noexcept {
+    for (auto& o : objects_) {
+      if (o.used && o.id == id) return o;
+    }
+    for (auto& o : objects_) {
+      if (!o.used) {
+        o = Object{true, id, 0, false, 0};
+        return o;
+      }
+    }
+    return objects_.back();  // full: tests never get here
+  }
+  RequestId add_request(ObjectDef def, bool write, std::int64_t v) noexcept {
+    if (queue_full_) return kNoRequest;
+    for (auto& r : requests_) {
+      if (r.used) continue;
+      r = Request{true, ++next_id_, def, write, v, latency_};
+      return r.id;
+    }
+    return kNoRequest;
+  }
+
+  std::array<Object, 96> objects_{};
+  std::array<Request, 32> requests_{};
+  std::array<Logged, 256> log_{};
+  std::size_t log_count_ = 0;
+  std::size_t reads_ = 0;
+  RequestId next_id_ = 0;
+  int latency_ = 2;
+  bool queue_full_ = false;
+  bool fresh_ = true;
+};
+
+}  // namespace drivegate::cia402::test

@@ -1,0 +1,193 @@
+// The master against the simulated drive (profiles/cia402/sim) through DirectObjectAccess, with
+// virtual time: begin_cycle(); master.update(); end_cycle(); model.step(1 ms).
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <functional>
+
+#include "profiles/cia402/sim/direct_access.hpp"
+#include "profiles/cia402/sim/drive_model.hpp"
+#include "tests/cia402/master_harness.hpp"
+
+namespace drivegate::cia402::test {
+namespace {
+
+using core::CommandKind;
+using core::Mode;
+
+const std::array kMapped = {obj::kControlword.id,    obj::kStatusword.id,     obj::kModesOfOperation.id,
+                            obj::kModesOfOperationDisplay.id, obj::kPositionActual.id, obj::kVelocityActual.id,
+                            obj::kTorqueActual.id,   obj::kTargetPosition.id, obj::kProfileVelocity.id,
+                            obj::kTargetVelocity.id, obj::kTargetTorque.id,   obj::kErrorCode.id};
+
+sim::DriveModelConfig config() {
+  sim::DriveModelConfig c;
+  c.negative_limit_position = -5000.0;
+  c.positive_limit_position = 200000.0;
+  return c;
+}
+
+struct Bench {
+  sim::DriveModel model{config()};
+  sim::DirectObjectAccess io{model, kMapped, 2};
+  Cia402Master master{io, MasterSettings{}};
+  RecordingSink sink;
+  core::TimePoint now{};
+
+  void cycle() {
+    io.begin_cycle();
+    master.update(now, sink);
+    io.end_cycle();
+    model.step(1ms);
+    now += 1ms;
+  }
+  // Cycles until `id` completed or failed; false on timeout or failure.
+  bool run(core::CommandId id, int max_cycles) {
+    for (int i = 0; i < max_cycles; ++i) {
+      cycle();
+      if (sink.done(id)) return true;
+      if (!sink.failure(id).empty()) {
+        ADD_FAILURE() << "command " << id << " failed: " << sink.failure(id);
+        return false;
+      }
+    }
+    ADD_FAILURE() << "command " << id << " did not finish within " << max_cycles << " cycles";
+    return false;
+  }
+  bool submit(const core::DriveCommand& c) {
+    const auto a = master.submit(c, now, sink);
+    EXPECT_TRUE(a.accepted) << a.reason.view();
+    return a.accepted;
+  }
+  void enable(core::CommandId id = 1) {
+    for (int i = 0; i < 20; ++i) cycle();  // boot: not ready -> switch on disabled
+    ASSERT_TRUE(submit(command(id, CommandKind::Enable)));
+    ASSERT_TRUE(run(id, 100));
+    ASSERT_EQ(model.state(), sim::DriveState::OperationEnabled);
+  }
+};
+
+TEST(MasterVsModel, Enable) {
+  Bench b;
+  b.enable();
+  EXPECT_EQ(b.master.feedback().state, core::AxisState::OperationEnabled);
+}
+
+TEST(MasterVsModel, ProfilePositionMove) {
+  Bench b;
+  b.enable();
+  auto c = command(2, CommandKind::Move);
+  c.target_position = 10000;
+  c.profile_velocity = 20000;
+  c.profile_acceleration = 100000;
+  c.profile_deceleration = 100000;
+  ASSERT_TRUE(b.submit(c));
+  ASSERT_TRUE(b.run(2, 5000));
+  EXPECT_NEAR(b.model.position(), 10000.0, 10.0);
+  // A second, relative move.
+  c.id = 3;
+  c.target_position = -2500;
+  c.relative = true;
+  ASSERT_TRUE(b.submit(c));
+  ASSERT_TRUE(b.run(3, 5000));
+  EXPECT_NEAR(b.model.position(), 7500.0, 10.0);
+}
+
+TEST(MasterVsModel, ProfileVelocityThenStopAndQuickStop) {
+  Bench b;
+  b.enable();
+  auto c = command(2, CommandKind::Velocity, Mode::ProfileVelocity);
+  c.target_velocity = 5000;
+  c.profile_acceleration = 50000;
+  c.profile_deceleration = 50000;
+  ASSERT_TRUE(b.submit(c));
+  ASSERT_TRUE(b.run(2, 3000));
+  EXPECT_NEAR(b.model.velocity(), 5000.0, 150.0);
+  ASSERT_TRUE(b.submit(command(3, CommandKind::Stop)));
+  ASSERT_TRUE(b.run(3, 3000));
+  EXPECT_NEAR(b.model.velocity(), 0.0, 150.0);
+  c.id = 4;
+  ASSERT_TRUE(b.submit(c));
+  ASSERT_TRUE(b.run(4, 3000));
+  ASSERT_TRUE(b.submit(command(5, CommandKind::QuickStop)));
+  ASSERT_TRUE(b.run(5, 3000));
+  for (int i = 0; i < 2000; ++i) b.cycle();
+  EXPECT_NEAR(b.model.velocity(), 0.0, 1.0);
+}
+
+TEST(MasterVsModel, ProfileTorque) {
+  Bench b;
+  b.enable();
+  auto c = command(2, CommandKind::Torque);
+  c.target_torque = 100;
+  c.torque_slope = 10000;
+  ASSERT_TRUE(b.submit(c));
+  ASSERT_TRUE(b.run(2, 2000));
+  EXPECT_NEAR(b.model.torque(), 100.0, 5.0);
+  ASSERT_TRUE(b.submit(command(3, CommandKind::Stop)));
+  ASSERT_TRUE(b.run(3, 2000));
+}
+
+TEST(MasterVsModel, HomingCurrentPosition) {
+  Bench b;
+  b.enable();
+  auto c = command(2, CommandKind::Home);
+  c.homing_method = 35;
+  c.home_offset = 1234;
+  ASSERT_TRUE(b.submit(c));
+  ASSERT_TRUE(b.run(2, 1000));
+  EXPECT_TRUE(b.master.feedback().homed);
+}
+
+TEST(MasterVsModel, HomingOnNegativeLimitSwitch) {
+  Bench b;
+  b.enable();
+  auto c = command(2, CommandKind::Home);
+  c.homing_method = 17;
+  c.homing_search_velocity = 5000;
+  c.homing_zero_velocity = 1000;
+  c.homing_acceleration = 50000;
+  ASSERT_TRUE(b.submit(c));
+  ASSERT_TRUE(b.run(2, 20000));
+  EXPECT_TRUE(b.master.feedback().homed);
+}
+
+TEST(MasterVsModel, FaultThenReset) {
+  Bench b;
+  b.enable();
+  b.model.inject_fault(0x2310);
+  for (int i = 0; i < 20; ++i) b.cycle();
+  EXPECT_EQ(b.master.feedback().state, core::AxisState::Fault);
+  EXPECT_EQ(b.master.feedback().fault_code, 0x2310U);
+  EXPECT_EQ(b.master.feedback().fault_text.view(), "continuous overcurrent (output)");
+  ASSERT_TRUE(b.submit(command(2, CommandKind::FaultReset)));
+  for (int i = 0; i < 20; ++i) b.cycle();
+  EXPECT_FALSE(b.sink.done(2));  // the cause is still there
+  b.model.clear_fault_cause();
+  ASSERT_TRUE(b.submit(command(3, CommandKind::FaultReset)));
+  ASSERT_TRUE(b.run(3, 100));
+  EXPECT_EQ(b.sink.count(core::EventKind::FaultCleared), 1U);
+  ASSERT_TRUE(b.submit(command(4, CommandKind::Enable)));
+  ASSERT_TRUE(b.run(4, 100));
+}
+
+TEST(MasterVsModel, CyclicSynchronousPosition) {
+  Bench b;
+  b.enable();
+  ASSERT_TRUE(b.submit(command(2, CommandKind::SetMode, Mode::CyclicPosition)));
+  ASSERT_TRUE(b.run(2, 100));
+  for (int i = 0; i < 50; ++i) b.cycle();
+  EXPECT_NEAR(b.model.position(), 0.0, 1.0);  // held where it stood
+  core::DriveSetpoint sp;
+  for (int i = 1; i <= 500; ++i) {
+    sp.position = i * 10;
+    b.master.setpoint(sp, b.now);
+    b.cycle();
+  }
+  for (int i = 0; i < 50; ++i) b.cycle();
+  EXPECT_NEAR(b.model.position(), 5000.0, 20.0);
+}
+
+}  // namespace
+}  // namespace drivegate::cia402::test
