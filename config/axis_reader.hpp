@@ -1,0 +1,27 @@
+#pragma once
+// Reading one entry of `axes:` into an AxisPlan, checked against its bus and device profile.
+#include <cstddef>
+#include <optional>
+#include <vector>
+
+#include "config/bus_types.hpp"
+#include "config/device_profile.hpp"
+#include "config/plan.hpp"
+#include "config/yaml_reader.hpp"
+
+namespace drivegate::config {
+
+struct AxisContext {
+  const std::vector<BusPlan>& buses;
+  const BusTypeRegistry& bus_types;
+  DeviceCatalog& devices;
+};
+
+struct ReadAxis {
+  AxisPlan plan;
+  std::optional<std::size_t> bus;  // index into AxisContext::buses; none when the bus is unknown
+};
+
+ReadAxis read_axis(const MapReader& axis, AxisContext& ctx);
+
+}  // namespace drivegate::config

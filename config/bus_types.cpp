@@ -1,0 +1,54 @@
+#include "config/bus_types.hpp"
+
+#include <algorithm>
+
+namespace drivegate::config {
+
+BusTypeRegistry BusTypeRegistry::builtin() {
+  BusTypeRegistry r;
+  r.add({"sim", true, 1, 127,
+         {{"acyclic_latency_cycles", OptionKind::Integer, 0, 1000, std::int64_t{1},
+           "cycles before a simulated drive answers an acyclic read/write"}},
+         "sim"});
+  // Node-ids 1..127 [CiA 301]; EtherCAT configured station addresses; PROFINET device numbers.
+  r.add({"canopen", false, 1, 127, {}, ""});
+  r.add({"ethercat", false, 1, 65535, {}, ""});
+  r.add({"profinet", false, 1, 65535, {}, ""});
+  return r;
+}
+
+void BusTypeRegistry::add(BusTypeInfo info) {
+  const auto it = std::find_if(types_.begin(), types_.end(), [&](const BusTypeInfo& t) { return t.name == info.name; });
+  if (it != types_.end())
+    *it = std::move(info);
+  else
+    types_.push_back(std::move(info));
+}
+
+const BusTypeInfo* BusTypeRegistry::find(std::string_view name) const noexcept {
+  const auto it = std::find_if(types_.begin(), types_.end(), [&](const BusTypeInfo& t) { return t.name == name; });
+  return it == types_.end() ? nullptr : &*it;
+}
+
+std::vector<std::string> BusTypeRegistry::names() const {
+  std::vector<std::string> out;
+  for (const auto& t : types_) out.push_back(t.name);
+  return out;
+}
+
+std::vector<std::string> BusTypeRegistry::available_names() const {
+  std::vector<std::string> out;
+  for (const auto& t : types_)
+    if (t.available) out.push_back(t.name);
+  return out;
+}
+
+std::vector<std::string> BusTypeRegistry::axis_sections() const {
+  std::vector<std::string> out;
+  for (const auto& t : types_)
+    if (!t.axis_section.empty() && std::find(out.begin(), out.end(), t.axis_section) == out.end())
+      out.push_back(t.axis_section);
+  return out;
+}
+
+}  // namespace drivegate::config

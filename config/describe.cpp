@@ -1,0 +1,140 @@
+#include "config/describe.hpp"
+
+#include <cstdio>
+#include <sstream>
+
+#include "config/scalars.hpp"
+#include "config/text_util.hpp"
+
+namespace drivegate::config {
+
+namespace {
+
+// "  label:        value" with labels padded to one column.
+class Printer {
+ public:
+  Printer(std::ostringstream& out, int indent, int width) : out_(out), indent_(indent), width_(width) {}
+  void row(const std::string& label, const std::string& value) const {
+    out_ << std::string(static_cast<std::size_t>(indent_), ' ') << label << ':'
+         << std::string(static_cast<std::size_t>(std::max<int>(1, width_ - static_cast<int>(label.size()))), ' ')
+         << value << '\n';
+  }
+
+ private:
+  std::ostringstream& out_;
+  int indent_;
+  int width_;
+};
+
+std::string modes_text(core::ModeSet modes) {
+  std::vector<std::string> names;
+  for (std::size_t i = 1; i < core::kModeCount; ++i)
+    if (modes.contains(static_cast<core::Mode>(i))) names.emplace_back(core::mode_short_name(static_cast<core::Mode>(i)));
+  return join(names, " ");
+}
+
+std::string object_text(cia402::ObjectId id) {
+  char buf[16];
+  if (id.sub == 0)
+    std::snprintf(buf, sizeof buf, "%04Xh", id.index);
+  else
+    std::snprintf(buf, sizeof buf, "%04Xh:%u", id.index, static_cast<unsigned>(id.sub));
+  return buf;
+}
+
+std::string option_text(const OptionValue& v) {
+  return std::visit(
+      [](const auto& x) -> std::string {
+        using T = std::decay_t<decltype(x)>;
+        if constexpr (std::is_same_v<T, std::int64_t>) return std::to_string(x);
+        else if constexpr (std::is_same_v<T, double>) return format_number(x);
+        else if constexpr (std::is_same_v<T, bool>) return x ? "true" : "false";
+        else if constexpr (std::is_same_v<T, std::string>) return x;
+        else return format_duration(x);
+      },
+      v);
+}
+
+std::string limit_text(double v, const std::string& unit) {
+  return v > 0 ? format_number(v) + " " + unit : "none";
+}
+
+void describe_axis(std::ostringstream& out, const AxisPlan& a, bool simulated) {
+  const auto& s = a.spec;
+  const std::string& u = s.user_unit;
+  const std::string torque_unit = a.mechanics.rated_torque > 0 ? "Nm" : "%";
+  out << "    axis " << s.name << '\n';
+  const Printer p{out, 6, 22};
+  p.row("address", std::to_string(a.address));
+  p.row("device", a.device.name + (a.device.vendor.empty() ? "" : " (" + a.device.vendor + ")"));
+  p.row("modes", modes_text(s.modes));
+  p.row("default mode", s.default_mode == core::Mode::None ? "none" : std::string{core::to_string(s.default_mode)});
+  p.row("mechanics", "feed " + format_number(a.mechanics.feed) + " " + u + "/load rev, gear " +
+                         format_number(a.mechanics.gear_ratio) + " motor rev/load rev, encoder " +
+                         format_number(a.encoder_counts_per_rev) + " counts/rev");
+  p.row("position scale", format_number(s.units.position_factor()) + " drive units per " + u);
+  p.row("velocity scale", format_number(s.units.velocity_factor()) + " drive units per " + u + "/s");
+  p.row("acceleration scale", format_number(s.units.acceleration_factor()) + " drive units per " + u + "/s^2");
+  p.row("torque scale", format_number(s.units.torque_factor()) + " drive units per " + torque_unit);
+  p.row("position limits", s.limits.has_position_limits() ? format_number(s.limits.min_position) + " .. " +
+                                                                format_number(s.limits.max_position) + " " + u
+                                                          : "none");
+  p.row("max velocity", limit_text(s.limits.max_velocity, u + "/s"));
+  p.row("max acceleration", limit_text(s.limits.max_acceleration, u + "/s^2"));
+  p.row("max torque", limit_text(s.limits.max_torque, torque_unit));
+  p.row("default motion", "velocity " + format_number(s.defaults.velocity) + " " + u + "/s, accel " +
+                              format_number(s.defaults.acceleration) + ", decel " +
+                              format_number(s.defaults.deceleration) + " " + u + "/s^2");
+  p.row("homing", "method " + std::to_string(s.homing.method) + ", offset " + format_number(s.homing.offset) + " " +
+                      u + ", timeout " + format_duration(s.homing.timeout));
+  p.row("command timeout", format_duration(s.command_timeout) + ", then " +
+                               (s.timeout_stop == core::TimeoutStop::Halt ? "halt" : "quick stop"));
+  p.row("enable step timeout", format_duration(s.enable_step_timeout));
+  std::vector<std::string> objects;
+  for (const auto& o : a.device.cyclic_objects) objects.push_back(object_text(o));
+  p.row("cyclic objects", join(objects, " "));
+  if (simulated) {
+    // The simulated drive's settings are stored in drive units; shown in user units again.
+    const auto user = [&](const std::optional<double>& drive) {
+      return drive ? format_number(s.units.position_to_user(*drive)) + " " + u : std::string{"none"};
+    };
+    p.row("simulated drive", "start " + user(a.sim.start_position) + ", home switch " + user(a.sim.home_switch_position) +
+                                 ", limit switches " + user(a.sim.negative_limit_switch_position) + " / " +
+                                 user(a.sim.positive_limit_switch_position) + ", top speed " +
+                                 format_number(s.units.velocity_to_user(a.sim.max_velocity)) + " " + u + "/s");
+  }
+}
+
+}  // namespace
+
+std::string describe_plan(const Plan& plan) {
+  std::ostringstream out;
+  out << "configuration " << plan.file << '\n';
+  const auto& g = plan.gateway;
+  out << "gateway " << g.name << '\n';
+  const Printer gp{out, 2, 16};
+  gp.row("dds", "domain " + std::to_string(g.domain) + ", namespace " + g.ns);
+  gp.row("log level", g.log_level);
+  gp.row("status rate", format_number(g.status_rate_hz) + " Hz");
+  if (!g.device_dirs.empty()) gp.row("device dirs", join(g.device_dirs));
+  for (const auto& b : plan.buses) {
+    out << "  bus " << b.name << '\n';
+    const Printer bp{out, 4, 16};
+    bp.row("type", b.type);
+    bp.row("cycle time", format_duration(b.cycle_time));
+    bp.row("scheduling", (b.priority > 0 ? "SCHED_FIFO priority " + std::to_string(b.priority) : "normal") +
+                             std::string{", "} + (b.cpu >= 0 ? "CPU " + std::to_string(b.cpu) : "any CPU"));
+    std::vector<std::string> opts;
+    for (const auto& [name, value] : b.options) opts.push_back(name + "=" + option_text(value));
+    if (!opts.empty()) bp.row("options", join(opts));
+    bp.row("axes", std::to_string(b.axes.size()));
+    for (const auto& a : b.axes) describe_axis(out, a, b.type == "sim");
+  }
+  if (!plan.warnings.empty()) {
+    out << "warnings\n";
+    for (const auto& w : plan.warnings) out << "  " << w << '\n';
+  }
+  return out.str();
+}
+
+}  // namespace drivegate::config

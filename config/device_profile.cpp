@@ -1,0 +1,247 @@
+#include "config/device_profile.hpp"
+
+#include <algorithm>
+#include <set>
+
+#include "config/scalars.hpp"
+#include "config/text_util.hpp"
+#include "config/yaml_reader.hpp"
+
+namespace drivegate::config {
+
+namespace fs = std::filesystem;
+
+const std::vector<std::string>& known_quirks() {
+  // Behaviours where a reference device departs from plain CiA 402; the digest sections give the
+  // facts (akd-canopen-part2-ds402.md §15, nord-sk500p-ds402.md §14).
+  static const std::vector<std::string> kQuirks{
+      "switched_on_energises_power_stage",  // AKD §15.1: torque already in Switched on
+      "fault_reset_needs_bit7_release",     // AKD §15.6: host must clear CW bit 7 after the reset
+      "quick_stop_clears_setpoints",        // AKD §15.5: set-points must be re-sent after quick stop
+      "mode_valid_when_displayed",          // AKD §15.10: wait for 6061h before using a new mode
+      "setpoint_rewrite_after_mode_change", // AKD §15.10
+      "supported_modes_object_incomplete",  // AKD §15.9: 6502h omits tq, do not trust it
+      "homing_objects_not_pdo_mappable",    // AKD §15.15: 6098h/6099h/609Ah/607Ch by SDO only
+      "setpoints_only_in_operation_enabled",  // AKD §15.23
+      "no_sync_producer",                   // AKD §15.20: the drive cannot produce SYNC
+  };
+  return kQuirks;
+}
+
+std::vector<fs::path> default_device_dirs() {
+  return {fs::path{DRIVEGATE_DEVICE_DIR_SOURCE}, fs::path{DRIVEGATE_DEVICE_DIR_INSTALLED}};
+}
+
+namespace {
+
+const std::vector<std::string> kProfileKeys{"name", "vendor", "description", "identity", "modes", "units",
+                                            "homing_methods", "fault_texts", "quirks", "cyclic_objects"};
+
+// "0x6040" or "0x6099:1" (index hex with 0x, sub-index decimal or 0x hex).
+std::optional<cia402::ObjectId> parse_object_id(std::string_view text) {
+  const auto colon = text.find(':');
+  const std::string_view index_text = text.substr(0, colon);
+  if (!index_text.starts_with("0x") && !index_text.starts_with("0X")) return std::nullopt;
+  const auto index = parse_integer(index_text);
+  if (!index || *index < 0 || *index > 0xFFFF) return std::nullopt;
+  std::int64_t sub = 0;
+  if (colon != std::string_view::npos) {
+    const auto s = parse_integer(text.substr(colon + 1));
+    if (!s || *s < 0 || *s > 0xFF) return std::nullopt;
+    sub = *s;
+  }
+  return cia402::ObjectId{static_cast<std::uint16_t>(*index), static_cast<std::uint8_t>(sub)};
+}
+
+void read_units(const MapReader& units, NativeUnitsSpec& out) {
+  units.check_keys({"position", "velocity", "acceleration", "torque"});
+  const Source& src = units.source();
+
+  const MapReader pos = units.map("position", Need::Required);
+  pos.check_keys({"per_rev"});
+  if (const YAML::Node n = pos.find("per_rev"); n.IsScalar() && n.Scalar() == "counts") {
+    out.position_base = UnitBase::EncoderCounts;
+  } else if (pos.present()) {
+    NumberRule rule = NumberRule::positive();
+    rule.words = "\"counts\" (the axis' encoder_counts_per_rev) or a number > 0";
+    if (const auto v = pos.number("per_rev", Need::Required, rule)) {
+      out.position_base = UnitBase::Fixed;
+      out.position_per_rev = *v;
+    }
+  }
+
+  // velocity: { unit: position_per_s } or { per_rps: N }; acceleration likewise.
+  const auto read_rate = [&src](const MapReader& m, const char* fixed_key,
+                                const std::vector<std::string>& bases, UnitBase& base, double& value) {
+    std::vector<std::string> keys{"unit", fixed_key};
+    m.check_keys(keys);
+    if (!m.present()) return;
+    if (m.has("unit") == m.has(fixed_key)) {
+      src.error(m.mark(), m.path(),
+                "give exactly one of unit (" + join(bases) + ") or " + fixed_key + " (a number > 0)");
+      return;
+    }
+    if (m.has("unit")) {
+      if (const auto u = m.choice("unit", Need::Required, bases))
+        base = (*u == "velocity_per_s") ? UnitBase::Velocity : UnitBase::Position;
+    } else if (const auto v = m.number(fixed_key, Need::Required, NumberRule::positive())) {
+      base = UnitBase::Fixed;
+      value = *v;
+    }
+  };
+  read_rate(units.map("velocity", Need::Required), "per_rps", {"position_per_s"}, out.velocity_base,
+            out.velocity_per_rps);
+  read_rate(units.map("acceleration", Need::Required), "per_rps2", {"position_per_s2", "velocity_per_s"},
+            out.acceleration_base, out.acceleration_per_rps2);
+
+  const MapReader torque = units.map("torque", Need::Optional);
+  torque.check_keys({"per_rated"});
+  if (const auto v = torque.number("per_rated", Need::Optional, NumberRule::positive()))
+    out.torque_per_rated = *v;
+}
+
+void read_profile(const MapReader& root, const fs::path& file, DeviceProfile& p) {
+  const Source& src = root.source();
+  root.check_keys(kProfileKeys);
+  if (const auto name = root.name("name", Need::Required)) {
+    p.name = *name;
+    if (*name != file.stem().string())
+      root.error("name", "must match the file name \"" + file.stem().string() + "\", got \"" + *name + "\"");
+  }
+  p.vendor = root.string("vendor", Need::Required).value_or("");
+  p.description = root.string("description", Need::Optional).value_or("");
+
+  const MapReader identity = root.map("identity", Need::Optional);
+  identity.check_keys({"vendor_id", "product_code"});
+  if (const auto v = identity.integer("vendor_id", Need::Optional, 0, 0xFFFFFFFF))
+    p.identity.vendor_id = static_cast<std::uint32_t>(*v);
+  if (const auto v = identity.integer("product_code", Need::Optional, 0, 0xFFFFFFFF))
+    p.identity.product_code = static_cast<std::uint32_t>(*v);
+
+  if (const auto modes = root.list("modes", Need::Required)) {
+    for (std::size_t i = 0; i < modes->size(); ++i) {
+      const YAML::Node n = (*modes)[i];
+      const auto mode = n.IsScalar() ? core::parse_mode(n.Scalar()) : std::nullopt;
+      if (!mode || *mode == core::Mode::None)
+        src.error(n.Mark(), root.field("modes") + "[" + std::to_string(i) + "]",
+                  "must be a mode name (pp, pv, vl, tq, hm, ip, csp, csv, cst, tb or the long form such "
+                  "as profile_position), got " + describe_value(n));
+      else
+        p.modes.add(*mode);
+    }
+    if (modes->size() == 0) root.error("modes", "must list at least one mode");
+  }
+
+  read_units(root.map("units", Need::Required), p.units);
+
+  if (const auto methods = root.list("homing_methods", Need::Optional)) {
+    for (std::size_t i = 0; i < methods->size(); ++i) {
+      // 6098h homing method is INTEGER8 [CiA 402; AKD digest §9.1].
+      if (const auto m = read_integer((*methods)[i], root.field("homing_methods") + "[" + std::to_string(i) + "]",
+                                      src, -128, 127))
+        p.homing_methods.push_back(static_cast<std::int16_t>(*m));
+    }
+  }
+
+  const MapReader faults = root.map("fault_texts", Need::Optional);
+  if (faults.present()) {
+    for (const auto& kv : faults.node()) {
+      const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : std::string{"?"};
+      const std::string path = faults.path() + "." + key;
+      const std::int64_t code = parse_integer(key).value_or(-1);
+      if (code < 0 || code > 0xFFFFFFFF) {
+        src.error(kv.first.Mark(), path, "fault codes must be integers 0..0xFFFFFFFF, got " + describe_value(kv.first));
+        continue;
+      }
+      if (const auto text = read_string(kv.second, path, src)) p.fault_texts[static_cast<std::uint32_t>(code)] = *text;
+    }
+  }
+
+  const MapReader quirks = root.map("quirks", Need::Optional);
+  quirks.check_keys(known_quirks());
+  for (const auto& q : known_quirks())
+    if (const auto v = quirks.boolean(q, Need::Optional)) p.quirks[q] = *v;
+
+  if (const auto objects = root.list("cyclic_objects", Need::Optional)) {
+    for (std::size_t i = 0; i < objects->size(); ++i) {
+      const YAML::Node n = (*objects)[i];
+      const auto id = n.IsScalar() ? parse_object_id(n.Scalar()) : std::nullopt;
+      if (!id)
+        src.error(n.Mark(), root.field("cyclic_objects") + "[" + std::to_string(i) + "]",
+                  "must be an object as \"0x6040\" or \"0x6099:1\" (hex index, optional sub-index), got " +
+                      describe_value(n));
+      else
+        p.cyclic_objects.push_back(*id);
+    }
+  }
+}
+
+}  // namespace
+
+core::NativeUnits NativeUnitsSpec::resolve(double encoder_counts_per_rev) const noexcept {
+  core::NativeUnits n;
+  n.position_per_rev = position_base == UnitBase::Fixed ? position_per_rev : encoder_counts_per_rev;
+  n.velocity_per_rps = velocity_base == UnitBase::Fixed ? velocity_per_rps : n.position_per_rev;
+  switch (acceleration_base) {
+    case UnitBase::Fixed: n.acceleration_per_rps2 = acceleration_per_rps2; break;
+    case UnitBase::Velocity: n.acceleration_per_rps2 = n.velocity_per_rps; break;
+    default: n.acceleration_per_rps2 = n.position_per_rev; break;
+  }
+  n.torque_per_rated = torque_per_rated;
+  return n;
+}
+
+std::optional<DeviceProfile> parse_device_profile(const fs::path& file, Problems& problems) {
+  const Source src{file.string(), &problems};
+  const std::size_t errors_before = problems.errors().size();
+  const auto text = read_text_file(file.string(), src);
+  if (!text) return std::nullopt;
+  const auto doc = parse_document(*text, src);
+  if (!doc) return std::nullopt;
+  DeviceProfile p;
+  p.file = file.string();
+  read_profile(MapReader{*doc, "", src}, file, p);
+  if (problems.errors().size() != errors_before) return std::nullopt;
+  return p;
+}
+
+DeviceProfile load_device_profile(const fs::path& file) {
+  Problems problems;
+  auto p = parse_device_profile(file, problems);
+  problems.throw_if_errors();
+  return std::move(*p);
+}
+
+std::optional<fs::path> DeviceCatalog::locate(const std::string& name) const {
+  if (!is_valid_name(name)) return std::nullopt;  // never let a name walk out of the directories
+  for (const auto& dir : dirs_) {
+    std::error_code ec;
+    const fs::path candidate = dir / (name + ".yaml");
+    if (fs::is_regular_file(candidate, ec)) return candidate;
+  }
+  return std::nullopt;
+}
+
+const DeviceProfile* DeviceCatalog::get(const std::string& name, Problems& problems) {
+  auto it = cache_.find(name);
+  if (it == cache_.end()) {
+    const auto file = locate(name);
+    std::optional<DeviceProfile> profile;
+    if (file) profile = parse_device_profile(*file, problems);
+    it = cache_.emplace(name, std::move(profile)).first;
+  }
+  return it->second ? &*it->second : nullptr;
+}
+
+std::vector<std::string> DeviceCatalog::available() const {
+  std::set<std::string> names;
+  for (const auto& dir : dirs_) {
+    std::error_code ec;
+    for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec))
+      if (it->path().extension() == ".yaml" && is_valid_name(it->path().stem().string()))
+        names.insert(it->path().stem().string());
+  }
+  return {names.begin(), names.end()};
+}
+
+}  // namespace drivegate::config

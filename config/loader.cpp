@@ -1,0 +1,196 @@
+#include "config/loader.hpp"
+
+#include <algorithm>
+#include <map>
+#include <thread>
+
+#include "config/axis_reader.hpp"
+#include "config/text_util.hpp"
+#include "config/yaml_reader.hpp"
+
+namespace drivegate::config {
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+
+std::string indexed(std::string_view list, std::size_t i) { return std::string{list} + "[" + std::to_string(i) + "]"; }
+
+void read_gateway(const MapReader& g, const fs::path& base_dir, GatewayPlan& out) {
+  g.check_keys({"name", "dds", "log_level", "status_rate_hz", "device_dirs"});
+  out.name = g.name("name", Need::Required).value_or("");
+  const MapReader dds = g.map("dds", Need::Optional);
+  dds.check_keys({"domain", "namespace"});
+  // RTPS port arithmetic limits domain ids to 0..232 with the default port parameters.
+  out.domain = static_cast<int>(dds.integer("domain", Need::Optional, 0, 232).value_or(0));
+  out.ns = dds.name("namespace", Need::Optional, false).value_or(out.ns);
+  static const std::vector<std::string> kLevels{"trace", "debug", "info", "warn", "error", "critical", "off"};
+  out.log_level = g.choice("log_level", Need::Optional, kLevels).value_or(out.log_level);
+  NumberRule rate{1, 1000, false, "a number in 1..1000 (Hz)"};
+  out.status_rate_hz = g.number("status_rate_hz", Need::Optional, rate).value_or(out.status_rate_hz);
+  if (const auto dirs = g.list("device_dirs", Need::Optional)) {
+    for (std::size_t i = 0; i < dirs->size(); ++i) {
+      const auto dir = read_string((*dirs)[i], indexed(g.field("device_dirs"), i), g.source());
+      if (!dir) continue;
+      const fs::path p{*dir};
+      const fs::path abs = p.is_absolute() ? p : base_dir / p;
+      std::error_code ec;
+      if (!fs::is_directory(abs, ec))
+        g.source().error((*dirs)[i].Mark(), indexed(g.field("device_dirs"), i),
+                         "directory \"" + abs.string() + "\" does not exist (relative paths start at the "
+                         "config file's directory)");
+      out.device_dirs.push_back(abs.lexically_normal().string());
+    }
+  }
+}
+
+void read_options(const MapReader& m, const BusTypeInfo& type, BusPlan& bus) {
+  std::vector<std::string> keys;
+  for (const auto& o : type.options) keys.push_back(o.name);
+  m.check_keys(keys);
+  for (const auto& o : type.options) {
+    OptionValue v = o.default_value;
+    switch (o.kind) {
+      case OptionKind::Integer:
+        if (const auto i = m.integer(o.name, Need::Optional, static_cast<std::int64_t>(o.min),
+                                     static_cast<std::int64_t>(o.max)))
+          v = *i;
+        break;
+      case OptionKind::Number:
+        if (const auto d = m.number(o.name, Need::Optional,
+                                    {o.min, o.max, false, "a number in " + format_number(o.min) + ".." +
+                                                              format_number(o.max)}))
+          v = *d;
+        break;
+      case OptionKind::Boolean:
+        if (const auto b = m.boolean(o.name, Need::Optional)) v = *b;
+        break;
+      case OptionKind::String:
+        if (const auto s = m.string(o.name, Need::Optional)) v = *s;
+        break;
+      case OptionKind::Duration:
+        if (const auto d = m.duration(o.name, Need::Optional, 0ns, std::chrono::hours(1))) v = *d;
+        break;
+    }
+    bus.options[o.name] = v;
+  }
+  if (type.name == "sim")
+    bus.sim.acyclic_latency_cycles = static_cast<int>(std::get<std::int64_t>(bus.options["acyclic_latency_cycles"]));
+}
+
+void read_bus(const MapReader& b, const BusTypeRegistry& registry, BusPlan& bus) {
+  b.check_keys({"name", "type", "cycle_time", "priority", "cpu", "options"});
+  bus.name = b.name("name", Need::Required).value_or("");
+  const BusTypeInfo* type = nullptr;
+  if (const auto t = b.string("type", Need::Required)) {
+    type = registry.find(*t);
+    const auto available = registry.available_names();
+    if (!type) {
+      b.error("type", "unknown bus type \"" + *t + "\"" + did_you_mean(*t, registry.names()) +
+                          " (available: " + join(available) + ")");
+    } else if (!type->available) {
+      b.error("type", "bus type \"" + *t + "\" has no adapter in this build (available: " + join(available) + ")");
+      type = nullptr;
+    } else {
+      bus.type = *t;
+    }
+  }
+  bus.cycle_time = b.duration("cycle_time", Need::Required, 100us, 1s).value_or(bus.cycle_time);
+  if (const auto p = b.integer("priority", Need::Optional, 0, 99)) bus.priority = static_cast<int>(*p);
+  // CPU_SETSIZE is 1024 on Linux; whether the CPU exists is only known on the target machine.
+  if (const auto c = b.integer("cpu", Need::Optional, -1, 1023)) {
+    bus.cpu = static_cast<int>(*c);
+    const unsigned cpus = std::thread::hardware_concurrency();
+    if (cpus > 0 && *c >= static_cast<std::int64_t>(cpus))
+      b.source().warning(b.mark_of("cpu"), b.field("cpu"),
+                         "this machine has " + std::to_string(cpus) + " CPUs (0.." + std::to_string(cpus - 1) + ")");
+  }
+  if (type) read_options(b.map("options", Need::Optional), *type, bus);
+}
+
+struct Seen {
+  std::string what;
+  std::map<std::string, std::string> first;  // key -> field path of the first occurrence
+  // Reports `key` when it was seen before; returns true when it is new.
+  bool check(const std::string& key, const MapReader& m, std::string_view field, const std::string& label) {
+    if (key.empty()) return true;
+    const auto [it, added] = first.emplace(key, m.field(field));
+    if (!added) m.error(field, what + " " + label + " is already used by " + it->second);
+    return added;
+  }
+};
+
+Plan compile(const std::string& text, const std::string& file, const LoadOptions& options) {
+  Problems problems;
+  const Source src{file, &problems};
+  const auto doc = parse_document(text, src);
+  problems.throw_if_errors();
+
+  Plan plan;
+  plan.file = file;
+  const MapReader root{*doc, "", src};
+  root.check_keys({"gateway", "buses", "axes"});
+  const fs::path base_dir = fs::absolute(fs::path{file}).parent_path();
+  read_gateway(root.map("gateway", Need::Required), base_dir, plan.gateway);
+
+  std::vector<YAML::Mark> bus_marks;
+  Seen bus_names{"bus name", {}};
+  if (const auto buses = root.list("buses", Need::Required)) {
+    if (buses->size() == 0) root.error("buses", "must list at least one bus");
+    for (std::size_t i = 0; i < buses->size(); ++i) {
+      const MapReader b{(*buses)[i], indexed("buses", i), src};
+      if (!b.present()) continue;
+      BusPlan bus;
+      read_bus(b, options.bus_types, bus);
+      bus_names.check(bus.name, b, "name", "\"" + bus.name + "\"");
+      bus_marks.push_back(b.mark());
+      plan.buses.push_back(std::move(bus));
+    }
+  }
+
+  std::vector<fs::path> dirs(plan.gateway.device_dirs.begin(), plan.gateway.device_dirs.end());
+  dirs.insert(dirs.end(), options.device_dirs.begin(), options.device_dirs.end());
+  DeviceCatalog devices{dirs};
+  AxisContext ctx{plan.buses, options.bus_types, devices};
+  Seen axis_names{"axis name", {}};
+  std::vector<Seen> addresses(plan.buses.size(), Seen{"address", {}});
+  std::vector<std::pair<std::size_t, AxisPlan>> axes;
+  if (const auto list = root.list("axes", Need::Optional)) {
+    for (std::size_t i = 0; i < list->size(); ++i) {
+      const MapReader a{(*list)[i], indexed("axes", i), src};
+      if (!a.present()) continue;
+      ReadAxis axis = read_axis(a, ctx);
+      axis_names.check(axis.plan.spec.name, a, "name", "\"" + axis.plan.spec.name + "\"");
+      if (!axis.bus) continue;
+      if (axis.plan.address != 0)
+        addresses[*axis.bus].check(std::to_string(axis.plan.address), a, "address",
+                                   std::to_string(axis.plan.address) + " on bus \"" + plan.buses[*axis.bus].name + "\"");
+      axes.emplace_back(*axis.bus, std::move(axis.plan));
+    }
+  }
+  for (auto& [bus, axis] : axes) plan.buses[bus].axes.push_back(std::move(axis));
+  for (std::size_t i = 0; i < plan.buses.size(); ++i)
+    if (plan.buses[i].axes.empty() && !plan.buses[i].name.empty())
+      src.warning(bus_marks[i], indexed("buses", i),
+                  "bus \"" + plan.buses[i].name + "\" has no axes; it will run its cycle with nothing on it");
+
+  problems.throw_if_errors();
+  for (const auto& w : problems.warnings()) plan.warnings.push_back(w.to_string());
+  return plan;
+}
+
+}  // namespace
+
+Plan load_plan(const std::string& path, const LoadOptions& options) {
+  Problems problems;
+  const auto text = read_text_file(path, Source{path, &problems});
+  problems.throw_if_errors();
+  return compile(*text, path, options);
+}
+
+Plan load_plan_from_string(std::string_view yaml, std::string_view file_label, const LoadOptions& options) {
+  return compile(std::string{yaml}, std::string{file_label}, options);
+}
+
+}  // namespace drivegate::config

@@ -1,0 +1,26 @@
+#pragma once
+// Small text helpers for configuration messages: "did you mean", lists, name patterns, numbers.
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace drivegate::config {
+
+// The candidate closest to `word` by edit distance, if it is close enough to be a likely typo
+// (at most a third of the word's length, at least one edit); empty otherwise.
+std::string closest_match(std::string_view word, std::span<const std::string> candidates);
+
+// `, did you mean "x"?` or nothing, ready to append to a message.
+std::string did_you_mean(std::string_view word, std::span<const std::string> candidates);
+
+// "a, b, c" (or "(none)" for an empty list).
+std::string join(std::span<const std::string> items, std::string_view sep = ", ");
+
+// Names of gateways, buses and axes: [A-Za-z0-9_.-]{1,63}. With allow_punct false: [A-Za-z0-9_]{1,63}.
+bool is_valid_name(std::string_view s, bool allow_punct = true) noexcept;
+
+// Shortest readable form of a number: "5", "0.5", "26214.4", "1e-06".
+std::string format_number(double v);
+
+}  // namespace drivegate::config

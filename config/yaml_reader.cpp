@@ -1,0 +1,265 @@
+#include "config/yaml_reader.hpp"
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <limits>
+
+#include "config/scalars.hpp"
+#include "config/text_util.hpp"
+
+namespace drivegate::config {
+
+namespace {
+Diagnostic make(const std::string& file, const YAML::Mark& mark, std::string path, std::string message) {
+  Diagnostic d;
+  d.file = file;
+  if (mark.line >= 0) {
+    d.line = mark.line + 1;
+    d.column = mark.column + 1;
+  }
+  d.path = std::move(path);
+  d.message = std::move(message);
+  return d;
+}
+
+// yaml-cpp marks quoted scalars with the non-specific tag "!": they are strings, never numbers.
+bool is_quoted(const YAML::Node& n) { return n.Tag() == "!"; }
+
+std::string got(const YAML::Node& n) { return ", got " + describe_value(n); }
+}  // namespace
+
+void Source::error(const YAML::Mark& mark, std::string path, std::string message) const {
+  problems->error(make(file, mark, std::move(path), std::move(message)));
+}
+
+void Source::warning(const YAML::Mark& mark, std::string path, std::string message) const {
+  problems->warning(make(file, mark, std::move(path), std::move(message)));
+}
+
+std::string describe_value(const YAML::Node& node) {
+  switch (node.Type()) {
+    case YAML::NodeType::Scalar: return "\"" + node.Scalar() + "\"";
+    case YAML::NodeType::Map: return "a map";
+    case YAML::NodeType::Sequence: return "a list";
+    default: return "nothing";
+  }
+}
+
+std::optional<double> read_number(const YAML::Node& n, const std::string& path, const Source& src,
+                                  const NumberRule& rule) {
+  const auto v = n.IsScalar() && !is_quoted(n) ? parse_number(n.Scalar()) : std::nullopt;
+  if (!v) {
+    src.error(n.Mark(), path, "must be " + rule.words + got(n));
+    return std::nullopt;
+  }
+  if (!std::isfinite(*v)) {
+    src.error(n.Mark(), path, "must be " + rule.words + got(n) + " (not a finite number)");
+    return std::nullopt;
+  }
+  if (!rule.allows(*v)) {
+    src.error(n.Mark(), path, "must be " + rule.words + got(n));
+    return std::nullopt;
+  }
+  return v;
+}
+
+std::optional<std::int64_t> read_integer(const YAML::Node& n, const std::string& path, const Source& src,
+                                         std::int64_t lo, std::int64_t hi) {
+  const auto v = n.IsScalar() && !is_quoted(n) ? parse_integer(n.Scalar()) : std::nullopt;
+  if (!v || *v < lo || *v > hi) {
+    src.error(n.Mark(), path,
+              "must be an integer in " + std::to_string(lo) + ".." + std::to_string(hi) + got(n));
+    return std::nullopt;
+  }
+  return v;
+}
+
+std::optional<std::string> read_string(const YAML::Node& n, const std::string& path, const Source& src) {
+  if (!n.IsScalar()) {
+    src.error(n.Mark(), path, "must be a string" + got(n));
+    return std::nullopt;
+  }
+  return n.Scalar();
+}
+
+std::optional<std::string> read_text_file(const std::string& file, const Source& src) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) {
+    src.error(YAML::Mark::null_mark(), "", "cannot open file: " + std::string{std::strerror(errno)});
+    return std::nullopt;
+  }
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+std::optional<YAML::Node> parse_document(const std::string& text, const Source& src) {
+  try {
+    return YAML::Load(text);
+  } catch (const YAML::ParserException& e) {
+    src.error(e.mark, "", "YAML syntax error: " + e.msg);
+  } catch (const YAML::Exception& e) {
+    src.error(e.mark, "", std::string{"cannot read YAML: "} + e.what());
+  }
+  return std::nullopt;
+}
+
+MapReader::MapReader(const YAML::Node& node, std::string path, const Source& src)
+    : node_(node), path_(std::move(path)), src_(src), mark_(node.Mark()), present_(node.IsMap()) {
+  if (!present_) {
+    src_.error(mark_, path_, "must be a map of fields" + got(node));
+    quiet_ = true;
+  }
+}
+
+MapReader::MapReader(std::string path, const Source& src, YAML::Mark mark, bool quiet)
+    : path_(std::move(path)), src_(src), mark_(mark), quiet_(quiet) {}
+
+std::string MapReader::field(std::string_view key) const {
+  return path_.empty() ? std::string{key} : path_ + "." + std::string{key};
+}
+
+void MapReader::check_keys(std::span<const std::string> allowed) const {
+  if (!present_) return;
+  std::vector<std::string> seen;
+  for (const auto& kv : node_) {
+    const YAML::Node& k = kv.first;
+    if (!k.IsScalar()) {
+      src_.error(k.Mark(), path_, "keys must be plain names" + got(k));
+      continue;
+    }
+    const std::string& key = k.Scalar();
+    if (std::find(seen.begin(), seen.end(), key) != seen.end()) {
+      src_.error(k.Mark(), field(key), "given more than once");
+      continue;
+    }
+    seen.push_back(key);
+    if (std::find(allowed.begin(), allowed.end(), key) == allowed.end())
+      src_.error(k.Mark(), field(key),
+                 "unknown field" + did_you_mean(key, allowed) + " (allowed: " + join(allowed) + ")");
+  }
+}
+
+void MapReader::check_keys(std::initializer_list<std::string_view> allowed) const {
+  const std::vector<std::string> keys(allowed.begin(), allowed.end());
+  check_keys(std::span<const std::string>{keys});
+}
+
+YAML::Node MapReader::find(std::string_view key) const {
+  if (!present_) return YAML::Node{YAML::NodeType::Undefined};
+  for (const auto& kv : node_)
+    if (kv.first.IsScalar() && kv.first.Scalar() == key) return kv.second;
+  return YAML::Node{YAML::NodeType::Undefined};
+}
+
+YAML::Mark MapReader::mark_of(std::string_view key) const {
+  const YAML::Node n = find(key);
+  return n.IsDefined() ? n.Mark() : mark_;
+}
+
+void MapReader::error(std::string_view key, std::string message) const {
+  src_.error(mark_of(key), field(key), std::move(message));
+}
+
+YAML::Node MapReader::value(std::string_view key, Need need) const {
+  YAML::Node n = find(key);
+  if (!n.IsDefined() && need == Need::Required && !quiet_)
+    src_.error(mark_, field(key), "missing required field");
+  return n;
+}
+
+MapReader MapReader::map(std::string_view key, Need need) const {
+  const YAML::Node n = value(key, need);
+  if (!n.IsDefined()) return MapReader{field(key), src_, mark_, quiet_ || need == Need::Required};
+  return MapReader{n, field(key), src_};
+}
+
+std::optional<YAML::Node> MapReader::list(std::string_view key, Need need) const {
+  const YAML::Node n = value(key, need);
+  if (!n.IsDefined()) return std::nullopt;
+  if (!n.IsSequence()) {
+    src_.error(n.Mark(), field(key), "must be a list" + got(n));
+    return std::nullopt;
+  }
+  return n;
+}
+
+std::optional<std::string> MapReader::string(std::string_view key, Need need) const {
+  const YAML::Node n = value(key, need);
+  if (!n.IsDefined()) return std::nullopt;
+  return read_string(n, field(key), src_);
+}
+
+std::optional<std::string> MapReader::name(std::string_view key, Need need, bool allow_punct) const {
+  const YAML::Node n = value(key, need);
+  if (!n.IsDefined()) return std::nullopt;
+  if (!n.IsScalar() || !is_valid_name(n.Scalar(), allow_punct)) {
+    src_.error(n.Mark(), field(key),
+               std::string{"must be a name of 1 to 63 characters from "} +
+                   (allow_punct ? "A-Z a-z 0-9 _ . -" : "A-Z a-z 0-9 _") + got(n));
+    return std::nullopt;
+  }
+  return n.Scalar();
+}
+
+std::optional<std::string> MapReader::choice(std::string_view key, Need need,
+                                             std::span<const std::string> options) const {
+  const YAML::Node n = value(key, need);
+  if (!n.IsDefined()) return std::nullopt;
+  if (!n.IsScalar() || std::find(options.begin(), options.end(), n.Scalar()) == options.end()) {
+    src_.error(n.Mark(), field(key),
+               "must be one of " + join(options) + got(n) +
+                   (n.IsScalar() ? did_you_mean(n.Scalar(), options) : std::string{}));
+    return std::nullopt;
+  }
+  return n.Scalar();
+}
+
+std::optional<double> MapReader::number(std::string_view key, Need need, const NumberRule& rule) const {
+  const YAML::Node n = value(key, need);
+  if (!n.IsDefined()) return std::nullopt;
+  return read_number(n, field(key), src_, rule);
+}
+
+std::optional<std::int64_t> MapReader::integer(std::string_view key, Need need, std::int64_t lo,
+                                               std::int64_t hi) const {
+  const YAML::Node n = value(key, need);
+  if (!n.IsDefined()) return std::nullopt;
+  return read_integer(n, field(key), src_, lo, hi);
+}
+
+std::optional<core::Duration> MapReader::duration(std::string_view key, Need need, core::Duration min,
+                                                  core::Duration max) const {
+  const YAML::Node n = value(key, need);
+  if (!n.IsDefined()) return std::nullopt;
+  const auto d = n.IsScalar() && !is_quoted(n) ? parse_duration(n.Scalar()) : std::nullopt;
+  // A zero minimum means "strictly positive"; any other minimum is inclusive.
+  const bool ok = d && (min.count() == 0 ? *d > min : *d >= min) && *d <= max;
+  if (!ok) {
+    const std::string range = min.count() == 0 ? "> 0 (at most " + format_duration(max) + ")"
+                                               : "in " + format_duration(min) + ".." + format_duration(max);
+    src_.error(n.Mark(), field(key),
+               "must be a duration " + range + " such as 250us, 1ms, 0.5s or 2s (a bare number is seconds)" +
+                   got(n));
+    return std::nullopt;
+  }
+  return d;
+}
+
+std::optional<bool> MapReader::boolean(std::string_view key, Need need) const {
+  const YAML::Node n = value(key, need);
+  if (!n.IsDefined()) return std::nullopt;
+  if (n.IsScalar() && !is_quoted(n)) {
+    const std::string& s = n.Scalar();
+    if (s == "true" || s == "True" || s == "TRUE") return true;
+    if (s == "false" || s == "False" || s == "FALSE") return false;
+  }
+  src_.error(n.Mark(), field(key), "must be true or false" + got(n));
+  return std::nullopt;
+}
+
+}  // namespace drivegate::config

@@ -1,0 +1,342 @@
+// Every class of configuration error is reported with FILE:LINE:COL and the field path.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "config/loader.hpp"
+
+namespace drivegate::config {
+namespace {
+
+LoadOptions test_options() {
+  LoadOptions o;
+  o.device_dirs = {DRIVEGATE_DEVICE_DIR_SOURCE, DRIVEGATE_TEST_DEVICE_DIR};
+  return o;
+}
+
+std::string errors_of(const std::string& yaml, const LoadOptions& options = test_options()) {
+  try {
+    load_plan_from_string(yaml, "t.yaml", options);
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "(loaded without error)";
+}
+
+// A valid file up to and including the first axis' device line (line 11); tests append lines.
+const std::string kHead = R"(gateway:
+  name: cell-1
+buses:
+  - name: sim0
+    type: sim
+    cycle_time: 1ms
+axes:
+  - name: x
+    bus: sim0
+    address: 1
+    device: sim-servo
+)";
+// Line 12.
+const std::string kCounts = "    mechanics: { encoder_counts_per_rev: 4096 }\n";
+
+#define EXPECT_REPORTED(errors, text) EXPECT_NE((errors).find(text), std::string::npos) << (errors)
+
+TEST(LoadErrors, HeadIsValid) { EXPECT_NO_THROW(load_plan_from_string(kHead + kCounts, "t.yaml", test_options())); }
+
+TEST(LoadErrors, YamlSyntaxError) {
+  const std::string e = errors_of("gateway:\n  name: [cell\nbuses: []\n");
+  EXPECT_REPORTED(e, "t.yaml:3:6: YAML syntax error: ");
+}
+
+TEST(LoadErrors, UnknownKeyWithSuggestion) {
+  const std::string e = errors_of(kHead + kCounts + "    comand_timeout: 1s\n");
+  EXPECT_REPORTED(e, "t.yaml:13:5: axes[0].comand_timeout: unknown field, did you mean \"command_timeout\"?");
+  const std::string top = errors_of(kHead + kCounts + "gatway: {}\n");
+  EXPECT_REPORTED(top, "t.yaml:13:1: gatway: unknown field, did you mean \"gateway\"?");
+}
+
+TEST(LoadErrors, DuplicateKey) {
+  const std::string e = errors_of(kHead + kCounts + "    address: 2\n");
+  EXPECT_REPORTED(e, "t.yaml:13:5: axes[0].address: given more than once");
+}
+
+TEST(LoadErrors, WrongTypes) {
+  const std::string e = errors_of(kHead + kCounts +
+                                  "    limits: { max_velocity: fast }\n"
+                                  "    defaults: [pp]\n"
+                                  "    command_timeout: \"1s\"\n");
+  EXPECT_REPORTED(e, "t.yaml:13:29: axes[0].limits.max_velocity: must be a number > 0, got \"fast\"");
+  EXPECT_REPORTED(e, "t.yaml:14:15: axes[0].defaults: must be a map of fields, got a list");
+  EXPECT_REPORTED(e, "t.yaml:15:22: axes[0].command_timeout: must be a duration > 0");
+}
+
+TEST(LoadErrors, MissingRequiredFields) {
+  const std::string e = errors_of(R"(gateway:
+  dds: { domain: 1 }
+buses:
+  - type: sim
+axes:
+  - name: x
+    bus: sim0
+)");
+  EXPECT_REPORTED(e, "t.yaml:2:3: gateway.name: missing required field");
+  EXPECT_REPORTED(e, "t.yaml:4:5: buses[0].name: missing required field");
+  EXPECT_REPORTED(e, "t.yaml:4:5: buses[0].cycle_time: missing required field");
+  EXPECT_REPORTED(e, "t.yaml:6:5: axes[0].address: missing required field");
+  EXPECT_REPORTED(e, "t.yaml:6:5: axes[0].device: missing required field");
+  const std::string no_buses = errors_of("gateway: { name: g }\n");
+  EXPECT_REPORTED(no_buses, "t.yaml:1:1: buses: missing required field");
+}
+
+TEST(LoadErrors, EncoderResolutionRequiredForCountingDevices) {
+  const std::string e = errors_of(kHead);
+  EXPECT_REPORTED(e, "t.yaml:8:5: axes[0].mechanics.encoder_counts_per_rev: missing required field");
+}
+
+TEST(LoadErrors, DuplicateBusAndAxisNamesAndAddresses) {
+  const std::string e = errors_of(R"(gateway: { name: g }
+buses:
+  - { name: sim0, type: sim, cycle_time: 1ms }
+  - { name: sim0, type: sim, cycle_time: 2ms }
+axes:
+  - { name: x, bus: sim0, address: 1, device: pp-only }
+  - { name: x, bus: sim0, address: 2, device: pp-only }
+  - { name: y, bus: sim0, address: 1, device: pp-only }
+)");
+  EXPECT_REPORTED(e, "t.yaml:4:13: buses[1].name: bus name \"sim0\" is already used by buses[0].name");
+  EXPECT_REPORTED(e, "t.yaml:7:13: axes[1].name: axis name \"x\" is already used by axes[0].name");
+  EXPECT_REPORTED(e, "t.yaml:8:36: axes[2].address: address 1 on bus \"sim0\" is already used by axes[0].address");
+}
+
+TEST(LoadErrors, UnknownBusListsKnownOnes) {
+  const std::string e = errors_of(R"(gateway: { name: g }
+buses:
+  - { name: sim0, type: sim, cycle_time: 1ms }
+  - { name: bench, type: sim, cycle_time: 1ms }
+axes:
+  - { name: x, bus: sim1, address: 1, device: pp-only }
+)");
+  EXPECT_REPORTED(e, "t.yaml:6:21: axes[0].bus: unknown bus \"sim1\", did you mean \"sim0\"? (buses: sim0, bench)");
+}
+
+TEST(LoadErrors, UnknownDeviceListsAvailableOnes) {
+  const std::string e = errors_of(R"(gateway: { name: g }
+buses:
+  - { name: sim0, type: sim, cycle_time: 1ms }
+axes:
+  - { name: x, bus: sim0, address: 1, device: sim-servoo }
+)");
+  EXPECT_REPORTED(e, "t.yaml:5:47: axes[0].device: unknown device profile \"sim-servoo\", did you mean \"sim-servo\"?");
+  EXPECT_REPORTED(e, "available: generic-cia402, pp-only, sim-servo;");
+}
+
+TEST(LoadErrors, NoDeviceProfileInTheSearchPath) {
+  LoadOptions o = test_options();
+  o.device_dirs = {DRIVEGATE_TEST_DEVICE_DIR "/../no-such-dir"};
+  const std::string e = errors_of(kHead + kCounts, o);
+  EXPECT_REPORTED(e, "t.yaml:11:13: axes[0].device: unknown device profile \"sim-servo\" (available: (none)");
+}
+
+TEST(LoadErrors, ModeTheDeviceDoesNotSupport) {
+  const std::string e = errors_of(R"(gateway: { name: g }
+buses:
+  - { name: sim0, type: sim, cycle_time: 1ms }
+axes:
+  - name: x
+    bus: sim0
+    address: 1
+    device: pp-only
+    defaults: { mode: profile_velocity }
+  - name: y
+    bus: sim0
+    address: 2
+    device: pp-only
+    defaults: { mode: warp_speed }
+)");
+  EXPECT_REPORTED(e, "t.yaml:9:23: axes[0].defaults.mode: device \"pp-only\" does not support mode profile_velocity; "
+                     "supported: pp, hm");
+  EXPECT_REPORTED(e, "t.yaml:14:23: axes[1].defaults.mode: must be a mode name");
+}
+
+TEST(LoadErrors, HomingMethodTheDeviceLacks) {
+  const std::string e = errors_of(R"(gateway: { name: g }
+buses:
+  - { name: sim0, type: sim, cycle_time: 1ms }
+axes:
+  - name: x
+    bus: sim0
+    address: 1
+    device: pp-only
+    homing: { method: 19 }
+)");
+  EXPECT_REPORTED(e, "t.yaml:9:23: axes[0].homing.method: device \"pp-only\" does not support homing method 19; "
+                     "supported: 35, 37");
+}
+
+TEST(LoadErrors, OutOfRangeValues) {
+  const std::string e = errors_of(R"(gateway:
+  name: "cell 1"
+  dds: { domain: 300, namespace: a-b }
+  log_level: loud
+  status_rate_hz: 0
+buses:
+  - name: fast
+    type: sim
+    cycle_time: 50us
+    priority: 100
+    cpu: -2
+    options: { acyclic_latency_cycles: -1 }
+  - name: slow
+    type: sim
+    cycle_time: 2s
+axes:
+  - name: x
+    bus: fast
+    address: 200
+    device: pp-only
+    command_timeout: -5ms
+    enable_step_timeout: 0s
+    timeout_stop: brake
+    limits: { min_position: 10, max_position: 10, max_acceleration: -1 }
+    homing: { timeout: 0 }
+    mechanics: { gear_ratio: 0, feed: -5 }
+)");
+  EXPECT_REPORTED(e, "t.yaml:2:9: gateway.name: must be a name of 1 to 63 characters from A-Z a-z 0-9 _ . -, got \"cell 1\"");
+  EXPECT_REPORTED(e, "t.yaml:3:18: gateway.dds.domain: must be an integer in 0..232, got \"300\"");
+  EXPECT_REPORTED(e, "t.yaml:3:34: gateway.dds.namespace: must be a name of 1 to 63 characters from A-Z a-z 0-9 _");
+  EXPECT_REPORTED(e, "t.yaml:4:14: gateway.log_level: must be one of trace, debug, info, warn, error, critical, off, got \"loud\"");
+  EXPECT_REPORTED(e, "t.yaml:5:19: gateway.status_rate_hz: must be a number in 1..1000 (Hz), got \"0\"");
+  EXPECT_REPORTED(e, "t.yaml:9:17: buses[0].cycle_time: must be a duration in 100us..1s");
+  EXPECT_REPORTED(e, "t.yaml:10:15: buses[0].priority: must be an integer in 0..99, got \"100\"");
+  EXPECT_REPORTED(e, "t.yaml:11:10: buses[0].cpu: must be an integer in -1..1023, got \"-2\"");
+  EXPECT_REPORTED(e, "t.yaml:12:40: buses[0].options.acyclic_latency_cycles: must be an integer in 0..1000");
+  EXPECT_REPORTED(e, "t.yaml:15:17: buses[1].cycle_time: must be a duration in 100us..1s");
+  EXPECT_REPORTED(e, "t.yaml:19:14: axes[0].address: must be an integer in 1..127, got \"200\"");
+  EXPECT_REPORTED(e, "t.yaml:21:22: axes[0].command_timeout: must be a duration > 0");
+  EXPECT_REPORTED(e, "t.yaml:22:26: axes[0].enable_step_timeout: must be a duration > 0");
+  EXPECT_REPORTED(e, "t.yaml:23:19: axes[0].timeout_stop: must be one of quick_stop, halt, got \"brake\"");
+  EXPECT_REPORTED(e, "t.yaml:24:29: axes[0].limits.min_position: must be less than max_position (10), got 10");
+  EXPECT_REPORTED(e, "t.yaml:24:69: axes[0].limits.max_acceleration: must be a number > 0, got \"-1\"");
+  EXPECT_REPORTED(e, "t.yaml:25:24: axes[0].homing.timeout: must be a duration > 0");
+  EXPECT_REPORTED(e, "t.yaml:26:30: axes[0].mechanics.gear_ratio: must be a number > 0, got \"0\"");
+  EXPECT_REPORTED(e, "t.yaml:26:39: axes[0].mechanics.feed: must be a number > 0, got \"-5\"");
+}
+
+TEST(LoadErrors, NonFiniteNumbers) {
+  const std::string e = errors_of(kHead + kCounts + "    limits: { min_position: -.inf, max_position: .nan, max_velocity: .inf }\n");
+  EXPECT_REPORTED(e, "t.yaml:13:29: axes[0].limits.min_position: must be a finite number, got \"-.inf\" (not a finite number)");
+  EXPECT_REPORTED(e, "t.yaml:13:50: axes[0].limits.max_position: must be a finite number, got \".nan\"");
+  EXPECT_REPORTED(e, "t.yaml:13:70: axes[0].limits.max_velocity: must be a number > 0, got \".inf\"");
+}
+
+TEST(LoadErrors, OnlyOnePositionLimit) {
+  const std::string e = errors_of(kHead + kCounts + "    limits: { min_position: 0 }\n");
+  EXPECT_REPORTED(e, "t.yaml:13:13: axes[0].limits.max_position: missing: give both min_position and max_position");
+}
+
+TEST(LoadErrors, PositionLimitBeyondDriveRange) {
+  const std::string e = errors_of(kHead + kCounts + "    limits: { min_position: -1e6, max_position: 1 }\n");
+  EXPECT_REPORTED(e, "t.yaml:13:29: axes[0].limits.min_position: is -4096000000 in drive units");
+}
+
+TEST(LoadErrors, DefaultsAboveLimits) {
+  const std::string e = errors_of(kHead + kCounts +
+                                  "    limits: { max_velocity: 10 }\n"
+                                  "    defaults: { velocity: 20 }\n");
+  EXPECT_REPORTED(e, "t.yaml:14:27: axes[0].defaults.velocity: must not exceed limits.max_velocity (10), got 20");
+}
+
+TEST(LoadErrors, BusTypes) {
+  const std::string e = errors_of(R"(gateway: { name: g }
+buses:
+  - { name: a, type: simm, cycle_time: 1ms }
+  - { name: b, type: canopen, cycle_time: 1ms }
+  - { name: c, type: sim, cycle_time: 1ms, options: { latency: 2 } }
+)");
+  EXPECT_REPORTED(e, "t.yaml:3:22: buses[0].type: unknown bus type \"simm\", did you mean \"sim\"? (available: sim)");
+  EXPECT_REPORTED(e, "t.yaml:4:22: buses[1].type: bus type \"canopen\" has no adapter in this build (available: sim)");
+  EXPECT_REPORTED(e, "t.yaml:5:55: buses[2].options.latency: unknown field (allowed: acyclic_latency_cycles)");
+}
+
+TEST(LoadErrors, SimSectionOnlyOnSimBuses) {
+  LoadOptions o = test_options();
+  o.bus_types.add({"canopen", true, 1, 127, {}, ""});  // as the CANopen adapter will
+  const std::string e = errors_of(R"(gateway: { name: g }
+buses:
+  - { name: can0, type: canopen, cycle_time: 1ms }
+axes:
+  - name: x
+    bus: can0
+    address: 5
+    device: pp-only
+    sim: { home_switch: 3 }
+)",
+                                  o);
+  EXPECT_REPORTED(e, "t.yaml:9:10: axes[0].sim: only allowed for axes on a sim bus; bus is of type canopen");
+}
+
+TEST(LoadErrors, SimSectionRanges) {
+  const std::string e = errors_of(kHead + kCounts +
+                                  "    sim: { negative_limit_switch: 5, positive_limit_switch: 1, home_switch: 9 }\n");
+  EXPECT_REPORTED(e, "t.yaml:13:35: axes[0].sim.negative_limit_switch: must be less than positive_limit_switch (1), got 5");
+  EXPECT_REPORTED(e, "t.yaml:13:77: axes[0].sim.home_switch: must lie between the limit switches");
+}
+
+TEST(LoadErrors, DeviceDirsRelativeToTheFile) {
+  const std::string e = errors_of("gateway: { name: g, device_dirs: [nowhere] }\nbuses: []\n");
+  EXPECT_REPORTED(e, "t.yaml:1:35: gateway.device_dirs[0]: directory \"");
+  EXPECT_REPORTED(e, "t.yaml:2:8: buses: must list at least one bus");
+}
+
+TEST(LoadErrors, AllProblemsAtOnceInFileOrder) {
+  const std::string e = errors_of(R"(gateway:
+  name: g
+  log_level: chatty
+buses:
+  - { name: sim0, type: sim, cycle_time: 0 }
+axes:
+  - { name: x, bus: nope, address: 1, device: pp-only }
+  - { name: y, bus: sim0, address: 1, device: pp-only, limits: { max_velocity: fast } }
+)");
+  const auto a = e.find("t.yaml:3:14: gateway.log_level:");
+  const auto b = e.find("t.yaml:5:42: buses[0].cycle_time:");
+  const auto c = e.find("t.yaml:7:21: axes[0].bus: unknown bus \"nope\"");
+  const auto d = e.find("t.yaml:8:80: axes[1].limits.max_velocity:");
+  ASSERT_NE(a, std::string::npos) << e;
+  ASSERT_NE(b, std::string::npos) << e;
+  ASSERT_NE(c, std::string::npos) << e;
+  ASSERT_NE(d, std::string::npos) << e;
+  EXPECT_LT(a, b);
+  EXPECT_LT(b, c);
+  EXPECT_LT(c, d);
+  EXPECT_EQ(std::count(e.begin(), e.end(), '\n'), 3) << e;  // exactly four problems, one a line
+}
+
+TEST(LoadErrors, ProblemsAreStructuredToo) {
+  try {
+    load_plan_from_string(kHead + kCounts + "    unit: \"\"\n", "t.yaml", test_options());
+    FAIL() << "expected ConfigError";
+  } catch (const ConfigError& e) {
+    ASSERT_EQ(e.problems().size(), 1U);
+    EXPECT_EQ(e.problems()[0].line, 13);
+    EXPECT_EQ(e.problems()[0].column, 11);
+    EXPECT_EQ(e.problems()[0].path, "axes[0].unit");
+  }
+}
+
+TEST(LoadErrors, MissingFile) {
+  try {
+    load_plan("/nonexistent/drivegate.yaml");
+    FAIL() << "expected ConfigError";
+  } catch (const ConfigError& e) {
+    EXPECT_REPORTED(std::string{e.what()}, "/nonexistent/drivegate.yaml: cannot open file: No such file");
+  }
+}
+
+TEST(LoadErrors, EmptyDocument) {
+  const std::string e = errors_of("");
+  EXPECT_REPORTED(e, "t.yaml: must be a map of fields, got nothing");
+}
+
+}  // namespace
+}  // namespace drivegate::config
