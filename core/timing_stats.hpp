@@ -38,11 +38,12 @@ class LatencyHistogram {
   }
 
   // Value below which p percent of the recorded values fall (p in [0, 100], clamped; NaN counts
-  // as 0). Returns 0 when nothing was recorded. The answer never leaves [min(), max()].
+  // as 0). Returns 0 when nothing was recorded. The answer never leaves [min(), max()], and the
+  // ends are exact: percentile(0) == min(), percentile(100) == max().
   [[nodiscard]] constexpr std::int64_t percentile(double p) const noexcept {
     if (count_ == 0) return 0;
-    if (!(p > 0.0)) p = 0.0;  // also catches NaN
-    if (p > 100.0) p = 100.0;
+    if (!(p > 0.0)) return min_;  // also catches NaN
+    if (p >= 100.0) return max_;
     const double wanted = std::ceil(p / 100.0 * static_cast<double>(count_));
     const std::uint64_t rank = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(wanted));
     std::uint64_t seen = 0;
