@@ -110,10 +110,9 @@ void AxisRunner::parameter(const ParamRequest& req, TimePoint now, RunnerOutput&
   }
 }
 
-void AxisRunner::update(TimePoint now, LinkState link, RunnerOutput& out) noexcept {
+void AxisRunner::observe_link(TimePoint now, LinkState link, RunnerOutput& out) noexcept {
   out_ = &out;
   now_ = now;
-  ++cycle_;
   if (link != last_link_) {
     Text t;
     t.format("link %s -> %s", to_string(last_link_).data(), to_string(link).data());
@@ -125,9 +124,15 @@ void AxisRunner::update(TimePoint now, LinkState link, RunnerOutput& out) noexce
       controller_.link_lost(now, *this);
     }
   }
+}
+
+void AxisRunner::update(TimePoint now, RunnerOutput& out) noexcept {
+  out_ = &out;
+  now_ = now;
+  ++cycle_;
   controller_.update(now, *this);
   check_command_timeout(now);
-  build_snapshot(now, link);
+  build_snapshot(now);
 }
 
 void AxisRunner::check_command_timeout(TimePoint now) noexcept {
@@ -158,12 +163,12 @@ void AxisRunner::check_command_timeout(TimePoint now) noexcept {
   }
 }
 
-void AxisRunner::build_snapshot(TimePoint now, LinkState link) noexcept {
+void AxisRunner::build_snapshot(TimePoint now) noexcept {
   const DriveFeedback& fb = controller_.feedback();
   const UnitConverter& u = spec_.units;
   AxisSnapshot& s = snapshot_;
   s.axis = index_;
-  s.link = link;
+  s.link = last_link_;
   s.state = fb.valid ? fb.state : AxisState::Unknown;
   s.mode = fb.mode;
   s.position = u.position_to_user(fb.position);

@@ -35,8 +35,16 @@ class AxisRunner final : private ControllerSink {
   void setpoint(const Setpoint& sp, TimePoint now, RunnerOutput& out) noexcept;
   void parameter(const ParamRequest& req, TimePoint now, RunnerOutput& out) noexcept;
 
-  // One cycle, after the bus delivered inputs and before it sends outputs.
-  void update(TimePoint now, LinkState link, RunnerOutput& out) noexcept;
+  // Start of a cycle, right after the bus delivered inputs: takes note of the link state, so
+  // commands handled in this cycle see it.
+  void observe_link(TimePoint now, LinkState link, RunnerOutput& out) noexcept;
+  // One cycle, after commands were handled and before the bus sends outputs.
+  void update(TimePoint now, RunnerOutput& out) noexcept;
+  // Both, for callers without commands in between.
+  void update(TimePoint now, LinkState link, RunnerOutput& out) noexcept {
+    observe_link(now, link, out);
+    update(now, out);
+  }
 
   [[nodiscard]] const AxisSnapshot& snapshot() const noexcept { return snapshot_; }
   [[nodiscard]] const AxisSpec& spec() const noexcept { return spec_; }
@@ -52,7 +60,7 @@ class AxisRunner final : private ControllerSink {
   void send_reply(CommandId id, ReplyStatus status, std::string_view reason) noexcept;
   void emit(EventKind kind, std::uint32_t code, std::string_view text) noexcept;
   void check_command_timeout(TimePoint now) noexcept;
-  void build_snapshot(TimePoint now, LinkState link) noexcept;
+  void build_snapshot(TimePoint now) noexcept;
 
   AxisIndex index_;
   const AxisSpec& spec_;

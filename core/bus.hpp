@@ -48,6 +48,7 @@ class Bus {
   virtual void receive(TimePoint now) noexcept = 0;
   virtual void transmit(TimePoint now) noexcept = 0;
 
+  // May be called from any thread while the bus runs (implementations keep relaxed atomics).
   [[nodiscard]] virtual BusCounters counters() const noexcept = 0;
 };
 

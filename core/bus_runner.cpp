@@ -12,6 +12,7 @@ BusRunner::BusRunner(Bus& bus, const std::vector<AxisSpec>& specs)
 
 void BusRunner::cycle(TimePoint now) noexcept {
   bus_.receive(now);
+  for (std::size_t i = 0; i < axes_.size(); ++i) axes_[i].observe_link(now, bus_.link_state(i), *this);
 
   Command cmd;
   for (std::size_t n = 0; n < kMaxCommandsPerCycle && commands_.pop(cmd); ++n)
@@ -24,7 +25,7 @@ void BusRunner::cycle(TimePoint now) noexcept {
     if (pr.axis < axes_.size()) axes_[pr.axis].parameter(pr, now, *this);
 
   for (std::size_t i = 0; i < axes_.size(); ++i) {
-    axes_[i].update(now, bus_.link_state(i), *this);
+    axes_[i].update(now, *this);
     snapshots_[i].store(axes_[i].snapshot());
   }
   bus_.transmit(now);
