@@ -52,6 +52,7 @@ DriveModel::DriveModel(DriveModelConfig config) : config_(std::move(config)), od
   vl_scale_ = config_.vl_units_per_rps / config_.position_units_per_rev;
   populate_dictionary();
   mode_ = static_cast<std::int8_t>(od(obj::kModesOfOperation));
+  pos_ = demand_pos_ = config_.start_position;
   publish();
 }
 

@@ -64,6 +64,7 @@ struct DriveModelConfig {
 
   // Switches at physical motor positions (position units at power-up, before any homing). The
   // home switch is active at and above its position, a limit switch at and beyond its own.
+  double start_position = 0.0;  // where the motor stands at construction (position units)
   std::optional<double> home_switch_position;
   std::optional<double> negative_limit_position;
   std::optional<double> positive_limit_position;
