@@ -1,0 +1,531 @@
+#include "client/client.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <condition_variable>
+#include <deque>
+#include <map>
+#include <mutex>
+#include <random>
+#include <stdexcept>
+
+#include <fastdds/dds/core/status/PublicationMatchedStatus.hpp>
+#include <fastdds/dds/core/status/SubscriptionMatchedStatus.hpp>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/DataReaderListener.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+
+#include "drivegate.h"
+#include "idl/dds_node.hpp"
+
+namespace drivegate::client {
+
+namespace dds = eprosima::fastdds::dds;
+using SteadyClock = std::chrono::steady_clock;
+
+namespace {
+
+constexpr std::size_t kMaxEvents = 1000;
+constexpr Millis kPollSlice{50};
+// Gateways on one domain are discovered within a few hundred ms of each other.
+constexpr Millis kDiscoveryQuiet{1000};
+
+std::string default_name() {
+  char host[256] = {};
+  if (::gethostname(host, sizeof host - 1) != 0) host[0] = '\0';
+  std::random_device rd;
+  char suffix[16] = {};
+  std::snprintf(suffix, sizeof suffix, "%08x", rd());
+  return std::string(host[0] != '\0' ? host : "host") + "-" + std::to_string(::getpid()) + "-" + suffix;
+}
+
+std::string join(const std::vector<std::string>& v) {
+  std::string s;
+  for (const auto& x : v) {
+    if (!s.empty()) s += ", ";
+    s += x;
+  }
+  return s;
+}
+
+struct ReplyRecord {
+  std::string gateway;
+  std::string status;
+  std::string reason;
+};
+
+}  // namespace
+
+std::string_view to_string(Outcome o) noexcept {
+  switch (o) {
+    case Outcome::Accepted: return "accepted";
+    case Outcome::Completed: return "completed";
+    case Outcome::Rejected: return "rejected";
+    case Outcome::Failed: return "failed";
+    case Outcome::Timeout: return "timeout";
+    case Outcome::NoGateway: return "no_gateway";
+  }
+  return "unknown";
+}
+
+class Client::Impl : public dds::DataReaderListener {
+ public:
+  explicit Impl(ClientOptions options) : opt_(std::move(options)) {
+    if (opt_.name.empty()) opt_.name = default_name();
+    node_ = std::make_unique<msg::DdsNode>(opt_.domain, opt_.ns, "drivegate-client/" + opt_.name);
+    cmd_w_ = &node_->writer(msg::TopicId::AxisCommand);
+    sp_w_ = &node_->writer(msg::TopicId::Setpoint);
+    param_w_ = &node_->writer(msg::TopicId::ParamRequest);
+    // Transient-local history can be delivered while create_datareader() is still running, before
+    // the reader pointers below are known to on_data_available(). So: create all readers without a
+    // listener, then attach it and take whatever already arrived.
+    info_r_ = &node_->reader(msg::TopicId::GatewayInfo, nullptr, dds::StatusMask::none());
+    state_r_ = &node_->reader(msg::TopicId::AxisState, nullptr, dds::StatusMask::none());
+    reply_r_ = &node_->reader(msg::TopicId::CommandReply, nullptr, dds::StatusMask::none());
+    event_r_ = &node_->reader(msg::TopicId::AxisEvent, nullptr, dds::StatusMask::none());
+    bus_r_ = &node_->reader(msg::TopicId::BusStatus, nullptr, dds::StatusMask::none());
+    param_r_ = &node_->reader(msg::TopicId::ParamReply, nullptr, dds::StatusMask::none());
+    for (dds::DataReader* r : {info_r_, state_r_, reply_r_, event_r_, bus_r_, param_r_}) {
+      r->set_listener(this, dds::StatusMask::data_available());
+      on_data_available(r);
+    }
+  }
+  // The readers call back into this object: delete them before anything else goes.
+  ~Impl() override { node_.reset(); }
+  Impl(const Impl&) = delete;
+  Impl& operator=(const Impl&) = delete;
+
+  void on_data_available(dds::DataReader* reader) override {
+    if (reader == info_r_) take_infos();
+    else if (reader == state_r_) take_states();
+    else if (reader == reply_r_) take_replies();
+    else if (reader == event_r_) take_events();
+    else if (reader == bus_r_) take_buses();
+    else if (reader == param_r_) take_param_replies();
+    {
+      std::lock_guard lock(mutex_);
+      ++generation_;
+    }
+    cv_.notify_all();
+  }
+
+  bool wait_until(const std::function<bool()>& condition, Millis timeout) const {
+    const auto deadline = SteadyClock::now() + timeout;
+    for (;;) {
+      std::uint64_t gen = 0;
+      {
+        std::lock_guard lock(mutex_);
+        gen = generation_;
+      }
+      if (condition()) return true;
+      const auto now = SteadyClock::now();
+      if (now >= deadline) return false;
+      std::unique_lock lock(mutex_);
+      cv_.wait_until(lock, std::min(deadline, now + kPollSlice), [&] { return generation_ != gen; });
+    }
+  }
+
+  Route route(std::string_view axis, std::string_view gateway) const {
+    std::lock_guard lock(mutex_);
+    if (!gateway.empty()) {
+      const auto it = gateways_.find(std::string(gateway));
+      if (it == gateways_.end())
+        return {{}, "gateway '" + std::string(gateway) + "' is not known; known gateways: " + known_gateways_locked()};
+      // A named gateway is asked even when discovery does not list the axis there: the gateway's
+      // own answer is authoritative (and says which axes it has) where discovery may be stale.
+      return {std::string(gateway), {}};
+    }
+    std::vector<std::string> owners;
+    for (const auto& [name, g] : gateways_)
+      for (const auto& a : g.axes)
+        if (a.name == axis) owners.push_back(name);
+    if (owners.size() == 1) return {owners.front(), {}};
+    if (owners.empty())
+      return {{}, "no gateway owns axis '" + std::string(axis) + "'; known axes: " + known_axes_locked()};
+    return {{}, "axis '" + std::string(axis) + "' is claimed by several gateways (" + join(owners) +
+                    "); name one with --gateway"};
+  }
+
+  CommandResult send(const CommandRequest& req, bool wait_final, Millis timeout) {
+    const auto deadline = SteadyClock::now() + timeout;
+    CommandResult result;
+    result.axis = req.axis;
+    const Route r = wait_route(req.axis, req.gateway, timeout);
+    if (!r.error.empty()) {
+      result.outcome = Outcome::NoGateway;
+      result.reason = r.error;
+      return result;
+    }
+    result.gateway = r.gateway;
+    ensure_matched(deadline);
+
+    msg::AxisCommand out;
+    out.gateway(r.gateway);
+    out.axis(req.axis);
+    out.client(opt_.name);
+    result.id = next_id_++;
+    out.id(result.id);
+    out.kind(req.kind);
+    out.mode(req.mode);
+    out.position(req.position);
+    out.velocity(req.velocity);
+    out.acceleration(req.acceleration);
+    out.deceleration(req.deceleration);
+    out.torque(req.torque);
+    out.relative(req.relative);
+    out.immediate(req.immediate);
+    out.homing_method(req.homing_method);
+    out.home_offset(req.home_offset);
+    out.homing_search_velocity(req.homing_search_velocity);
+    out.homing_zero_velocity(req.homing_zero_velocity);
+    out.block(req.block);
+    {
+      std::lock_guard lock(mutex_);
+      replies_[result.id];  // from now on, replies with this id are kept
+    }
+    cmd_w_->write(&out);
+
+    std::unique_lock lock(mutex_);
+    bool accepted = false;
+    for (;;) {
+      auto& queue = replies_[result.id];
+      while (!queue.empty()) {
+        ReplyRecord rec = std::move(queue.front());
+        queue.pop_front();
+        if (rec.status == "accepted") {
+          accepted = true;
+          result.outcome = Outcome::Accepted;
+          result.reason = rec.reason;
+          if (!wait_final) {
+            replies_.erase(result.id);
+            return result;
+          }
+          continue;
+        }
+        result.outcome = rec.status == "completed" ? Outcome::Completed
+                         : rec.status == "rejected" ? Outcome::Rejected
+                                                    : Outcome::Failed;
+        result.reason = rec.reason;
+        replies_.erase(result.id);
+        return result;
+      }
+      if (cv_.wait_until(lock, deadline) == std::cv_status::timeout && replies_[result.id].empty()) {
+        replies_.erase(result.id);
+        result.outcome = Outcome::Timeout;
+        result.reason = accepted ? "gateway '" + r.gateway + "' accepted the command but did not finish it in time"
+                                 : "no reply from gateway '" + r.gateway + "' in time";
+        return result;
+      }
+    }
+  }
+
+  std::string stream_setpoint(std::string_view axis, std::string_view gateway, double position, double velocity,
+                              double torque) {
+    const Route r = route(axis, gateway);
+    if (!r.error.empty()) return r.error;
+    msg::Setpoint out;
+    out.gateway(r.gateway);
+    out.axis(std::string(axis));
+    out.client(opt_.name);
+    out.position(position);
+    out.velocity(velocity);
+    out.torque(torque);
+    out.seq(++setpoint_seq_);
+    if (!sp_w_->write(&out)) return "set-point could not be written";
+    return {};
+  }
+
+  ParamResult param(const ParamRequest& req, Millis timeout) {
+    const auto deadline = SteadyClock::now() + timeout;
+    ParamResult result;
+    const Route r = wait_route(req.axis, req.gateway, timeout);
+    if (!r.error.empty()) {
+      result.error = r.error;
+      return result;
+    }
+    result.gateway = r.gateway;
+    ensure_matched(deadline);
+    msg::ParamRequest out;
+    out.gateway(r.gateway);
+    out.axis(req.axis);
+    out.client(opt_.name);
+    const std::uint64_t id = next_id_++;
+    out.id(id);
+    out.write(req.write);
+    out.index(req.index);
+    out.subindex(req.subindex);
+    out.size(req.size);
+    out.is_signed(req.is_signed);
+    out.value(req.value);
+    {
+      std::lock_guard lock(mutex_);
+      param_replies_[id];
+    }
+    param_w_->write(&out);
+    std::unique_lock lock(mutex_);
+    if (!cv_.wait_until(lock, deadline, [&] { return param_replies_[id].has_value(); })) {
+      param_replies_.erase(id);
+      result.error = "no parameter reply from gateway '" + r.gateway + "' in time";
+      return result;
+    }
+    const ParamResult got = *param_replies_[id];
+    param_replies_.erase(id);
+    return got;
+  }
+
+  std::vector<GatewayInfo> gateways() const {
+    std::lock_guard lock(mutex_);
+    std::vector<GatewayInfo> v;
+    for (const auto& [name, g] : gateways_) v.push_back(g);
+    return v;
+  }
+  std::vector<AxisState> states() const {
+    std::lock_guard lock(mutex_);
+    std::vector<AxisState> v;
+    for (const auto& [key, s] : states_) v.push_back(s);
+    return v;
+  }
+  std::optional<AxisState> state(std::string_view axis, std::string_view gateway) const {
+    std::lock_guard lock(mutex_);
+    for (const auto& [key, s] : states_)
+      if (s.axis == axis && (gateway.empty() || s.gateway == gateway)) return s;
+    return std::nullopt;
+  }
+  std::vector<BusStatus> buses() const {
+    std::lock_guard lock(mutex_);
+    std::vector<BusStatus> v;
+    for (const auto& [key, b] : buses_) v.push_back(b);
+    return v;
+  }
+  std::vector<AxisEvent> events_since(std::uint64_t& cursor) const {
+    std::lock_guard lock(mutex_);
+    std::vector<AxisEvent> v;
+    const std::uint64_t first = events_end_ - events_.size();
+    for (std::uint64_t i = std::max(cursor, first); i < events_end_; ++i) v.push_back(events_[i - first]);
+    cursor = events_end_;
+    return v;
+  }
+  const std::string& name() const noexcept { return opt_.name; }
+
+ private:
+  // The route for an axis, waiting for discovery: until the axis has an owner, or gateways are known
+  // and none appeared for a while (then the axis really is unknown and waiting longer is pointless).
+  Route wait_route(std::string_view axis, std::string_view gateway, Millis timeout) const {
+    Route r;
+    wait_until(
+        [&] {
+          r = route(axis, gateway);
+          if (r.error.empty()) return true;
+          std::lock_guard lock(mutex_);
+          return !gateways_.empty() && SteadyClock::now() - last_info_change_ >= kDiscoveryQuiet;
+        },
+        timeout);
+    return r;
+  }
+
+  // A reliable volatile sample written before the gateway's reader matched us would be lost, and so
+  // would a reply written before our reply reader matched. Wait (bounded) until every known gateway
+  // can be reached both ways.
+  void ensure_matched(SteadyClock::time_point deadline) const {
+    wait_until(
+        [&] {
+          std::size_t gateways = 0;
+          {
+            std::lock_guard lock(mutex_);
+            gateways = gateways_.size();
+          }
+          dds::PublicationMatchedStatus cmd{};
+          dds::PublicationMatchedStatus par{};
+          dds::SubscriptionMatchedStatus rep{};
+          dds::SubscriptionMatchedStatus prep{};
+          cmd_w_->get_publication_matched_status(cmd);
+          param_w_->get_publication_matched_status(par);
+          reply_r_->get_subscription_matched_status(rep);
+          param_r_->get_subscription_matched_status(prep);
+          const auto n = static_cast<std::int32_t>(gateways);
+          return cmd.current_count >= n && par.current_count >= n && rep.current_count >= n &&
+                 prep.current_count >= n;
+        },
+        std::chrono::duration_cast<Millis>(deadline - SteadyClock::now()));
+  }
+
+  std::string known_gateways_locked() const {
+    std::vector<std::string> v;
+    for (const auto& [name, g] : gateways_) v.push_back(name);
+    return v.empty() ? "(none discovered)" : join(v);
+  }
+  std::string known_axes_locked() const {
+    std::vector<std::string> v;
+    for (const auto& [name, g] : gateways_)
+      for (const auto& a : g.axes) v.push_back(name + "/" + a.name);
+    return v.empty() ? "(no gateway discovered)" : join(v);
+  }
+
+  void take_infos() {
+    msg::GatewayInfo in;
+    dds::SampleInfo si;
+    while (info_r_->take_next_sample(&in, &si) == ReturnCode_t::RETCODE_OK) {
+      std::lock_guard lock(mutex_);
+      if (!si.valid_data) {
+        // The gateway went away (disposed or no writers left): forget what it owned.
+        if (si.instance_state != dds::ALIVE_INSTANCE_STATE) {
+          const auto it = info_handles_.find(si.instance_handle);
+          if (it != info_handles_.end()) {
+            gateways_.erase(it->second);
+            info_handles_.erase(it);
+            last_info_change_ = SteadyClock::now();
+          }
+        }
+        continue;
+      }
+      GatewayInfo g;
+      g.name = in.gateway();
+      g.host = in.host();
+      g.pid = in.pid();
+      for (const auto& a : in.axes())
+        g.axes.push_back({in.gateway(), a.name(), a.bus(), a.device(), a.unit(), a.modes()});
+      info_handles_[si.instance_handle] = g.name;
+      gateways_[g.name] = std::move(g);
+      last_info_change_ = SteadyClock::now();
+    }
+  }
+
+  void take_states() {
+    msg::AxisState in;
+    dds::SampleInfo si;
+    while (state_r_->take_next_sample(&in, &si) == ReturnCode_t::RETCODE_OK) {
+      if (!si.valid_data) continue;
+      AxisState s;
+      s.gateway = in.gateway();
+      s.axis = in.axis();
+      s.state = in.state();
+      s.link = in.link();
+      s.mode = in.mode();
+      s.position = in.position();
+      s.velocity = in.velocity();
+      s.torque = in.torque();
+      s.unit = in.unit();
+      s.fault_code = in.fault_code();
+      s.fault_text = in.fault_text();
+      s.target_reached = in.target_reached();
+      s.homed = in.homed();
+      s.warning = in.warning();
+      s.stopping = in.stopping();
+      s.following_error = in.following_error();
+      s.statusword = in.statusword();
+      s.active_command = in.active_command();
+      s.stamp_ns = in.stamp();
+      s.seq = in.seq();
+      s.received = SteadyClock::now();
+      std::lock_guard lock(mutex_);
+      states_[{s.gateway, s.axis}] = std::move(s);
+    }
+  }
+
+  void take_replies() {
+    msg::CommandReply in;
+    dds::SampleInfo si;
+    while (reply_r_->take_next_sample(&in, &si) == ReturnCode_t::RETCODE_OK) {
+      if (!si.valid_data || in.client() != opt_.name) continue;
+      std::lock_guard lock(mutex_);
+      const auto it = replies_.find(in.id());
+      if (it != replies_.end()) it->second.push_back({in.gateway(), in.status(), in.reason()});
+    }
+  }
+
+  void take_events() {
+    msg::AxisEvent in;
+    dds::SampleInfo si;
+    while (event_r_->take_next_sample(&in, &si) == ReturnCode_t::RETCODE_OK) {
+      if (!si.valid_data) continue;
+      std::lock_guard lock(mutex_);
+      events_.push_back({in.gateway(), in.axis(), in.bus(), in.kind(), in.state(), in.code(), in.text(), in.stamp()});
+      ++events_end_;
+      if (events_.size() > kMaxEvents) events_.pop_front();
+    }
+  }
+
+  void take_buses() {
+    msg::BusStatus in;
+    dds::SampleInfo si;
+    while (bus_r_->take_next_sample(&in, &si) == ReturnCode_t::RETCODE_OK) {
+      if (!si.valid_data) continue;
+      BusStatus b{in.gateway(),        in.bus(),         in.type(),
+                  in.running(),        in.healthy(),     in.period_ns(),
+                  in.achieved_period_ns(), in.lateness_p50_ns(), in.lateness_p99_ns(),
+                  in.lateness_max_ns(), in.cycles(),      in.overruns(),
+                  in.frames_sent(),    in.frames_received(), in.frames_lost(),
+                  in.frames_dropped(), in.errors()};
+      std::lock_guard lock(mutex_);
+      buses_[{b.gateway, b.bus}] = std::move(b);
+    }
+  }
+
+  void take_param_replies() {
+    msg::ParamReply in;
+    dds::SampleInfo si;
+    while (param_r_->take_next_sample(&in, &si) == ReturnCode_t::RETCODE_OK) {
+      if (!si.valid_data || in.client() != opt_.name) continue;
+      std::lock_guard lock(mutex_);
+      const auto it = param_replies_.find(in.id());
+      if (it != param_replies_.end())
+        it->second = ParamResult{in.ok(), in.gateway(), in.value(), in.error_code(), in.error()};
+    }
+  }
+
+  ClientOptions opt_;
+  std::unique_ptr<msg::DdsNode> node_;
+  dds::DataWriter* cmd_w_ = nullptr;
+  dds::DataWriter* sp_w_ = nullptr;
+  dds::DataWriter* param_w_ = nullptr;
+  dds::DataReader* info_r_ = nullptr;
+  dds::DataReader* state_r_ = nullptr;
+  dds::DataReader* reply_r_ = nullptr;
+  dds::DataReader* event_r_ = nullptr;
+  dds::DataReader* bus_r_ = nullptr;
+  dds::DataReader* param_r_ = nullptr;
+
+  std::atomic<std::uint64_t> next_id_{1};
+  std::atomic<std::uint64_t> setpoint_seq_{0};
+
+  mutable std::mutex mutex_;
+  mutable std::condition_variable cv_;
+  std::uint64_t generation_ = 0;
+  std::map<std::string, GatewayInfo> gateways_;
+  std::map<dds::InstanceHandle_t, std::string> info_handles_;
+  SteadyClock::time_point last_info_change_;
+  std::map<std::pair<std::string, std::string>, AxisState> states_;
+  std::map<std::pair<std::string, std::string>, BusStatus> buses_;
+  std::deque<AxisEvent> events_;
+  std::uint64_t events_end_ = 0;  // number of events ever received
+  std::map<std::uint64_t, std::deque<ReplyRecord>> replies_;
+  std::map<std::uint64_t, std::optional<ParamResult>> param_replies_;
+};
+
+Client::Client(ClientOptions options) : impl_(std::make_unique<Impl>(std::move(options))) {}
+Client::~Client() = default;
+const std::string& Client::name() const noexcept { return impl_->name(); }
+std::vector<GatewayInfo> Client::gateways() const { return impl_->gateways(); }
+std::vector<AxisState> Client::states() const { return impl_->states(); }
+std::optional<AxisState> Client::state(std::string_view axis, std::string_view gateway) const {
+  return impl_->state(axis, gateway);
+}
+std::vector<BusStatus> Client::buses() const { return impl_->buses(); }
+std::vector<AxisEvent> Client::events_since(std::uint64_t& cursor) const { return impl_->events_since(cursor); }
+bool Client::wait_until(const std::function<bool()>& condition, Millis timeout) const {
+  return impl_->wait_until(condition, timeout);
+}
+Route Client::route(std::string_view axis, std::string_view gateway) const { return impl_->route(axis, gateway); }
+CommandResult Client::send(const CommandRequest& request, bool wait_final, Millis timeout) {
+  return impl_->send(request, wait_final, timeout);
+}
+std::string Client::stream_setpoint(std::string_view axis, std::string_view gateway, double position,
+                                    double velocity, double torque) {
+  return impl_->stream_setpoint(axis, gateway, position, velocity, torque);
+}
+ParamResult Client::param(const ParamRequest& request, Millis timeout) { return impl_->param(request, timeout); }
+
+}  // namespace drivegate::client

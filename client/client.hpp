@@ -1,0 +1,205 @@
+#pragma once
+// drivegate client library: discovers gateways and axes over DDS, keeps the latest state of every
+// axis, sends commands and waits for their replies, streams set-points, collects events, reads and
+// writes drive parameters. Thread-safe: DDS delivers into internal tables under a mutex, and every
+// public call may come from any thread.
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace drivegate::client {
+
+using Millis = std::chrono::milliseconds;
+
+struct ClientOptions {
+  std::uint32_t domain = 0;
+  std::string ns = "drivegate";
+  std::string name;  // empty: "<hostname>-<pid>-<random>"
+};
+
+struct AxisInfo {
+  std::string gateway;
+  std::string name;
+  std::string bus;
+  std::string device;
+  std::string unit;
+  std::vector<std::string> modes;
+};
+
+struct GatewayInfo {
+  std::string name;
+  std::string host;
+  std::uint32_t pid = 0;
+  std::vector<AxisInfo> axes;
+};
+
+struct AxisState {
+  std::string gateway;
+  std::string axis;
+  std::string state;
+  std::string link;
+  std::string mode;
+  double position = 0;
+  double velocity = 0;
+  double torque = 0;
+  std::string unit;
+  std::uint32_t fault_code = 0;
+  std::string fault_text;
+  bool target_reached = false;
+  bool homed = false;
+  bool warning = false;
+  bool stopping = false;
+  bool following_error = false;
+  std::uint16_t statusword = 0;
+  std::uint64_t active_command = 0;
+  std::int64_t stamp_ns = 0;
+  std::uint64_t seq = 0;
+  std::chrono::steady_clock::time_point received;
+};
+
+struct AxisEvent {
+  std::string gateway;
+  std::string axis;  // empty for bus events
+  std::string bus;
+  std::string kind;
+  std::string state;
+  std::uint32_t code = 0;
+  std::string text;
+  std::int64_t stamp_ns = 0;
+};
+
+struct BusStatus {
+  std::string gateway;
+  std::string bus;
+  std::string type;
+  bool running = false;
+  bool healthy = false;
+  std::int64_t period_ns = 0;
+  std::int64_t achieved_period_ns = 0;
+  std::int64_t lateness_p50_ns = 0;
+  std::int64_t lateness_p99_ns = 0;
+  std::int64_t lateness_max_ns = 0;
+  std::uint64_t cycles = 0;
+  std::uint64_t overruns = 0;
+  std::uint64_t frames_sent = 0;
+  std::uint64_t frames_received = 0;
+  std::uint64_t frames_lost = 0;
+  std::uint64_t frames_dropped = 0;
+  std::uint64_t errors = 0;
+};
+
+// Mirrors core::Command in user units; kind/mode use the names of core/axis_types.cpp.
+struct CommandRequest {
+  std::string axis;
+  std::string gateway;  // empty: the gateway that owns the axis (from discovery)
+  std::string kind;
+  std::string mode;
+  double position = 0;
+  double velocity = 0;
+  double acceleration = 0;
+  double deceleration = 0;
+  double torque = 0;
+  bool relative = false;
+  bool immediate = true;
+  std::int16_t homing_method = 0;
+  double home_offset = 0;
+  double homing_search_velocity = 0;
+  double homing_zero_velocity = 0;
+  std::int32_t block = 0;
+};
+
+enum class Outcome {
+  Accepted,   // accepted, final outcome not awaited
+  Completed,
+  Rejected,
+  Failed,
+  Timeout,    // the gateway did not answer in time
+  NoGateway,  // no gateway owns the axis (or the named gateway is unknown)
+};
+std::string_view to_string(Outcome o) noexcept;
+
+struct CommandResult {
+  Outcome outcome = Outcome::Timeout;
+  std::string gateway;
+  std::string axis;
+  std::uint64_t id = 0;
+  std::string reason;  // gateway's reason, or ours for Timeout/NoGateway
+  [[nodiscard]] bool ok() const noexcept { return outcome == Outcome::Accepted || outcome == Outcome::Completed; }
+};
+
+struct ParamRequest {
+  std::string axis;
+  std::string gateway;  // empty: owner from discovery
+  bool write = false;
+  std::uint16_t index = 0;
+  std::uint8_t subindex = 0;
+  std::uint8_t size = 4;
+  bool is_signed = false;
+  std::int64_t value = 0;
+};
+
+struct ParamResult {
+  bool ok = false;
+  std::string gateway;
+  std::int64_t value = 0;
+  std::uint32_t error_code = 0;
+  std::string error;
+};
+
+// Which gateway a request goes to, or why none.
+struct Route {
+  std::string gateway;
+  std::string error;  // non-empty: no route
+};
+
+class Client {
+ public:
+  // Throws std::runtime_error when DDS cannot be set up.
+  explicit Client(ClientOptions options);
+  ~Client();
+  Client(const Client&) = delete;
+  Client& operator=(const Client&) = delete;
+
+  [[nodiscard]] const std::string& name() const noexcept;
+
+  // Discovery and latest data (copies, sorted by gateway then axis).
+  [[nodiscard]] std::vector<GatewayInfo> gateways() const;
+  [[nodiscard]] std::vector<AxisState> states() const;
+  [[nodiscard]] std::optional<AxisState> state(std::string_view axis, std::string_view gateway = {}) const;
+  [[nodiscard]] std::vector<BusStatus> buses() const;
+
+  // Events in arrival order. `cursor` starts at 0 and is advanced past the returned events; at most
+  // the newest 1000 are kept.
+  [[nodiscard]] std::vector<AxisEvent> events_since(std::uint64_t& cursor) const;
+
+  // Polls `condition` whenever new data arrives (and at least every 50 ms) until it holds or the
+  // timeout passes. `condition` may call this client's other methods.
+  bool wait_until(const std::function<bool()>& condition, Millis timeout) const;
+
+  // The gateway for `axis`: `gateway` if given and known, else the one gateway that owns it.
+  [[nodiscard]] Route route(std::string_view axis, std::string_view gateway = {}) const;
+
+  // Sends a command and waits for Accepted/Rejected, then (wait_final) for Completed/Failed, all
+  // within `timeout`. Waits for discovery of the axis' owner within the same budget (less when gateways are known
+  // and none has appeared for a second: then the axis is unknown).
+  CommandResult send(const CommandRequest& request, bool wait_final, Millis timeout);
+
+  // Best-effort set-point (also the keep-alive of velocity/torque/cyclic commands). Returns an
+  // error text, empty on success.
+  std::string stream_setpoint(std::string_view axis, std::string_view gateway, double position, double velocity,
+                              double torque);
+
+  ParamResult param(const ParamRequest& request, Millis timeout);
+
+  class Impl;
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace drivegate::client

@@ -1,0 +1,545 @@
+// drivegatectl: command-line client of drivegated (see --help).
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+#include <string>
+#include <thread>
+
+#include "client/cli_args.hpp"
+#include "client/client.hpp"
+#include "client/discovery.hpp"
+#include "client/interrupt.hpp"
+#include "client/json_writer.hpp"
+#include "client/status_table.hpp"
+
+namespace {
+
+using namespace drivegate::client;
+using SteadyClock = std::chrono::steady_clock;
+using StringSet = std::set<std::string, std::less<>>;
+
+struct CommandHelp {
+  const char* name;
+  const char* usage;
+  const char* text;
+  std::size_t min_words = 0;  // positional words after the command name, checked before discovery
+  std::size_t max_words = 0;
+};
+constexpr std::size_t kAny = 64;
+
+constexpr CommandHelp kCommands[] = {
+    {"list", "list", "gateways and their axes (bus, device, unit, modes)", 0, 0},
+    {"status", "status [AXIS...] [--watch]", "axis table; --watch redraws it at 10 Hz until Ctrl-C", 0, kAny},
+    {"enable", "enable AXIS", "walk the axis to operation enabled", 1, 1},
+    {"disable", "disable AXIS", "disable the drive (power stage off)", 1, 1},
+    {"stop", "stop AXIS", "bring the axis to standstill, keep it enabled", 1, 1},
+    {"quick-stop", "quick-stop AXIS", "quick stop (fast ramp, then disabled)", 1, 1},
+    {"halt", "halt AXIS", "halt the running motion", 1, 1},
+    {"resume", "resume AXIS", "resume after halt", 1, 1},
+    {"reset", "reset AXIS", "acknowledge a drive fault", 1, 1},
+    {"mode", "mode AXIS MODE", "select the mode (pp, pv, vl, tq, hm, ip, csp, csv, cst, tb or long names)", 2, 2},
+    {"move", "move AXIS POS [--relative] [--velocity V] [--accel A] [--decel D] [--queued] [--no-wait]",
+     "profile position move; waits for target reached unless --no-wait", 2, 2},
+    {"velocity", "velocity AXIS V [--accel A] [--for SECONDS]",
+     "jog at V, streaming keep-alive set-points until --for elapses or Ctrl-C, then stop", 2, 2},
+    {"torque", "torque AXIS T [--for SECONDS]", "torque T, kept alive like velocity, then stop", 2, 2},
+    {"home", "home AXIS [--method M] [--offset O]", "run homing and wait until it is attained", 1, 1},
+    {"events", "events [--follow] [AXIS]", "recent events (faults, warnings, state changes); --follow keeps printing",
+     0, 1},
+    {"param",
+     "param get AXIS INDEX[:SUB] [--size 1|2|4] [--signed]\n"
+     "  param set AXIS INDEX[:SUB] VALUE [--size 1|2|4] [--signed]",
+     "read/write a drive object; INDEX is hex (0x optional), SUB decimal or 0x-hex", 3, 4},
+    {"buses", "buses", "bus status: cycle timing, lateness, frame counters", 0, 0},
+};
+
+void print_usage(std::ostream& os) {
+  os << "usage: drivegatectl [--domain N] [--namespace NS] [--gateway G] [--json] [--timeout S] <command> ...\n\n"
+        "commands:\n";
+  for (const auto& c : kCommands) os << "  " << c.usage << "\n      " << c.text << "\n";
+  os << "\n--domain N      DDS domain id (default 0)\n"
+        "--namespace NS  topic namespace (default drivegate)\n"
+        "--gateway G     address gateway G (needed when several gateways claim an axis)\n"
+        "--json          one JSON object per result on stdout\n"
+        "--timeout S     seconds to wait for discovery and replies (default 5)\n"
+        "exit status: 0 success, 1 rejected/failed/timed out/no gateway, 2 usage error\n";
+}
+
+void print_command_usage(std::string_view name) {
+  for (const auto& c : kCommands)
+    if (name == c.name) {
+      std::cout << "usage: drivegatectl [global options] " << c.usage << "\n  " << c.text << "\n";
+      return;
+    }
+  print_usage(std::cout);
+}
+
+struct Context {
+  Client& client;
+  const Args& args;
+  bool json = false;
+  Millis timeout{5000};
+  std::string gateway;
+  std::vector<std::string> words;  // positional words after the command name
+};
+
+const std::string& word(const Context& ctx, std::size_t i, const char* what) {
+  if (i >= ctx.words.size()) throw UsageError(std::string("missing ") + what);
+  return ctx.words[i];
+}
+
+void expect_words(const Context& ctx, std::size_t n) {
+  if (ctx.words.size() > n) throw UsageError("unexpected argument '" + ctx.words[n] + "'");
+}
+
+int fail(const std::string& message) {
+  std::cerr << "drivegatectl: " << message << "\n";
+  return 1;
+}
+
+int require_gateways(const Context& ctx) {
+  if (discover_gateways(ctx.client, ctx.gateway, ctx.timeout)) return 0;
+  return fail(ctx.gateway.empty() ? "no gateway answered on this domain/namespace"
+                                  : "gateway '" + ctx.gateway + "' did not answer");
+}
+
+int report(const Context& ctx, std::string_view command, const CommandResult& r) {
+  if (ctx.json) {
+    JsonWriter w;
+    w.begin_object()
+        .field("command", command)
+        .field("axis", std::string_view(r.axis))
+        .field("gateway", std::string_view(r.gateway))
+        .field("id", r.id)
+        .field("status", to_string(r.outcome))
+        .field("ok", r.ok())
+        .field("reason", std::string_view(r.reason))
+        .end_object();
+    std::cout << w.str() << std::endl;
+  } else if (r.ok()) {
+    std::cout << command << " " << r.axis << " (" << r.gateway << "): " << to_string(r.outcome)
+              << (r.reason.empty() ? "" : ": " + r.reason) << std::endl;
+  }
+  if (r.ok()) return 0;
+  return fail(std::string(command) + " " + r.axis + ": " + std::string(to_string(r.outcome)) +
+              (r.reason.empty() ? "" : ": " + r.reason));
+}
+
+CommandRequest request(const Context& ctx, std::string kind) {
+  CommandRequest req;
+  req.axis = word(ctx, 0, "AXIS");
+  req.gateway = ctx.gateway;
+  req.kind = std::move(kind);
+  return req;
+}
+
+int cmd_list(Context& ctx) {
+  expect_words(ctx, 0);
+  for (const auto& g : ctx.client.gateways()) {
+    if (!ctx.gateway.empty() && g.name != ctx.gateway) continue;
+    if (ctx.json) {
+      JsonWriter w;
+      w.begin_object().field("gateway", std::string_view(g.name)).field("host", std::string_view(g.host));
+      w.field("pid", static_cast<std::uint64_t>(g.pid)).key("axes").begin_array();
+      for (const auto& a : g.axes) {
+        w.begin_object()
+            .field("name", std::string_view(a.name))
+            .field("bus", std::string_view(a.bus))
+            .field("device", std::string_view(a.device))
+            .field("unit", std::string_view(a.unit))
+            .key("modes")
+            .begin_array();
+        for (const auto& m : a.modes) w.value(std::string_view(m));
+        w.end_array().end_object();
+      }
+      w.end_array().end_object();
+      std::cout << w.str() << "\n";
+      continue;
+    }
+    std::cout << "gateway " << g.name << " (" << g.host << ", pid " << g.pid << ")\n";
+    for (const auto& a : g.axes) {
+      std::string modes;
+      for (const auto& m : a.modes) modes += (modes.empty() ? "" : ",") + m;
+      std::cout << "  " << a.name << "  bus=" << a.bus << "  device=" << a.device << "  unit=" << a.unit
+                << "  modes=" << modes << "\n";
+    }
+  }
+  return 0;
+}
+
+std::vector<AxisState> selected_states(const Context& ctx) {
+  auto states = ctx.client.states();
+  std::erase_if(states, [&](const AxisState& s) {
+    if (!ctx.gateway.empty() && s.gateway != ctx.gateway) return true;
+    return !ctx.words.empty() && std::find(ctx.words.begin(), ctx.words.end(), s.axis) == ctx.words.end();
+  });
+  return states;
+}
+
+void print_state_json(const AxisState& s) {
+  JsonWriter w;
+  w.begin_object()
+      .field("gateway", std::string_view(s.gateway))
+      .field("axis", std::string_view(s.axis))
+      .field("state", std::string_view(s.state))
+      .field("link", std::string_view(s.link))
+      .field("mode", std::string_view(s.mode))
+      .field("position", s.position)
+      .field("velocity", s.velocity)
+      .field("torque", s.torque)
+      .field("unit", std::string_view(s.unit))
+      .field("fault_code", static_cast<std::uint64_t>(s.fault_code))
+      .field("fault_text", std::string_view(s.fault_text))
+      .field("target_reached", s.target_reached)
+      .field("homed", s.homed)
+      .field("warning", s.warning)
+      .field("stopping", s.stopping)
+      .field("statusword", static_cast<std::uint64_t>(s.statusword))
+      .end_object();
+  std::cout << w.str() << "\n";
+}
+
+int cmd_status(Context& ctx) {
+  // Wait until every requested axis (or every discovered one) has reported its state.
+  const auto wanted = [&] {
+    std::size_t n = 0;
+    for (const auto& g : ctx.client.gateways()) {
+      if (!ctx.gateway.empty() && g.name != ctx.gateway) continue;
+      for (const auto& a : g.axes)
+        if (ctx.words.empty() || std::find(ctx.words.begin(), ctx.words.end(), a.name) != ctx.words.end()) ++n;
+    }
+    return n;
+  };
+  ctx.client.wait_until([&] { return selected_states(ctx).size() >= wanted(); }, ctx.timeout);
+  if (ctx.args.flag("watch")) {
+    while (!interrupted()) {
+      const auto states = selected_states(ctx);
+      std::cout << kAnsiClearHome << format_status_table(states, SteadyClock::now())
+                << "\n(refreshing at 10 Hz, Ctrl-C to quit)" << std::flush;
+      std::this_thread::sleep_for(Millis(100));  // display pacing, not synchronisation
+    }
+    std::cout << "\n";
+    return 0;
+  }
+  const auto states = selected_states(ctx);
+  for (const auto& name : ctx.words)
+    if (std::none_of(states.begin(), states.end(), [&](const AxisState& s) { return s.axis == name; }))
+      return fail("no state for axis '" + name + "'");
+  if (ctx.json) {
+    for (const auto& s : states) print_state_json(s);
+  } else {
+    std::cout << format_status_table(states, SteadyClock::now());
+  }
+  return 0;
+}
+
+int cmd_simple(Context& ctx, std::string_view command, const char* kind) {
+  expect_words(ctx, 1);
+  return report(ctx, command, ctx.client.send(request(ctx, kind), true, ctx.timeout));
+}
+
+int cmd_mode(Context& ctx) {
+  expect_words(ctx, 2);
+  auto req = request(ctx, "set_mode");
+  req.mode = word(ctx, 1, "MODE");
+  return report(ctx, "mode", ctx.client.send(req, true, ctx.timeout));
+}
+
+int cmd_move(Context& ctx) {
+  expect_words(ctx, 2);
+  auto req = request(ctx, "move");
+  req.position = parse_number("POS", word(ctx, 1, "POS"));
+  req.relative = ctx.args.flag("relative");
+  req.immediate = !ctx.args.flag("queued");
+  req.velocity = ctx.args.number("velocity").value_or(0);
+  req.acceleration = ctx.args.number("accel").value_or(0);
+  req.deceleration = ctx.args.number("decel").value_or(0);
+  return report(ctx, "move", ctx.client.send(req, !ctx.args.flag("no-wait"), ctx.timeout));
+}
+
+// Set-points keep a velocity/torque command alive: the gateway stops an axis whose source is silent
+// for longer than its command timeout (DESIGN.md §4), typically a few hundred ms; 20 Hz is several
+// times faster than that needs.
+constexpr Millis kKeepAlivePeriod{50};
+
+int cmd_stream(Context& ctx, bool torque) {
+  expect_words(ctx, 2);
+  auto req = request(ctx, torque ? "torque" : "velocity");
+  const double value = parse_number(torque ? "T" : "V", word(ctx, 1, torque ? "T" : "V"));
+  if (torque) {
+    req.torque = value;
+  } else {
+    req.velocity = value;
+    req.acceleration = ctx.args.number("accel").value_or(0);
+  }
+  const auto duration = ctx.args.number("for");
+  if (duration && *duration <= 0) throw UsageError("--for must be positive");
+  const CommandResult started = ctx.client.send(req, false, ctx.timeout);
+  if (int rc = report(ctx, req.kind, started)) return rc;
+
+  const auto until = duration ? SteadyClock::now() + std::chrono::duration_cast<SteadyClock::duration>(
+                                                         std::chrono::duration<double>(*duration))
+                              : SteadyClock::time_point::max();
+  auto next = SteadyClock::now();
+  std::string error;
+  while (!interrupted() && SteadyClock::now() < until) {
+    error = ctx.client.stream_setpoint(req.axis, started.gateway, 0, torque ? 0 : value, torque ? value : 0);
+    if (!error.empty()) break;
+    next += kKeepAlivePeriod;
+    std::this_thread::sleep_until(std::min(next, until));
+  }
+  CommandRequest stop = req;
+  stop.kind = "stop";
+  stop.gateway = started.gateway;
+  const int rc = report(ctx, "stop", ctx.client.send(stop, true, ctx.timeout));
+  if (!error.empty()) return fail("set-point stream: " + error);
+  return rc;
+}
+
+int cmd_home(Context& ctx) {
+  expect_words(ctx, 1);
+  auto req = request(ctx, "home");
+  if (const auto m = ctx.args.option("method"))
+    req.homing_method = static_cast<std::int16_t>(parse_integer("--method", *m, -128, 127));
+  req.home_offset = ctx.args.number("offset").value_or(0);
+  return report(ctx, "home", ctx.client.send(req, true, ctx.timeout));
+}
+
+void print_event(const Context& ctx, const AxisEvent& e) {
+  if (ctx.json) {
+    JsonWriter w;
+    w.begin_object()
+        .field("gateway", std::string_view(e.gateway))
+        .field("axis", std::string_view(e.axis))
+        .field("bus", std::string_view(e.bus))
+        .field("kind", std::string_view(e.kind))
+        .field("state", std::string_view(e.state))
+        .field("code", static_cast<std::uint64_t>(e.code))
+        .field("text", std::string_view(e.text))
+        .field("stamp_ns", e.stamp_ns)
+        .end_object();
+    std::cout << w.str() << std::endl;
+    return;
+  }
+  char code[16] = "";
+  if (e.code != 0) std::snprintf(code, sizeof code, " 0x%04X", e.code);
+  std::cout << e.gateway << "/" << (e.axis.empty() ? "bus:" + e.bus : e.axis) << "  " << e.kind << code << "  "
+            << e.text << (e.state.empty() || e.state == "unknown" ? "" : "  [" + e.state + "]") << std::endl;
+}
+
+int cmd_events(Context& ctx) {
+  expect_words(ctx, 1);
+  const std::string axis = ctx.words.empty() ? "" : ctx.words[0];
+  std::uint64_t seen = 0;
+  auto count = [&] {
+    std::uint64_t cursor = 0;
+    return ctx.client.events_since(cursor).size();
+  };
+  // Transient-local history arrives right after matching; wait for it to stop growing.
+  wait_settled(ctx.client, count, Millis(300), ctx.timeout);
+  do {
+    for (const auto& e : ctx.client.events_since(seen)) {
+      if (!axis.empty() && e.axis != axis) continue;
+      if (!ctx.gateway.empty() && e.gateway != ctx.gateway) continue;
+      print_event(ctx, e);
+    }
+    if (!ctx.args.flag("follow")) break;
+    std::uint64_t probe = seen;
+    ctx.client.wait_until([&] { return interrupted() || !ctx.client.events_since(probe).empty(); }, Millis(200));
+  } while (!interrupted());
+  return 0;
+}
+
+struct ObjectAddress {
+  std::uint16_t index = 0;
+  std::uint8_t sub = 0;
+};
+
+ObjectAddress parse_address(std::string_view text) {
+  ObjectAddress a;
+  const auto colon = text.find(':');
+  std::string index(text.substr(0, colon));
+  if (index.size() > 2 && (index.substr(0, 2) == "0x" || index.substr(0, 2) == "0X")) index = index.substr(2);
+  if (!index.empty() && (index.back() == 'h' || index.back() == 'H')) index.pop_back();
+  a.index = static_cast<std::uint16_t>(parse_integer("INDEX", "0x" + index, 0, 0xFFFF));
+  if (colon != std::string_view::npos)
+    a.sub = static_cast<std::uint8_t>(parse_integer("SUB", text.substr(colon + 1), 0, 0xFF));
+  return a;
+}
+
+int cmd_param(Context& ctx) {
+  const std::string& op = word(ctx, 0, "get|set");
+  if (op != "get" && op != "set") throw UsageError("param: expected 'get' or 'set', got '" + op + "'");
+  const bool write = op == "set";
+  expect_words(ctx, write ? 4 : 3);
+  ParamRequest req;
+  req.axis = word(ctx, 1, "AXIS");
+  req.gateway = ctx.gateway;
+  const ObjectAddress addr = parse_address(word(ctx, 2, "INDEX[:SUB]"));
+  req.index = addr.index;
+  req.subindex = addr.sub;
+  req.write = write;
+  req.is_signed = ctx.args.flag("signed");
+  req.size = static_cast<std::uint8_t>(parse_integer("--size", ctx.args.option_or("size", "4"), 1, 4));
+  if (req.size == 3) throw UsageError("--size must be 1, 2 or 4");
+  if (write) {
+    const unsigned bits = 8U * req.size;
+    const std::int64_t min = req.is_signed ? -(std::int64_t{1} << (bits - 1)) : 0;
+    const std::int64_t max = req.is_signed ? (std::int64_t{1} << (bits - 1)) - 1 : (std::int64_t{1} << bits) - 1;
+    req.value = parse_integer("VALUE", word(ctx, 3, "VALUE"), min, max);
+  }
+  const ParamResult r = ctx.client.param(req, ctx.timeout);
+  char where[32];
+  std::snprintf(where, sizeof where, "%04X:%u", req.index, static_cast<unsigned>(req.subindex));
+  if (ctx.json) {
+    JsonWriter w;
+    w.begin_object()
+        .field("axis", std::string_view(req.axis))
+        .field("gateway", std::string_view(r.gateway))
+        .field("object", std::string_view(where))
+        .field("write", write)
+        .field("ok", r.ok)
+        .field("value", r.ok && !write ? r.value : req.value)
+        .field("error_code", static_cast<std::uint64_t>(r.error_code))
+        .field("error", std::string_view(r.error))
+        .end_object();
+    std::cout << w.str() << std::endl;
+  } else if (r.ok) {
+    if (write) {
+      std::cout << req.axis << " " << where << " = " << req.value << " written\n";
+    } else {
+      std::cout << req.axis << " " << where << " = " << r.value << "\n";
+    }
+  }
+  if (r.ok) return 0;
+  char code[24] = "";
+  if (r.error_code != 0) std::snprintf(code, sizeof code, " (0x%08X)", r.error_code);
+  if (r.error.find(code + 2, 0, 10) != std::string::npos) code[0] = '\0';  // the text already names it
+  return fail("param " + op + " " + req.axis + " " + where + ": " + r.error + code);
+}
+
+int cmd_buses(Context& ctx) {
+  expect_words(ctx, 0);
+  ctx.client.wait_until([&] { return !ctx.client.buses().empty(); }, std::min(ctx.timeout, Millis(1500)));
+  wait_settled(ctx.client, [&] { return ctx.client.buses().size(); }, Millis(300), Millis(1000));
+  for (const auto& b : ctx.client.buses()) {
+    if (!ctx.gateway.empty() && b.gateway != ctx.gateway) continue;
+    if (ctx.json) {
+      JsonWriter w;
+      w.begin_object()
+          .field("gateway", std::string_view(b.gateway))
+          .field("bus", std::string_view(b.bus))
+          .field("type", std::string_view(b.type))
+          .field("running", b.running)
+          .field("healthy", b.healthy)
+          .field("period_ns", b.period_ns)
+          .field("achieved_period_ns", b.achieved_period_ns)
+          .field("lateness_p50_ns", b.lateness_p50_ns)
+          .field("lateness_p99_ns", b.lateness_p99_ns)
+          .field("lateness_max_ns", b.lateness_max_ns)
+          .field("cycles", b.cycles)
+          .field("overruns", b.overruns)
+          .field("frames_sent", b.frames_sent)
+          .field("frames_received", b.frames_received)
+          .field("frames_lost", b.frames_lost)
+          .field("frames_dropped", b.frames_dropped)
+          .field("errors", b.errors)
+          .end_object();
+      std::cout << w.str() << "\n";
+      continue;
+    }
+    auto us = [](std::int64_t ns) { return std::to_string(ns / 1000) + "us"; };
+    std::cout << b.gateway << "/" << b.bus << " (" << b.type << ") " << (b.running ? "running" : "stopped")
+              << (b.healthy ? ", healthy" : ", UNHEALTHY") << "\n  period " << us(b.period_ns) << " achieved "
+              << us(b.achieved_period_ns) << "  lateness p50 " << us(b.lateness_p50_ns) << " p99 "
+              << us(b.lateness_p99_ns) << " max " << us(b.lateness_max_ns) << "\n  cycles " << b.cycles
+              << " overruns " << b.overruns << "  frames sent " << b.frames_sent << " received "
+              << b.frames_received << " lost " << b.frames_lost << " dropped " << b.frames_dropped << " errors "
+              << b.errors << "\n";
+  }
+  return 0;
+}
+
+const StringSet kGlobal{"domain", "namespace", "gateway", "json", "timeout", "help"};
+
+StringSet options_of(std::string_view command) {
+  StringSet s = kGlobal;
+  auto add = [&](std::initializer_list<const char*> names) { s.insert(names.begin(), names.end()); };
+  if (command == "status") add({"watch"});
+  if (command == "move") add({"relative", "velocity", "accel", "decel", "queued", "no-wait"});
+  if (command == "velocity") add({"accel", "for"});
+  if (command == "torque") add({"for"});
+  if (command == "home") add({"method", "offset"});
+  if (command == "events") add({"follow"});
+  if (command == "param") add({"size", "signed"});
+  return s;
+}
+
+int run(int argc, char** argv) {
+  const Args args(argc, argv, {"json", "watch", "relative", "queued", "no-wait", "follow", "signed", "help"});
+  if (args.positional().empty()) {
+    if (args.flag("help")) {
+      print_usage(std::cout);
+      return 0;
+    }
+    print_usage(std::cerr);
+    return 2;
+  }
+  const std::string command = args.positional().front();
+  if (args.flag("help")) {
+    print_command_usage(command);
+    return 0;
+  }
+  const auto* help = std::find_if(std::begin(kCommands), std::end(kCommands),
+                                  [&](const CommandHelp& c) { return command == c.name; });
+  if (help == std::end(kCommands)) throw UsageError("unknown command '" + command + "'");
+  args.reject_unknown(options_of(command));
+  const std::size_t words = args.positional().size() - 1;
+  if (words < help->min_words) throw UsageError(std::string("missing arguments; usage: ") + help->usage);
+  if (words > help->max_words) throw UsageError(std::string("too many arguments; usage: ") + help->usage);
+
+  ClientOptions opts;
+  opts.domain = static_cast<std::uint32_t>(parse_integer("--domain", args.option_or("domain", "0"), 0, 232));
+  opts.ns = args.option_or("namespace", "drivegate");
+  const double timeout_s = args.number("timeout").value_or(5.0);
+  if (timeout_s <= 0) throw UsageError("--timeout must be positive");
+
+  install_interrupt_handler();
+  Client client(opts);
+  Context ctx{client, args, args.flag("json"), Millis(static_cast<std::int64_t>(timeout_s * 1000)),
+              args.option_or("gateway", ""), {args.positional().begin() + 1, args.positional().end()}};
+
+  if (int rc = require_gateways(ctx)) return rc;
+  if (command == "list") return cmd_list(ctx);
+  if (command == "status") return cmd_status(ctx);
+  if (command == "enable") return cmd_simple(ctx, command, "enable");
+  if (command == "disable") return cmd_simple(ctx, command, "disable");
+  if (command == "stop") return cmd_simple(ctx, command, "stop");
+  if (command == "quick-stop") return cmd_simple(ctx, command, "quick_stop");
+  if (command == "halt") return cmd_simple(ctx, command, "halt");
+  if (command == "resume") return cmd_simple(ctx, command, "resume");
+  if (command == "reset") return cmd_simple(ctx, command, "fault_reset");
+  if (command == "mode") return cmd_mode(ctx);
+  if (command == "move") return cmd_move(ctx);
+  if (command == "velocity") return cmd_stream(ctx, false);
+  if (command == "torque") return cmd_stream(ctx, true);
+  if (command == "home") return cmd_home(ctx);
+  if (command == "events") return cmd_events(ctx);
+  if (command == "param") return cmd_param(ctx);
+  return cmd_buses(ctx);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const UsageError& e) {
+    std::cerr << "drivegatectl: " << e.what() << " (see drivegatectl --help)\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "drivegatectl: " << e.what() << "\n";
+    return 1;
+  }
+}

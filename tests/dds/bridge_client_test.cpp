@@ -1,0 +1,412 @@
+// DdsBridge + Client in one process over real Fast DDS, against FakeRuntime. Each test process uses
+// its own domain id and namespace so parallel ctest runs do not see each other.
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <optional>
+#include <string>
+
+#include <fastdds/dds/core/status/PublicationMatchedStatus.hpp>
+#include <fastdds/dds/core/status/SubscriptionMatchedStatus.hpp>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <gtest/gtest.h>
+
+#include "client/client.hpp"
+#include "daemon/dds_bridge.hpp"
+#include "drivegate.h"
+#include "fake_runtime.hpp"
+#include "idl/dds_node.hpp"
+
+namespace drivegate::dds_test {
+namespace {
+
+namespace dds = eprosima::fastdds::dds;
+using client::Client;
+using client::CommandRequest;
+using client::Millis;
+using client::Outcome;
+using SteadyClock = std::chrono::steady_clock;
+
+// DDS discovery takes up to about a second; these bounds are generous so a loaded machine passes.
+constexpr Millis kTimeout{10000};
+
+// Domains 20..99: their RTPS ports (7400 + 250 * domain + ...) stay below Linux' ephemeral port
+// range (32768+), where another process' outgoing socket can steal a discovery port and make
+// discovery fail at random.
+std::uint32_t test_domain() { return 20U + static_cast<std::uint32_t>(::getpid() % 80); }
+
+std::string test_namespace() {
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  return "dgtest_" + std::to_string(::getpid()) + "_" + info->name();
+}
+
+daemon::DdsBridgeOptions bridge_options(double rate = 20) {
+  return {test_domain(), test_namespace(), rate};
+}
+
+client::ClientOptions client_options() {
+  client::ClientOptions o;
+  o.domain = test_domain();
+  o.ns = test_namespace();
+  return o;
+}
+
+// Talks to the bridge on the raw topics, so tests can send what the Client library would refuse.
+class RawPeer {
+ public:
+  RawPeer()
+      : node_(test_domain(), test_namespace(), "raw-peer"),
+        cmd_w_(node_.writer(msg::TopicId::AxisCommand)),
+        reply_r_(node_.reader(msg::TopicId::CommandReply)) {}
+
+  bool wait_matched() {
+    return poll([&] {
+      dds::PublicationMatchedStatus w{};
+      dds::SubscriptionMatchedStatus r{};
+      cmd_w_.get_publication_matched_status(w);
+      reply_r_.get_subscription_matched_status(r);
+      return w.current_count > 0 && r.current_count > 0;
+    });
+  }
+
+  void send(const std::string& gateway, const std::string& axis, std::uint64_t id, const std::string& kind,
+            const std::string& mode = {}) {
+    msg::AxisCommand c;
+    c.gateway(gateway);
+    c.axis(axis);
+    c.client("raw");
+    c.id(id);
+    c.kind(kind);
+    c.mode(mode);
+    cmd_w_.write(&c);
+  }
+
+  // The first reply with this id, if one arrives in time.
+  std::optional<msg::CommandReply> reply(std::uint64_t id) {
+    std::optional<msg::CommandReply> found;
+    poll([&] {
+      for (const auto& r : replies_)
+        if (r.id() == id) {
+          found = r;
+          return true;
+        }
+      return false;
+    });
+    return found;
+  }
+  [[nodiscard]] bool has_reply(std::uint64_t id) const {
+    return std::any_of(replies_.begin(), replies_.end(), [&](const msg::CommandReply& r) { return r.id() == id; });
+  }
+
+ private:
+  template <typename F>
+  bool poll(F&& done) {
+    const auto deadline = SteadyClock::now() + kTimeout;
+    for (;;) {
+      take();
+      if (done()) return true;
+      if (SteadyClock::now() >= deadline) return false;
+      reply_r_.wait_for_unread_message(eprosima::fastrtps::Duration_t(0, 50'000'000));  // wakes on data
+    }
+  }
+  void take() {
+    msg::CommandReply r;
+    dds::SampleInfo info;
+    while (reply_r_.take_next_sample(&r, &info) == ReturnCode_t::RETCODE_OK)
+      if (info.valid_data) replies_.push_back(r);
+  }
+
+  msg::DdsNode node_;
+  dds::DataWriter& cmd_w_;
+  dds::DataReader& reply_r_;
+  std::vector<msg::CommandReply> replies_;
+};
+
+// What the client discovered, for failure messages.
+std::string seen(const Client& c) {
+  return " [client saw " + std::to_string(c.gateways().size()) + " gateways, " + std::to_string(c.states().size()) +
+         " axis states]";
+}
+
+bool has_axes(const Client& c, std::size_t n) {
+  std::size_t total = 0;
+  for (const auto& g : c.gateways()) total += g.axes.size();
+  return total >= n;
+}
+
+TEST(DdsBridge, CommandAcceptedThenCompleted) {
+  FakeRuntime rt("gw1", {"x", "y"});
+  daemon::DdsBridge bridge(rt, bridge_options());
+  bridge.start();
+  Client c(client_options());
+
+  CommandRequest req;
+  req.axis = "y";
+  req.kind = "move";
+  req.position = 12.5;
+  req.velocity = 3;
+  req.relative = true;
+  const auto r = c.send(req, true, kTimeout);
+  EXPECT_EQ(r.outcome, Outcome::Completed) << r.reason << seen(c);
+  EXPECT_EQ(r.gateway, "gw1");
+  EXPECT_EQ(r.reason, "target reached");
+
+  const auto cmds = rt.commands();
+  ASSERT_EQ(cmds.size(), 1U);
+  EXPECT_EQ(cmds[0].axis_id, 1U);
+  EXPECT_EQ(cmds[0].command.kind, core::CommandKind::Move);
+  EXPECT_DOUBLE_EQ(cmds[0].command.position, 12.5);
+  EXPECT_DOUBLE_EQ(cmds[0].command.velocity, 3);
+  EXPECT_TRUE(cmds[0].command.relative);
+  EXPECT_NE(cmds[0].command.id, 0U);
+
+  // Without waiting for the final reply the client returns at Accepted.
+  rt.set_complete_commands(false);
+  req.kind = "enable";
+  const auto a = c.send(req, false, kTimeout);
+  EXPECT_EQ(a.outcome, Outcome::Accepted) << a.reason;
+  // Internal ids are unique even though the client's ids are its own.
+  const auto all = rt.commands();
+  ASSERT_EQ(all.size(), 2U);
+  EXPECT_NE(all[0].command.id, all[1].command.id);
+}
+
+TEST(DdsBridge, UnknownAxisIsRejectedWithTheAxesWeHave) {
+  FakeRuntime rt("gw1", {"x", "y"});
+  daemon::DdsBridge bridge(rt, bridge_options());
+  bridge.start();
+  RawPeer peer;
+  ASSERT_TRUE(peer.wait_matched());
+  peer.send("gw1", "zz", 7, "enable");
+  const auto r = peer.reply(7);
+  ASSERT_TRUE(r.has_value());
+  EXPECT_EQ(r->status(), "rejected");
+  EXPECT_EQ(r->gateway(), "gw1");
+  EXPECT_NE(r->reason().find("unknown axis 'zz'"), std::string::npos) << r->reason();
+  EXPECT_NE(r->reason().find("x, y"), std::string::npos) << r->reason();
+  EXPECT_TRUE(rt.commands().empty());
+}
+
+TEST(DdsBridge, UnknownKindModeAndBusyAreRejected) {
+  FakeRuntime rt("gw1", {"x"});
+  daemon::DdsBridge bridge(rt, bridge_options());
+  bridge.start();
+  RawPeer peer;
+  ASSERT_TRUE(peer.wait_matched());
+
+  peer.send("gw1", "x", 1, "teleport");
+  auto r = peer.reply(1);
+  ASSERT_TRUE(r.has_value());
+  EXPECT_EQ(r->status(), "rejected");
+  EXPECT_NE(r->reason().find("unknown command kind 'teleport'"), std::string::npos) << r->reason();
+
+  peer.send("gw1", "x", 2, "set_mode", "warp");
+  r = peer.reply(2);
+  ASSERT_TRUE(r.has_value());
+  EXPECT_EQ(r->status(), "rejected");
+  EXPECT_NE(r->reason().find("unknown mode 'warp'"), std::string::npos) << r->reason();
+
+  rt.set_busy(true);
+  peer.send("gw1", "x", 3, "enable");
+  r = peer.reply(3);
+  ASSERT_TRUE(r.has_value());
+  EXPECT_EQ(r->status(), "rejected");
+  EXPECT_NE(r->reason().find("gateway busy"), std::string::npos) << r->reason();
+  EXPECT_TRUE(rt.commands().empty());
+}
+
+TEST(DdsBridge, CommandForAnotherGatewayIsIgnored) {
+  FakeRuntime rt("gw1", {"x"});
+  daemon::DdsBridge bridge(rt, bridge_options());
+  bridge.start();
+  RawPeer peer;
+  ASSERT_TRUE(peer.wait_matched());
+  peer.send("gw2", "x", 1, "enable");
+  peer.send("gw1", "x", 2, "enable");
+  // Replies from one writer arrive in order: once #2 is answered, #1 was never going to be.
+  const auto r = peer.reply(2);
+  ASSERT_TRUE(r.has_value());
+  EXPECT_EQ(r->status(), "accepted");
+  EXPECT_FALSE(peer.has_reply(1));
+  EXPECT_EQ(rt.commands().size(), 1U);
+  EXPECT_EQ(bridge.stats().commands_ignored, 1U);
+}
+
+TEST(DdsBridge, TwoGatewaysAreListedAndCommandsReachOnlyTheOwner) {
+  FakeRuntime rt_a("gwA", {"x", "y"});
+  FakeRuntime rt_b("gwB", {"z", "w"});
+  daemon::DdsBridge a(rt_a, bridge_options());
+  daemon::DdsBridge b(rt_b, bridge_options());
+  a.start();
+  b.start();
+  Client c(client_options());
+  ASSERT_TRUE(c.wait_until([&] { return has_axes(c, 4); }, kTimeout)) << seen(c);
+  const auto gws = c.gateways();
+  ASSERT_EQ(gws.size(), 2U);
+  EXPECT_EQ(gws[0].name, "gwA");
+  EXPECT_EQ(gws[1].name, "gwB");
+  EXPECT_EQ(gws[1].axes[0].name, "z");
+  EXPECT_EQ(gws[1].axes[0].unit, "mm");
+  EXPECT_NE(std::find(gws[1].axes[0].modes.begin(), gws[1].axes[0].modes.end(), "homing"),
+            gws[1].axes[0].modes.end());
+
+  CommandRequest req;
+  req.axis = "z";
+  req.kind = "enable";
+  const auto r = c.send(req, true, kTimeout);
+  EXPECT_EQ(r.outcome, Outcome::Completed) << r.reason;
+  EXPECT_EQ(r.gateway, "gwB");
+  EXPECT_EQ(rt_b.commands().size(), 1U);
+  EXPECT_TRUE(rt_a.commands().empty());
+
+  // No owner: a clear error naming what is known.
+  req.axis = "nope";
+  const auto none = c.send(req, true, Millis(300));
+  EXPECT_EQ(none.outcome, Outcome::NoGateway);
+  EXPECT_NE(none.reason.find("gwB/z"), std::string::npos) << none.reason;
+
+  // States of both gateways arrive.
+  ASSERT_TRUE(c.wait_until([&] { return c.states().size() >= 4; }, kTimeout));
+  const auto w = c.state("w");
+  ASSERT_TRUE(w.has_value());
+  EXPECT_EQ(w->gateway, "gwB");
+  EXPECT_DOUBLE_EQ(w->position, 11.5);
+  EXPECT_EQ(w->state, "switch_on_disabled");
+}
+
+TEST(DdsBridge, DuplicateAxisNameAcrossGatewaysRaisesAWarningEvent) {
+  FakeRuntime rt_a("gwA", {"x", "y"});
+  FakeRuntime rt_b("gwB", {"x", "z"});
+  daemon::DdsBridge a(rt_a, bridge_options());
+  daemon::DdsBridge b(rt_b, bridge_options());
+  a.start();
+  b.start();
+  Client c(client_options());
+  std::uint64_t cursor = 0;
+  std::vector<client::AxisEvent> warnings;
+  ASSERT_TRUE(c.wait_until(
+      [&] {
+        for (auto& e : c.events_since(cursor))
+          if (e.kind == "warning") warnings.push_back(e);
+        return warnings.size() >= 2;  // each gateway reports the clash once
+      },
+      kTimeout));
+  for (const auto& e : warnings) {
+    EXPECT_EQ(e.axis, "x");
+    EXPECT_NE(e.text.find("gwA"), std::string::npos) << e.text;
+    EXPECT_NE(e.text.find("gwB"), std::string::npos) << e.text;
+  }
+  EXPECT_NE(warnings[0].gateway, warnings[1].gateway);
+
+  // The client refuses to guess the owner, but an explicit gateway works.
+  ASSERT_TRUE(c.wait_until([&] { return has_axes(c, 4); }, kTimeout)) << seen(c);
+  EXPECT_NE(c.route("x").error.find("several gateways"), std::string::npos);
+  CommandRequest req;
+  req.axis = "x";
+  req.gateway = "gwB";
+  req.kind = "enable";
+  EXPECT_EQ(c.send(req, true, kTimeout).outcome, Outcome::Completed);
+  EXPECT_EQ(rt_b.commands().size(), 1U);
+  EXPECT_TRUE(rt_a.commands().empty());
+}
+
+TEST(DdsBridge, StatesArriveAtAboutTheConfiguredRate) {
+  constexpr double kRate = 20;
+  FakeRuntime rt("gw1", {"x"});
+  daemon::DdsBridge bridge(rt, bridge_options(kRate));
+  bridge.start();
+  Client c(client_options());
+  ASSERT_TRUE(c.wait_until([&] { return c.state("x").has_value(); }, kTimeout));
+  const std::uint64_t seq0 = c.state("x")->seq;
+  const auto t0 = SteadyClock::now();
+  constexpr std::uint64_t kSamples = 20;
+  ASSERT_TRUE(c.wait_until([&] { return c.state("x")->seq >= seq0 + kSamples; }, kTimeout));
+  const double seconds = std::chrono::duration<double>(SteadyClock::now() - t0).count();
+  const double rate = static_cast<double>(c.state("x")->seq - seq0) / seconds;
+  // Generous bounds: the point is "configured rate, not cycle rate or 1 Hz".
+  EXPECT_GT(rate, kRate * 0.5);
+  EXPECT_LT(rate, kRate * 2.0);
+  EXPECT_EQ(c.state("x")->link, "operational");
+  EXPECT_EQ(c.state("x")->unit, "mm");
+
+  // Bus status arrives too (at 1 Hz, transient-local).
+  ASSERT_TRUE(c.wait_until([&] { return !c.buses().empty(); }, kTimeout));
+  EXPECT_EQ(c.buses()[0].type, "canopen");
+  EXPECT_EQ(c.buses()[0].cycles, 42U);
+}
+
+TEST(DdsBridge, ParameterGetAndSetRoundTrip) {
+  FakeRuntime rt("gw1", {"x", "y"});
+  rt.set_object(1, 0x6060, 0, 1);
+  daemon::DdsBridge bridge(rt, bridge_options());
+  bridge.start();
+  Client c(client_options());
+
+  client::ParamRequest get;
+  get.axis = "y";
+  get.index = 0x6060;
+  get.size = 1;
+  get.is_signed = true;
+  auto r = c.param(get, kTimeout);
+  ASSERT_TRUE(r.ok) << r.error << seen(c);
+  EXPECT_EQ(r.value, 1);
+  EXPECT_EQ(r.gateway, "gw1");
+
+  client::ParamRequest set = get;
+  set.write = true;
+  set.index = 0x6081;
+  set.size = 4;
+  set.value = -1234;
+  r = c.param(set, kTimeout);
+  ASSERT_TRUE(r.ok) << r.error;
+  EXPECT_EQ(rt.object(1, 0x6081, 0), -1234);
+
+  get.index = 0x6081;
+  r = c.param(get, kTimeout);
+  ASSERT_TRUE(r.ok) << r.error;
+  EXPECT_EQ(r.value, -1234);
+
+  get.index = 0x1234;
+  r = c.param(get, kTimeout);
+  EXPECT_FALSE(r.ok);
+  EXPECT_EQ(r.error_code, 0x06020000U);
+  EXPECT_NE(r.error.find("does not exist"), std::string::npos);
+}
+
+TEST(DdsBridge, SetpointsAndEventsFlow) {
+  FakeRuntime rt("gw1", {"x", "spindle"});
+  daemon::DdsBridge bridge(rt, bridge_options());
+  bridge.start();
+  Client c(client_options());
+  ASSERT_TRUE(c.wait_until([&] { return has_axes(c, 2); }, kTimeout)) << seen(c);
+  // Best effort: stream until one arrives.
+  ASSERT_TRUE(c.wait_until(
+      [&] {
+        EXPECT_EQ(c.stream_setpoint("spindle", "", 0, 250.0, 0), "");
+        return !rt.setpoints().empty();
+      },
+      kTimeout));
+  const auto sp = rt.setpoints().back();
+  EXPECT_EQ(sp.first, 1U);
+  EXPECT_DOUBLE_EQ(sp.second.velocity, 250.0);
+
+  rt.push_event(0, core::EventKind::Fault, "overcurrent \"phase U\"");
+  std::uint64_t cursor = 0;
+  std::optional<client::AxisEvent> fault;
+  ASSERT_TRUE(c.wait_until(
+      [&] {
+        for (auto& e : c.events_since(cursor))
+          if (e.kind == "fault") fault = e;
+        return fault.has_value();
+      },
+      kTimeout));
+  EXPECT_EQ(fault->axis, "x");
+  EXPECT_EQ(fault->gateway, "gw1");
+  EXPECT_EQ(fault->text, "overcurrent \"phase U\"");
+}
+
+}  // namespace
+}  // namespace drivegate::dds_test

@@ -1,0 +1,135 @@
+#include "fake_runtime.hpp"
+
+namespace drivegate::dds_test {
+
+FakeRuntime::FakeRuntime(std::string gateway, std::vector<std::string> axis_names) : gateway_(std::move(gateway)) {
+  for (auto& name : axis_names) {
+    daemon::AxisInfo a;
+    a.name = std::move(name);
+    a.bus = "can0";
+    a.device = "sim";
+    a.unit = "mm";
+    a.modes.add(core::Mode::ProfilePosition);
+    a.modes.add(core::Mode::ProfileVelocity);
+    a.modes.add(core::Mode::Homing);
+    axes_.push_back(std::move(a));
+  }
+}
+
+bool FakeRuntime::submit_command(std::size_t axis_id, const core::Command& cmd) {
+  std::lock_guard lock(mutex_);
+  if (busy_) return false;
+  commands_.push_back({axis_id, cmd});
+  daemon::GlobalReply r;
+  r.axis_id = axis_id;
+  r.reply.id = cmd.id;
+  r.reply.axis = static_cast<core::AxisIndex>(axis_id);
+  r.reply.status = core::ReplyStatus::Accepted;
+  pending_.replies.push_back(r);
+  if (complete_) {
+    r.reply.status = core::ReplyStatus::Completed;
+    r.reply.reason.assign("target reached");
+    pending_.replies.push_back(r);
+  }
+  return true;
+}
+
+bool FakeRuntime::submit_setpoint(std::size_t axis_id, const core::Setpoint& sp) {
+  std::lock_guard lock(mutex_);
+  if (busy_) return false;
+  setpoints_.emplace_back(axis_id, sp);
+  return true;
+}
+
+bool FakeRuntime::submit_parameter(std::size_t axis_id, const core::ParamRequest& req) {
+  std::lock_guard lock(mutex_);
+  if (busy_) return false;
+  core::ParamReply r;
+  r.id = req.id;
+  r.axis = static_cast<core::AxisIndex>(axis_id);
+  const auto key = std::make_tuple(axis_id, req.index, req.sub);
+  if (req.write) {
+    objects_[key] = req.value;
+    r.ok = true;
+  } else if (const auto it = objects_.find(key); it != objects_.end()) {
+    r.ok = true;
+    r.value = it->second;
+  } else {
+    r.error_code = 0x06020000;  // CiA 301 SDO abort: object does not exist
+    r.error.assign("object does not exist in the object dictionary");
+  }
+  pending_.param_replies.push_back({axis_id, r});
+  return true;
+}
+
+core::AxisSnapshot FakeRuntime::snapshot(std::size_t axis_id) const {
+  core::AxisSnapshot s;
+  s.axis = static_cast<core::AxisIndex>(axis_id);
+  s.state = core::AxisState::SwitchOnDisabled;
+  s.link = core::LinkState::Operational;
+  s.mode = core::Mode::ProfilePosition;
+  s.position = 10.0 * static_cast<double>(axis_id) + 1.5;
+  return s;
+}
+
+daemon::BusStatus FakeRuntime::bus_status(std::size_t /*bus*/) const {
+  daemon::BusStatus b;
+  b.name = "can0";
+  b.type = "canopen";
+  b.running = true;
+  b.healthy = true;
+  b.period_ns = 1'000'000;
+  b.cycles = 42;
+  return b;
+}
+
+void FakeRuntime::drain(daemon::Outbox& out) {
+  std::lock_guard lock(mutex_);
+  out.replies.insert(out.replies.end(), pending_.replies.begin(), pending_.replies.end());
+  out.events.insert(out.events.end(), pending_.events.begin(), pending_.events.end());
+  out.param_replies.insert(out.param_replies.end(), pending_.param_replies.begin(), pending_.param_replies.end());
+  pending_.clear();
+}
+
+void FakeRuntime::set_busy(bool busy) {
+  std::lock_guard lock(mutex_);
+  busy_ = busy;
+}
+
+void FakeRuntime::set_complete_commands(bool complete) {
+  std::lock_guard lock(mutex_);
+  complete_ = complete;
+}
+
+void FakeRuntime::set_object(std::size_t axis_id, std::uint16_t index, std::uint8_t sub, std::int64_t value) {
+  std::lock_guard lock(mutex_);
+  objects_[std::make_tuple(axis_id, index, sub)] = value;
+}
+
+void FakeRuntime::push_event(std::size_t axis_id, core::EventKind kind, std::string_view text) {
+  std::lock_guard lock(mutex_);
+  daemon::GlobalEvent e;
+  e.axis_id = axis_id;
+  e.bus = "can0";
+  e.event.kind = kind;
+  e.event.text.assign(text);
+  pending_.events.push_back(e);
+}
+
+std::vector<FakeRuntime::Received> FakeRuntime::commands() const {
+  std::lock_guard lock(mutex_);
+  return commands_;
+}
+
+std::vector<std::pair<std::size_t, core::Setpoint>> FakeRuntime::setpoints() const {
+  std::lock_guard lock(mutex_);
+  return setpoints_;
+}
+
+std::int64_t FakeRuntime::object(std::size_t axis_id, std::uint16_t index, std::uint8_t sub) const {
+  std::lock_guard lock(mutex_);
+  const auto it = objects_.find(std::make_tuple(axis_id, index, sub));
+  return it == objects_.end() ? -1 : it->second;
+}
+
+}  // namespace drivegate::dds_test

@@ -1,0 +1,54 @@
+#pragma once
+// An in-test daemon::Runtime: named axes, a recorded command log, scripted replies, an in-memory
+// object dictionary for parameter requests and synthetic snapshots. The bridge thread calls it;
+// the test thread inspects it, hence the mutex.
+#include <map>
+#include <mutex>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "daemon/runtime.hpp"
+
+namespace drivegate::dds_test {
+
+class FakeRuntime final : public daemon::Runtime {
+ public:
+  FakeRuntime(std::string gateway, std::vector<std::string> axis_names);
+
+  [[nodiscard]] const std::string& gateway_name() const noexcept override { return gateway_; }
+  [[nodiscard]] std::span<const daemon::AxisInfo> axes() const noexcept override { return axes_; }
+  bool submit_command(std::size_t axis_id, const core::Command& cmd) override;
+  bool submit_setpoint(std::size_t axis_id, const core::Setpoint& sp) override;
+  bool submit_parameter(std::size_t axis_id, const core::ParamRequest& req) override;
+  [[nodiscard]] core::AxisSnapshot snapshot(std::size_t axis_id) const override;
+  [[nodiscard]] std::size_t bus_count() const noexcept override { return 1; }
+  [[nodiscard]] daemon::BusStatus bus_status(std::size_t bus) const override;
+  void drain(daemon::Outbox& out) override;
+
+  // Test controls and observations.
+  void set_busy(bool busy);
+  void set_complete_commands(bool complete);  // false: reply Accepted only
+  void set_object(std::size_t axis_id, std::uint16_t index, std::uint8_t sub, std::int64_t value);
+  void push_event(std::size_t axis_id, core::EventKind kind, std::string_view text);
+  struct Received {
+    std::size_t axis_id;
+    core::Command command;
+  };
+  [[nodiscard]] std::vector<Received> commands() const;
+  [[nodiscard]] std::vector<std::pair<std::size_t, core::Setpoint>> setpoints() const;
+  [[nodiscard]] std::int64_t object(std::size_t axis_id, std::uint16_t index, std::uint8_t sub) const;
+
+ private:
+  std::string gateway_;
+  std::vector<daemon::AxisInfo> axes_;
+  mutable std::mutex mutex_;
+  bool busy_ = false;
+  bool complete_ = true;
+  std::vector<Received> commands_;
+  std::vector<std::pair<std::size_t, core::Setpoint>> setpoints_;
+  std::map<std::tuple<std::size_t, std::uint16_t, std::uint8_t>, std::int64_t> objects_;
+  daemon::Outbox pending_;
+};
+
+}  // namespace drivegate::dds_test
