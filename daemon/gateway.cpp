@@ -1,0 +1,271 @@
+#include "daemon/gateway.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <sstream>
+#include <thread>
+
+#include "daemon/bus_factory.hpp"
+
+namespace drivegate::daemon {
+
+using namespace std::chrono_literals;
+
+namespace {
+bool is_disabled(core::AxisState s) noexcept {
+  return s == core::AxisState::SwitchOnDisabled || s == core::AxisState::NotReadyToSwitchOn ||
+         s == core::AxisState::ReadyToSwitchOn || s == core::AxisState::Fault || s == core::AxisState::Unknown;
+}
+std::string_view severity_of(core::EventKind k) {
+  switch (k) {
+    case core::EventKind::Fault:
+    case core::EventKind::CommandTimeout: return "error";
+    case core::EventKind::Warning: return "warning";
+    default: return "info";
+  }
+}
+}  // namespace
+
+Gateway::Gateway(const config::Plan& plan) : name_(plan.gateway.name) {
+  buses_.reserve(plan.buses.size());
+  for (const auto& bp : plan.buses) {
+    BusSlot slot;
+    slot.plan = &bp;
+    slot.first_axis = axes_.size();
+    for (const auto& ap : bp.axes) {
+      slot.specs.push_back(ap.spec);
+      AxisInfo info;
+      info.name = ap.spec.name;
+      info.bus = bp.name;
+      info.device = ap.device.name;
+      info.unit = ap.spec.user_unit;
+      info.modes = ap.spec.modes;
+      axes_.push_back(std::move(info));
+      refs_.push_back({buses_.size(), static_cast<core::AxisIndex>(refs_.size() - slot.first_axis)});
+    }
+    slot.bus = make_bus(bp);
+    slot.runner = std::make_unique<core::BusRunner>(*slot.bus, slot.specs);
+    buses_.push_back(std::move(slot));
+  }
+}
+
+Gateway::~Gateway() {
+  for (auto& b : buses_) {
+    if (b.thread) b.thread->stop();
+    if (b.open) b.bus->close();
+  }
+}
+
+void Gateway::start() {
+  for (auto& b : buses_) {
+    const auto now = core::SteadyClock{}.now();
+    try {
+      b.bus->open(now);
+    } catch (const core::BusError& e) {
+      throw core::BusError("bus '" + b.plan->name + "' (" + b.plan->type + "): " + e.what());
+    }
+    b.open = true;
+    CycleThread::Schedule sched;
+    sched.period = b.plan->cycle_time;
+    sched.priority = b.plan->priority;
+    sched.cpu = b.plan->cpu;
+    core::BusRunner* runner = b.runner.get();
+    b.thread = std::make_unique<CycleThread>(sched, [runner](core::TimePoint t, std::uint64_t) { runner->cycle(t); });
+    if (!b.thread->start()) throw core::BusError("bus '" + b.plan->name + "': could not start its cycle thread");
+    spdlog::info("bus {}: {} with {} axes, cycle {} us", b.plan->name, b.plan->type, b.specs.size(),
+                 std::chrono::duration_cast<std::chrono::microseconds>(b.plan->cycle_time).count());
+  }
+}
+
+bool Gateway::submit_command(std::size_t axis_id, const core::Command& cmd) {
+  if (axis_id >= refs_.size()) return false;
+  std::lock_guard lock(submit_mutex_);
+  if (shutting_down_.load() && !core::is_internal(cmd.id)) {
+    GlobalReply r;
+    r.axis_id = axis_id;
+    r.reply.id = cmd.id;
+    r.reply.axis = refs_[axis_id].axis;
+    r.reply.status = core::ReplyStatus::Rejected;
+    r.reply.reason.assign("gateway is shutting down: every axis is being stopped and disabled");
+    local_replies_.push_back(r);
+    return true;
+  }
+  core::Command c = cmd;
+  c.axis = refs_[axis_id].axis;
+  return buses_[refs_[axis_id].bus].runner->push_command(c);
+}
+
+bool Gateway::submit_setpoint(std::size_t axis_id, const core::Setpoint& sp) {
+  if (axis_id >= refs_.size() || shutting_down_.load()) return false;
+  std::lock_guard lock(submit_mutex_);
+  core::Setpoint s = sp;
+  s.axis = refs_[axis_id].axis;
+  return buses_[refs_[axis_id].bus].runner->push_setpoint(s);
+}
+
+bool Gateway::submit_parameter(std::size_t axis_id, const core::ParamRequest& req) {
+  if (axis_id >= refs_.size()) return false;
+  std::lock_guard lock(submit_mutex_);
+  core::ParamRequest r = req;
+  r.axis = refs_[axis_id].axis;
+  return buses_[refs_[axis_id].bus].runner->push_parameter(r);
+}
+
+core::AxisSnapshot Gateway::snapshot(std::size_t axis_id) const {
+  if (axis_id >= refs_.size()) return {};
+  return buses_[refs_[axis_id].bus].runner->snapshot(refs_[axis_id].axis);
+}
+
+BusStatus Gateway::bus_status(std::size_t bus) const {
+  BusStatus s;
+  if (bus >= buses_.size()) return s;
+  const auto& b = buses_[bus];
+  s.name = b.plan->name;
+  s.type = b.plan->type;
+  s.period_ns = b.plan->cycle_time.count();
+  if (b.thread) {
+    const auto t = b.thread->timing();
+    s.running = b.thread->running();
+    s.healthy = b.thread->healthy(core::SteadyClock{}.now());
+    s.achieved_period_ns = t.achieved_period_ns;
+    s.lateness_p50_ns = t.lateness_p50_ns;
+    s.lateness_p99_ns = t.lateness_p99_ns;
+    s.lateness_max_ns = t.lateness_max_ns;
+    s.cycles = t.cycles;
+    s.overruns = t.overruns;
+  }
+  s.counters = b.bus->counters();
+  s.counters.frames_dropped += b.runner->dropped_outputs();
+  return s;
+}
+
+void Gateway::drain(Outbox& out) {
+  for (const auto& b : buses_) {
+    GlobalReply r;
+    while (b.runner->pop_reply(r.reply)) {
+      r.axis_id = b.first_axis + r.reply.axis;
+      out.replies.push_back(r);
+    }
+    GlobalEvent e;
+    while (b.runner->pop_event(e.event)) {
+      e.bus = b.plan->name;
+      e.axis_id = e.event.axis == core::kNoAxis ? SIZE_MAX : b.first_axis + e.event.axis;
+      const std::string who = e.axis_id == SIZE_MAX ? "bus " + e.bus : "axis " + axes_[e.axis_id].name;
+      const auto sev = severity_of(e.event.kind);
+      const auto level = sev == "error" ? spdlog::level::err : sev == "warning" ? spdlog::level::warn : spdlog::level::info;
+      if (e.event.code != 0)
+        spdlog::log(level, "{}: {} 0x{:04X}: {}", who, core::to_string(e.event.kind), e.event.code, e.event.text.view());
+      else
+        spdlog::log(level, "{}: {}: {}", who, core::to_string(e.event.kind), e.event.text.view());
+      out.events.push_back(e);
+    }
+    GlobalParamReply p;
+    while (b.runner->pop_parameter_reply(p.reply)) {
+      p.axis_id = b.first_axis + p.reply.axis;
+      out.param_replies.push_back(p);
+    }
+  }
+  std::lock_guard lock(submit_mutex_);
+  out.replies.insert(out.replies.end(), local_replies_.begin(), local_replies_.end());
+  local_replies_.clear();
+}
+
+void Gateway::submit_internal(std::size_t axis_id, core::CommandKind kind) {
+  core::Command c;
+  {
+    std::lock_guard lock(submit_mutex_);
+    c.id = next_internal_++;
+  }
+  c.kind = kind;
+  // The queue may be momentarily full of client commands; the cycle thread empties it every cycle.
+  for (int attempt = 0; attempt < 100 && !submit_command(axis_id, c); ++attempt) std::this_thread::sleep_for(1ms);
+}
+
+template <typename Pred>
+bool Gateway::wait_all(Pred pred, core::Duration budget) const {
+  const auto deadline = std::chrono::steady_clock::now() + budget;
+  for (;;) {
+    bool all = true;
+    for (std::size_t i = 0; i < refs_.size() && all; ++i) all = pred(snapshot(i));
+    if (all) return true;
+    if (std::chrono::steady_clock::now() >= deadline) return false;
+    // Polling the seqlocked snapshots: the cycle threads must not be made to signal anyone.
+    std::this_thread::sleep_for(2ms);
+  }
+}
+
+ShutdownReport Gateway::shutdown(core::Duration phase_budget) {
+  ShutdownReport report;
+  shutting_down_ = true;
+  const auto reachable = [](const core::AxisSnapshot& s) { return s.link == core::LinkState::Operational; };
+
+  bool any_thread = false;
+  for (const auto& b : buses_) any_thread = any_thread || (b.thread && b.thread->running());
+  if (any_thread) {
+    // Phase 1: brake every moving/enabled axis on its quick-stop ramp.
+    for (std::size_t i = 0; i < refs_.size(); ++i) {
+      const auto s = snapshot(i);
+      if (reachable(s) && s.state == core::AxisState::OperationEnabled) {
+        submit_internal(i, core::CommandKind::QuickStop);
+        ++report.stopped;
+      }
+    }
+    if (report.stopped > 0)
+      wait_all([&](const core::AxisSnapshot& s) { return !reachable(s) || s.state != core::AxisState::OperationEnabled; },
+               phase_budget);
+    // Phase 2: remove the power stage of every axis that still has one.
+    for (std::size_t i = 0; i < refs_.size(); ++i) {
+      const auto s = snapshot(i);
+      if (reachable(s) && !is_disabled(s.state)) submit_internal(i, core::CommandKind::Disable);
+    }
+    wait_all([&](const core::AxisSnapshot& s) { return !reachable(s) || is_disabled(s.state); }, phase_budget);
+    for (std::size_t i = 0; i < refs_.size(); ++i) {
+      const auto s = snapshot(i);
+      if (!reachable(s) || is_disabled(s.state))
+        ++report.disabled;
+      else
+        report.unconfirmed.push_back(axes_[i].name + " (" + std::string(core::to_string(s.state)) + ")");
+    }
+  }
+  for (auto& b : buses_) {
+    if (b.thread) b.thread->stop();
+    if (b.open) {
+      b.bus->close();
+      b.open = false;
+    }
+  }
+  return report;
+}
+
+bool Gateway::healthy() const noexcept {
+  const auto now = core::SteadyClock{}.now();
+  for (const auto& b : buses_)
+    if (!b.thread || !b.thread->healthy(now)) return false;
+  return true;
+}
+
+std::string Gateway::status_line() const {
+  std::size_t enabled = 0, faulted = 0, lost = 0;
+  for (std::size_t i = 0; i < refs_.size(); ++i) {
+    const auto s = snapshot(i);
+    enabled += s.state == core::AxisState::OperationEnabled ? 1 : 0;
+    faulted += s.state == core::AxisState::Fault ? 1 : 0;
+    lost += s.link != core::LinkState::Operational ? 1 : 0;
+  }
+  std::ostringstream o;
+  o << buses_.size() << (buses_.size() == 1 ? " bus, " : " buses, ") << refs_.size() << " axes: " << enabled
+    << " enabled, " << faulted << " in fault, " << lost << " not operational";
+  if (!healthy()) o << "; a cycle thread is late";
+  return o.str();
+}
+
+std::vector<std::string> Gateway::scheduling_notes() const {
+  std::vector<std::string> notes;
+  for (const auto& b : buses_)
+    if (b.thread && !b.thread->scheduling_note().empty())
+      notes.push_back("bus " + b.plan->name + ": " + b.thread->scheduling_note());
+  return notes;
+}
+
+}  // namespace drivegate::daemon

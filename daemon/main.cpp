@@ -1,0 +1,254 @@
+// drivegated: loads a deployment, brings its buses and axes up, and serves them over DDS.
+#include <signal.h>
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+#include <sys/signalfd.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <iostream>
+#include <optional>
+#include <string>
+#include <thread>
+
+#include "config/config_error.hpp"
+#include "config/describe.hpp"
+#include "config/loader.hpp"
+#include "core/bus.hpp"
+#include "daemon/dds_bridge.hpp"
+#include "daemon/gateway.hpp"
+#include "daemon/realtime.hpp"
+#include "daemon/systemd_notify.hpp"
+
+#ifndef DRIVEGATE_VERSION
+#define DRIVEGATE_VERSION "unknown"
+#endif
+
+namespace {
+
+using namespace drivegate;
+using namespace std::chrono_literals;
+
+constexpr const char* kUsage = R"(usage: drivegated --config FILE [--log-level LEVEL]
+       drivegated --check-config FILE
+       drivegated --version | --help
+
+Runs the gateway described by FILE: brings up every bus and axis, runs one cycle thread per bus
+and serves the axes over DDS. SIGTERM or SIGINT stops and disables every axis, then exits 0; a
+second signal exits at once.
+
+  --config FILE        the deployment (YAML); see config/README.md
+  --check-config FILE  validate FILE and print the compiled plan without touching any bus
+  --log-level LEVEL    trace|debug|info|warn|error|critical|off (overrides gateway.log_level)
+)";
+
+struct Args {
+  std::string config;
+  bool check_only = false;
+  std::optional<std::string> log_level;
+};
+
+std::optional<Args> parse_args(int argc, char** argv, int& exit_code) {
+  Args a;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    auto value = [&](const char* what) -> std::optional<std::string> {
+      if (i + 1 >= argc) {
+        std::cerr << "drivegated: " << arg << " needs " << what << "\n" << kUsage;
+        return std::nullopt;
+      }
+      return std::string(argv[++i]);
+    };
+    if (arg == "--help" || arg == "-h") {
+      std::cout << kUsage;
+      exit_code = 0;
+      return std::nullopt;
+    }
+    if (arg == "--version") {
+      std::cout << "drivegated " << DRIVEGATE_VERSION << "\n";
+      exit_code = 0;
+      return std::nullopt;
+    }
+    if (arg == "--config" || arg == "--check-config") {
+      auto v = value("a file");
+      if (!v) return std::nullopt;
+      a.config = *v;
+      a.check_only = a.check_only || arg == "--check-config";
+    } else if (arg == "--log-level") {
+      auto v = value("a level");
+      if (!v) return std::nullopt;
+      a.log_level = *v;
+    } else {
+      std::cerr << "drivegated: unknown argument '" << arg << "'\n" << kUsage;
+      return std::nullopt;
+    }
+  }
+  if (a.config.empty()) {
+    std::cerr << "drivegated: no configuration given\n" << kUsage;
+    return std::nullopt;
+  }
+  return a;
+}
+
+void setup_logging(const std::string& level) {
+  auto logger = spdlog::stderr_color_mt("drivegated");
+  // Under systemd the journal adds time and process; on a terminal we add the time ourselves.
+  if (std::getenv("JOURNAL_STREAM") != nullptr)
+    logger->set_pattern("<%l> %v");
+  else
+    logger->set_pattern("%H:%M:%S.%e %^%-5l%$ %v");
+  spdlog::set_default_logger(logger);
+  spdlog::set_level(spdlog::level::from_str(level));
+}
+
+// Signals are taken synchronously through a signalfd so that shutdown runs on the main thread.
+int make_signal_fd() {
+  sigset_t set;
+  sigemptyset(&set);
+  sigaddset(&set, SIGTERM);
+  sigaddset(&set, SIGINT);
+  pthread_sigmask(SIG_BLOCK, &set, nullptr);  // before any thread starts, so all inherit it
+  return signalfd(-1, &set, SFD_CLOEXEC | SFD_NONBLOCK);
+}
+
+int wait_signal(int fd, std::chrono::milliseconds timeout) {
+  fd_set fds;
+  FD_ZERO(&fds);
+  FD_SET(fd, &fds);
+  timeval tv{static_cast<time_t>(timeout.count() / 1000), static_cast<suseconds_t>((timeout.count() % 1000) * 1000)};
+  if (select(fd + 1, &fds, nullptr, nullptr, &tv) <= 0) return 0;
+  signalfd_siginfo info{};
+  if (read(fd, &info, sizeof info) != static_cast<ssize_t>(sizeof info)) return 0;
+  return static_cast<int>(info.ssi_signo);
+}
+
+int run(const Args& args) {
+  config::Plan plan;
+  try {
+    plan = config::load_plan(args.config);
+  } catch (const config::ConfigError& e) {
+    std::cerr << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "drivegated: " << args.config << ": " << e.what() << "\n";
+    return 2;
+  }
+  if (args.check_only) {
+    std::cout << config::describe_plan(plan);
+    return 0;
+  }
+  setup_logging(args.log_level.value_or(plan.gateway.log_level));
+  for (const auto& w : plan.warnings) spdlog::warn("{}", w);
+
+  const int sigfd = make_signal_fd();
+  if (sigfd < 0) {
+    spdlog::critical("cannot watch for signals: {}", std::strerror(errno));
+    return 1;
+  }
+  daemon::SystemdNotifier notifier;
+
+  bool realtime = false;
+  for (const auto& b : plan.buses) realtime = realtime || b.priority > 0;
+  if (realtime) {
+    // Page faults are the largest source of jitter once SCHED_FIFO is in use; without real-time
+    // scheduling locking memory would only cost RAM.
+    const auto note = daemon::lock_memory();
+    if (note.empty())
+      spdlog::info("memory locked");
+    else
+      spdlog::warn("{}", note);
+  }
+
+  std::unique_ptr<daemon::Gateway> gateway;
+  try {
+    gateway = std::make_unique<daemon::Gateway>(plan);
+    gateway->start();
+  } catch (const std::exception& e) {
+    spdlog::critical("start-up failed: {}", e.what());
+    notifier.status(std::string("start-up failed: ") + e.what());
+    return 1;
+  }
+  for (const auto& n : gateway->scheduling_notes()) spdlog::warn("{}", n);
+
+  daemon::DdsBridgeOptions dds;
+  dds.domain = static_cast<std::uint32_t>(plan.gateway.domain);
+  dds.ns = plan.gateway.ns;
+  dds.status_rate_hz = plan.gateway.status_rate_hz;
+  daemon::DdsBridge bridge(*gateway, dds);
+  try {
+    bridge.start();
+  } catch (const std::exception& e) {
+    spdlog::critical("DDS start-up failed: {}", e.what());
+    gateway->shutdown(2s);
+    return 1;
+  }
+
+  spdlog::info("gateway {} running: {} (DDS domain {}, namespace '{}')", plan.gateway.name, gateway->status_line(),
+               plan.gateway.domain, plan.gateway.ns);
+  notifier.ready();
+  notifier.status(gateway->status_line());
+
+  const auto wd = notifier.watchdog_interval();
+  auto last_status = std::chrono::steady_clock::now();
+  auto last_ping = last_status;
+  bool was_healthy = true;
+  int sig = 0;
+  while ((sig = wait_signal(sigfd, 100ms)) == 0) {
+    const auto now = std::chrono::steady_clock::now();
+    const bool ok = gateway->healthy();
+    if (ok != was_healthy) {
+      if (ok)
+        spdlog::info("all cycle threads keep their schedule again");
+      else
+        spdlog::error("a cycle thread stopped keeping its schedule; withholding the watchdog ping");
+      was_healthy = ok;
+    }
+    // WATCHDOG=1 only while every cycle thread is healthy: a stuck bus makes systemd restart us.
+    if (wd && ok && now - last_ping >= *wd / 2) {
+      notifier.watchdog();
+      last_ping = now;
+    }
+    if (now - last_status >= 1s) {
+      notifier.status(gateway->status_line());
+      last_status = now;
+    }
+  }
+
+  spdlog::info("{} received: stopping and disabling every axis", strsignal(sig));
+  notifier.stopping();
+  notifier.status("stopping: disabling axes");
+  // A second signal ends the process at once.
+  std::thread second([sigfd] {
+    while (wait_signal(sigfd, 1000ms) == 0) {
+    }
+    std::fputs("drivegated: second signal, exiting at once\n", stderr);
+    std::_Exit(130);
+  });
+  second.detach();
+
+  const auto report = gateway->shutdown(3s);
+  spdlog::info("{} axes quick-stopped, {} disabled", report.stopped, report.disabled);
+  int rc = 0;
+  for (const auto& a : report.unconfirmed) {
+    spdlog::error("axis {} did not confirm it is disabled", a);
+    rc = 1;
+  }
+  // Let the bridge publish the final states and events before it goes.
+  std::this_thread::sleep_for(std::chrono::milliseconds(static_cast<int>(1000.0 / plan.gateway.status_rate_hz) + 50));
+  bridge.stop();
+  gateway.reset();
+  spdlog::info("stopped");
+  return rc;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int exit_code = 2;
+  const auto args = parse_args(argc, argv, exit_code);
+  if (!args) return exit_code;
+  return run(*args);
+}

@@ -1,0 +1,64 @@
+#pragma once
+// Runs the real drivegated binary for an integration test: a config made from config/demo.yaml
+// with the test's own gateway name, DDS domain and topic namespace, a NOTIFY_SOCKET the test
+// listens on, and the daemon's log in a file. The process is killed when the object goes.
+#include <sys/types.h>
+
+#include <chrono>
+#include <condition_variable>
+#include <mutex>
+#include <optional>
+#include <thread>
+#include <string>
+#include <vector>
+
+namespace drivegate::test {
+
+// A DDS domain and namespace of this test process alone, so tests can run in parallel.
+struct DdsIsolation {
+  std::uint32_t domain;
+  std::string ns;
+};
+DdsIsolation unique_dds(const std::string& tag);
+
+// The demo configuration with gateway name, domain and namespace replaced; returns the file path.
+std::string write_demo_config(const std::string& gateway, const DdsIsolation& dds);
+
+// A NOTIFY_SOCKET like systemd's: it reads continuously (a unix datagram socket queues only a
+// few messages; a sender whose queue is full blocks, as drivegated would in sd_notify).
+class NotifySocket {
+ public:
+  NotifySocket();
+  ~NotifySocket();
+  [[nodiscard]] const std::string& path() const { return path_; }
+  // Waits until a datagram containing `what` (e.g. "READY=1") has arrived.
+  bool wait_for(const std::string& what, std::chrono::milliseconds timeout);
+
+ private:
+  void read_loop();
+  int fd_ = -1;
+  std::string path_;
+  std::mutex mutex_;
+  std::condition_variable arrived_;
+  std::vector<std::string> received_;
+  bool stop_ = false;
+  std::thread reader_;
+};
+
+class DaemonProcess {
+ public:
+  DaemonProcess(const std::string& config, const std::string& notify_socket);
+  ~DaemonProcess();
+  [[nodiscard]] pid_t pid() const { return pid_; }
+  // Sends a signal and waits for the exit; returns the exit status (or nullopt on timeout).
+  std::optional<int> terminate(int signal, std::chrono::milliseconds timeout);
+  [[nodiscard]] std::string log() const;
+  // Resident set size in KiB from /proc, 0 if unknown.
+  [[nodiscard]] long rss_kib() const;
+
+ private:
+  pid_t pid_ = -1;
+  std::string log_path_;
+};
+
+}  // namespace drivegate::test
