@@ -118,6 +118,10 @@ void AxisRunner::observe_link(TimePoint now, LinkState link, RunnerOutput& out) 
     t.format("link %s -> %s", to_string(last_link_).data(), to_string(link).data());
     const bool was_up = last_link_ == LinkState::Operational;
     last_link_ = link;
+    if (link == LinkState::Operational) {
+      default_mode_pending_ = true;
+      default_mode_attempts_ = 0;
+    }
     emit(EventKind::LinkChanged, 0, t.view());
     if (was_up) {
       live_armed_ = false;
@@ -131,8 +135,34 @@ void AxisRunner::update(TimePoint now, RunnerOutput& out) noexcept {
   now_ = now;
   ++cycle_;
   controller_.update(now, *this);
+  select_default_mode(now);
   check_command_timeout(now);
   build_snapshot(now);
+}
+
+void AxisRunner::select_default_mode(TimePoint now) noexcept {
+  if (!default_mode_pending_ || last_link_ != LinkState::Operational) return;
+  const DriveFeedback& fb = controller_.feedback();
+  if (spec_.default_mode == Mode::None || (fb.valid && fb.mode == spec_.default_mode)) {
+    default_mode_pending_ = false;
+    return;
+  }
+  if (!fb.valid) return;
+  DriveCommand cmd;
+  cmd.id = next_internal_++;
+  cmd.kind = CommandKind::SetMode;
+  cmd.mode = spec_.default_mode;
+  const Admission adm = controller_.submit(cmd, now, *this);
+  if (adm.accepted) {
+    default_mode_pending_ = false;
+  } else if (++default_mode_attempts_ == 1000) {
+    // Retried every cycle while the drive is busy (e.g. a client moved it first); give up after
+    // a while and say so.
+    default_mode_pending_ = false;
+    Text t;
+    t.format("default mode %s not selected: %s", to_string(spec_.default_mode).data(), adm.reason.c_str());
+    emit(EventKind::Warning, 0, t.view());
+  }
 }
 
 void AxisRunner::check_command_timeout(TimePoint now) noexcept {

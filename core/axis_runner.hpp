@@ -60,6 +60,7 @@ class AxisRunner final : private ControllerSink {
   void send_reply(CommandId id, ReplyStatus status, std::string_view reason) noexcept;
   void emit(EventKind kind, std::uint32_t code, std::string_view text) noexcept;
   void check_command_timeout(TimePoint now) noexcept;
+  void select_default_mode(TimePoint now) noexcept;
   void build_snapshot(TimePoint now) noexcept;
 
   AxisIndex index_;
@@ -72,6 +73,10 @@ class AxisRunner final : private ControllerSink {
   bool live_armed_ = false;
   TimePoint last_activity_{};
   CommandId next_internal_ = kInternalCommandBit | 1;
+
+  // The configured default mode is selected once the drive reports after each link-up.
+  bool default_mode_pending_ = true;
+  int default_mode_attempts_ = 0;
 
   LinkState last_link_ = LinkState::Offline;
   AxisState last_state_ = AxisState::Unknown;

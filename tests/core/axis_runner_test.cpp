@@ -255,3 +255,32 @@ TEST(BusRunner, RoutesCommandsAndRepliesAndNeverAllocatesInTheCycle) {
   while (runner.pop_event(e)) saw_link = saw_link || e.kind == EventKind::LinkChanged;
   EXPECT_TRUE(saw_link);
 }
+
+TEST(AxisRunnerDefaultMode, SelectedOnceTheDriveReportsAndAgainAfterALinkLoss) {
+  AxisSpec spec = drivegate::test::linear_axis_spec();
+  spec.default_mode = Mode::ProfilePosition;
+  FakeController ctl;
+  AxisRunner runner{0, spec, ctl};
+  Recorder out;
+  TimePoint t{1s};
+  runner.update(t, LinkState::Operational, out);  // no valid status yet: nothing sent
+  EXPECT_TRUE(ctl.submitted.empty());
+  ctl.fb.valid = true;
+  ctl.fb.state = AxisState::SwitchOnDisabled;
+  runner.update(t + 1ms, LinkState::Operational, out);
+  ASSERT_EQ(ctl.submitted.size(), 1u);
+  EXPECT_EQ(ctl.submitted[0].kind, CommandKind::SetMode);
+  EXPECT_EQ(ctl.submitted[0].mode, Mode::ProfilePosition);
+  EXPECT_TRUE(is_internal(ctl.submitted[0].id));
+  EXPECT_TRUE(out.replies.empty());  // the gateway's own command gets no reply
+  runner.update(t + 2ms, LinkState::Operational, out);
+  EXPECT_EQ(ctl.submitted.size(), 1u);
+  // After the link comes back the mode is selected again, unless the drive already has it.
+  runner.update(t + 3ms, LinkState::Lost, out);
+  runner.update(t + 4ms, LinkState::Operational, out);
+  EXPECT_EQ(ctl.submitted.size(), 2u);
+  ctl.fb.mode = Mode::ProfilePosition;
+  runner.update(t + 5ms, LinkState::Lost, out);
+  runner.update(t + 6ms, LinkState::Operational, out);
+  EXPECT_EQ(ctl.submitted.size(), 2u);
+}
