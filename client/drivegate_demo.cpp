@@ -126,6 +126,16 @@ class Demo {
       const auto r = client_.send(req, true, timeout_);
       log("disable " + a + ": " + std::string(to_string(r.outcome)) + (r.reason.empty() ? "" : " (" + r.reason + ")"));
     }
+    // The final table should show what the replies said: wait for the published states to agree.
+    client_.wait_until(
+        [&] {
+          for (const auto& a : axes) {
+            const auto st = client_.state(a, gateway_);
+            if (st && st->state == "operation_enabled") return false;
+          }
+          return true;
+        },
+        Millis(2000));
   }
 
  private:
