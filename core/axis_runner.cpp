@@ -34,7 +34,8 @@ void AxisRunner::command(const Command& cmd, TimePoint now, RunnerOutput& out) n
     return;
   }
 
-  const Conversion conv = validate_and_convert(spec_, cmd, snapshot_.position);
+  const double relative_base = move_in_flight_ != 0 ? move_target_ : snapshot_.position;
+  const Conversion conv = validate_and_convert(spec_, cmd, relative_base);
   if (!conv.ok) {
     send_reply(cmd.id, ReplyStatus::Rejected, conv.reason.view());
     return;
@@ -53,6 +54,15 @@ void AxisRunner::command(const Command& cmd, TimePoint now, RunnerOutput& out) n
   if (!accepted_sent_) send_reply(cmd.id, ReplyStatus::Accepted, {});
 
   if (!is_internal(cmd.id)) active_command_ = cmd.id;
+  if (cmd.kind == CommandKind::Move) {
+    move_in_flight_ = cmd.id;
+    move_target_ = cmd.relative ? relative_base + cmd.position : cmd.position;
+  } else if (cmd.kind != CommandKind::Resume && cmd.kind != CommandKind::Halt) {
+    move_in_flight_ = 0;
+  }
+  // The command timeout watches live modes (DESIGN.md §4). Only commands that bring the axis to
+  // rest disarm it; everything else keeps or (re)arms it, so a halt/resume or a set_mode to the
+  // running mode cannot switch the watchdog off.
   switch (cmd.kind) {
     case CommandKind::Velocity:
     case CommandKind::Torque:
@@ -60,7 +70,11 @@ void AxisRunner::command(const Command& cmd, TimePoint now, RunnerOutput& out) n
       last_activity_ = now;
       break;
     case CommandKind::SetMode:
-      live_armed_ = mode_is_cyclic(cmd.mode);
+      if (mode_is_cyclic(cmd.mode)) live_armed_ = true;
+      last_activity_ = now;
+      break;
+    case CommandKind::Resume:
+      if (mode_needs_live_source(controller_.feedback().mode)) live_armed_ = true;
       last_activity_ = now;
       break;
     case CommandKind::Move:
@@ -68,7 +82,6 @@ void AxisRunner::command(const Command& cmd, TimePoint now, RunnerOutput& out) n
     case CommandKind::Stop:
     case CommandKind::Disable:
     case CommandKind::QuickStop:
-    case CommandKind::Halt:
       live_armed_ = false;
       break;
     default:
@@ -80,20 +93,30 @@ void AxisRunner::setpoint(const Setpoint& sp, TimePoint now, RunnerOutput& out) 
   out_ = &out;
   now_ = now;
   const Mode mode = controller_.feedback().mode;
+  if (!mode_is_cyclic(mode)) {
+    // In pv, vl and tq a set-point is the keep-alive of the last velocity/torque command; its
+    // values are not used (the command sets the target). Elsewhere it has no meaning.
+    if (mode_needs_live_source(mode)) {
+      last_activity_ = now;
+    } else if (rejected_setpoints_++ % 1000 == 0) {
+      Text why;
+      why.format("axis '%s' is in %s, which takes no set-points (%llu dropped so far)", spec_.name.c_str(),
+                 to_string(mode).data(), static_cast<unsigned long long>(rejected_setpoints_));
+      emit(EventKind::Warning, 0, why.view());
+    }
+    return;
+  }
   Text why;
   const auto d = convert_setpoint(spec_, mode, sp, why);
   if (!d) {
-    // Set-points stream at cycle rate: count the drop; report the first of a run as a warning
+    // Set-points stream at cycle rate: count every drop, report one in a thousand as a warning
     // so the log is not flooded.
     if (rejected_setpoints_++ % 1000 == 0) emit(EventKind::Warning, 0, why.view());
     return;
   }
   controller_.setpoint(*d, now);
-  if (mode_needs_live_source(mode)) {
-    // A set-point keeps a live mode alive, and (re)arms the timeout for streamed cyclic modes.
-    if (mode_is_cyclic(mode)) live_armed_ = true;
-    last_activity_ = now;
-  }
+  live_armed_ = true;
+  last_activity_ = now;
 }
 
 void AxisRunner::parameter(const ParamRequest& req, TimePoint now, RunnerOutput& out) noexcept {
@@ -136,8 +159,9 @@ void AxisRunner::update(TimePoint now, RunnerOutput& out) noexcept {
   ++cycle_;
   controller_.update(now, *this);
   select_default_mode(now);
-  check_command_timeout(now);
   build_snapshot(now);
+  check_command_timeout(now);
+  check_soft_limits(now);
 }
 
 void AxisRunner::select_default_mode(TimePoint now) noexcept {
@@ -165,32 +189,68 @@ void AxisRunner::select_default_mode(TimePoint now) noexcept {
   }
 }
 
+void AxisRunner::internal_stop(CommandKind kind, TimePoint now) noexcept {
+  DriveCommand stop;
+  stop.id = next_internal_++;
+  stop.kind = kind;
+  const Admission adm = controller_.submit(stop, now, *this);
+  if (!adm.accepted) {
+    Text why;
+    why.format("the gateway's %s was refused by the profile: %s", to_string(kind).data(), adm.reason.c_str());
+    emit(EventKind::Warning, 0, why.view());
+  }
+}
+
 void AxisRunner::check_command_timeout(TimePoint now) noexcept {
   const DriveFeedback& fb = controller_.feedback();
   if (!live_armed_) return;
-  if (fb.state != AxisState::OperationEnabled) {
-    live_armed_ = false;  // nothing to stop any more
+  if (fb.state != AxisState::OperationEnabled || !mode_needs_live_source(fb.mode)) {
+    live_armed_ = false;  // nothing live to stop any more
     return;
   }
   if (spec_.command_timeout <= Duration::zero() || now - last_activity_ <= spec_.command_timeout) return;
 
   live_armed_ = false;
-  DriveCommand stop;
-  stop.id = next_internal_++;
-  stop.kind = spec_.timeout_stop == TimeoutStop::Halt ? CommandKind::Stop : CommandKind::QuickStop;
+  const CommandKind kind = spec_.timeout_stop == TimeoutStop::Halt ? CommandKind::Stop : CommandKind::QuickStop;
   const auto silent_ms = std::chrono::duration_cast<std::chrono::milliseconds>(now - last_activity_).count();
   const auto limit_ms = std::chrono::duration_cast<std::chrono::milliseconds>(spec_.command_timeout).count();
   Text t;
   t.format("no command or set-point for %lld ms (command timeout %lld ms) in %s: %s", static_cast<long long>(silent_ms),
            static_cast<long long>(limit_ms), to_string(fb.mode).data(),
-           stop.kind == CommandKind::Stop ? "stopping the axis" : "quick stop");
+           kind == CommandKind::Stop ? "stopping the axis" : "quick stop");
   emit(EventKind::CommandTimeout, 0, t.view());
-  const Admission adm = controller_.submit(stop, now, *this);
-  if (!adm.accepted) {
-    Text why;
-    why.format("command timeout stop was refused by the profile: %s", adm.reason.c_str());
-    emit(EventKind::Warning, 0, why.view());
+  internal_stop(kind, now);
+}
+
+// Profile position and homing keep to the limits through the checked target; the modes that set
+// a speed or a torque do not, so the position is watched: leaving the soft limits while moving
+// further out quick-stops the axis. Moving back in stays possible.
+void AxisRunner::check_soft_limits(TimePoint now) noexcept {
+  const auto& lim = spec_.limits;
+  const DriveFeedback& fb = controller_.feedback();
+  if (!lim.has_position_limits() || fb.state != AxisState::OperationEnabled) {
+    limit_stop_sent_ = false;
+    return;
   }
+  const Mode m = fb.mode;
+  if (m != Mode::ProfileVelocity && m != Mode::Velocity && m != Mode::ProfileTorque && m != Mode::CyclicVelocity &&
+      m != Mode::CyclicTorque)
+    return;
+  const double pos = snapshot_.position;
+  const double vel = spec_.units.velocity_to_user(fb.velocity);
+  const bool outward = (pos > lim.max_position && vel > 0) || (pos < lim.min_position && vel < 0);
+  if (!outward) {
+    limit_stop_sent_ = false;
+    return;
+  }
+  if (limit_stop_sent_) return;
+  limit_stop_sent_ = true;
+  live_armed_ = false;
+  Text t;
+  t.format("position %.6g %s is outside the soft limits [%.6g, %.6g] %s and moving out: quick stop", pos,
+           spec_.user_unit.c_str(), lim.min_position, lim.max_position, spec_.user_unit.c_str());
+  emit(EventKind::Warning, 0, t.view());
+  internal_stop(CommandKind::QuickStop, now);
 }
 
 void AxisRunner::build_snapshot(TimePoint now) noexcept {
@@ -235,6 +295,7 @@ void AxisRunner::completed(CommandId id) noexcept {
     send_reply(id, ReplyStatus::Accepted, {});
     accepted_sent_ = true;
   }
+  if (id == move_in_flight_) move_in_flight_ = 0;
   if (id == active_command_) active_command_ = 0;
   send_reply(id, ReplyStatus::Completed, {});
 }
@@ -244,6 +305,7 @@ void AxisRunner::failed(CommandId id, std::string_view reason) noexcept {
     send_reply(id, ReplyStatus::Accepted, {});
     accepted_sent_ = true;
   }
+  if (id == move_in_flight_) move_in_flight_ = 0;
   if (id == active_command_) active_command_ = 0;
   send_reply(id, ReplyStatus::Failed, reason);
 }

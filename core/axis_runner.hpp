@@ -60,6 +60,8 @@ class AxisRunner final : private ControllerSink {
   void send_reply(CommandId id, ReplyStatus status, std::string_view reason) noexcept;
   void emit(EventKind kind, std::uint32_t code, std::string_view text) noexcept;
   void check_command_timeout(TimePoint now) noexcept;
+  void check_soft_limits(TimePoint now) noexcept;
+  void internal_stop(CommandKind kind, TimePoint now) noexcept;
   void select_default_mode(TimePoint now) noexcept;
   void build_snapshot(TimePoint now) noexcept;
 
@@ -73,6 +75,11 @@ class AxisRunner final : private ControllerSink {
   bool live_armed_ = false;
   TimePoint last_activity_{};
   CommandId next_internal_ = kInternalCommandBit | 1;
+
+  // Relative moves are resolved against the target of a move still in flight.
+  CommandId move_in_flight_ = 0;
+  double move_target_ = 0;
+  bool limit_stop_sent_ = false;  // soft-limit stop issued for the present excursion
 
   // The configured default mode is selected once the drive reports after each link-up.
   bool default_mode_pending_ = true;

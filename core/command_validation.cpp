@@ -77,7 +77,7 @@ Mode mode_for(CommandKind kind, const ModeSet& modes, Mode requested) noexcept {
   }
 }
 
-Conversion validate_and_convert(const AxisSpec& spec, const Command& cmd, double actual_position) noexcept {
+Conversion validate_and_convert(const AxisSpec& spec, const Command& cmd, double relative_base) noexcept {
   if (!finite_all(cmd)) return reject("command for axis '%s' contains NaN or infinity; every number must be finite",
                                       spec.name.c_str());
   Conversion out;
@@ -104,7 +104,7 @@ Conversion validate_and_convert(const AxisSpec& spec, const Command& cmd, double
   const auto& u = spec.units;
   switch (cmd.kind) {
     case CommandKind::Move: {
-      const double end = cmd.relative ? actual_position + cmd.position : cmd.position;
+      const double end = cmd.relative ? relative_base + cmd.position : cmd.position;
       if (lim.has_position_limits() && (end < lim.min_position || end > lim.max_position))
         return reject("move target %.6g %s is outside the limits of axis '%s' [%.6g, %.6g] %s", end, unit_of(spec),
                       spec.name.c_str(), lim.min_position, lim.max_position, unit_of(spec));
@@ -117,12 +117,13 @@ Conversion validate_and_convert(const AxisSpec& spec, const Command& cmd, double
       if (!a.ok || !dc.ok)
         return reject("acceleration/deceleration must be >= 0 and at most %.6g %s/s^2", lim.max_acceleration,
                       unit_of(spec));
-      const auto pos = to_int32(u.position_to_drive(cmd.position));
+      const auto pos = to_int32(u.position_to_drive(end));
       const auto pv = to_uint32(u.velocity_to_drive(v.value));
       const auto pa = to_uint32(u.acceleration_to_drive(a.value));
       const auto pd = to_uint32(u.acceleration_to_drive(dc.value));
       if (!pos || !pv || !pa || !pd) return reject("move values do not fit the drive's 32-bit objects after unit conversion");
       d.target_position = *pos;
+      d.relative = false;  // resolved above
       d.profile_velocity = *pv;
       d.profile_acceleration = *pa;
       d.profile_deceleration = *pd;

@@ -20,9 +20,12 @@ struct Conversion {
 // has no pv). Mode::None for kinds that do not select a mode (enable, stop, ...).
 Mode mode_for(CommandKind kind, const ModeSet& modes, Mode requested) noexcept;
 
-// Validates `cmd` for the axis and converts it to drive units. `actual_position` (user units) is
-// used to check the end point of relative moves against the position limits.
-Conversion validate_and_convert(const AxisSpec& spec, const Command& cmd, double actual_position) noexcept;
+// Validates `cmd` for the axis and converts it to drive units. A relative move becomes an
+// absolute target here, `relative_base + distance` (user units), and that end point is what the
+// limits are checked against: the drive's own base for relative moves differs between drives
+// (last target or actual position), which would make a limit check on the distance meaningless.
+// The runner passes the target of a move still in flight, else the actual position.
+Conversion validate_and_convert(const AxisSpec& spec, const Command& cmd, double relative_base) noexcept;
 
 // Validates and converts a streaming set-point for the given cyclic mode.
 std::optional<DriveSetpoint> convert_setpoint(const AxisSpec& spec, Mode mode, const Setpoint& sp,

@@ -45,18 +45,15 @@ class FixedString {
   }
 
   __attribute__((format(printf, 2, 0))) void vformat(const char* fmt, va_list args) noexcept {
-    std::array<char, N + 1> tmp{};
+    // One character more than fits, so that assign() sees the overflow and truncates visibly and
+    // on a UTF-8 boundary.
+    std::array<char, N + 2> tmp{};
     const int n = std::vsnprintf(tmp.data(), tmp.size(), fmt, args);
     if (n < 0) {
       clear();
       return;
     }
-    if (static_cast<std::size_t>(n) <= N) {
-      assign(std::string_view(tmp.data(), static_cast<std::size_t>(n)));
-    } else {
-      assign(std::string_view(tmp.data(), N));
-      std::copy_n("...", 3, data_.begin() + static_cast<std::ptrdiff_t>(N - 3));
-    }
+    assign(std::string_view(tmp.data(), std::min(static_cast<std::size_t>(n), N + 1)));
   }
 
   void clear() noexcept {

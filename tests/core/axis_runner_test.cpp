@@ -139,7 +139,7 @@ TEST_F(RunnerFixture, SilenceAfterVelocityCommandStopsTheAxis) {
     runner.update(now + i * 50ms, LinkState::Operational, out);
   }
   EXPECT_EQ(ctl.submitted.size(), 1u);
-  EXPECT_EQ(ctl.last_setpoint.velocity, 20000);
+  EXPECT_EQ(ctl.setpoints, 0);  // in pv a set-point is a keep-alive; the command set the target
   // Then silence: after 100 ms the runner issues a quick stop of its own, without a reply.
   runner.update(now + 250ms + 90ms, LinkState::Operational, out);
   EXPECT_EQ(ctl.submitted.size(), 1u);
@@ -150,6 +150,75 @@ TEST_F(RunnerFixture, SilenceAfterVelocityCommandStopsTheAxis) {
   EXPECT_TRUE(out.has_event(EventKind::CommandTimeout));
   // Only once.
   runner.update(now + 2s, LinkState::Operational, out);
+  EXPECT_EQ(ctl.submitted.size(), 2u);
+}
+
+TEST_F(RunnerFixture, HaltAndResumeKeepTheCommandTimeoutArmed) {
+  auto v = cmd(14, CommandKind::Velocity);
+  v.velocity = 20;
+  runner.command(v, now, out);
+  runner.command(cmd(15, CommandKind::Halt), now + 10ms, out);
+  runner.command(cmd(16, CommandKind::Resume), now + 20ms, out);
+  runner.update(now + 200ms, LinkState::Operational, out);
+  ASSERT_EQ(ctl.submitted.size(), 4u);
+  EXPECT_EQ(ctl.submitted[3].kind, CommandKind::QuickStop);
+}
+
+TEST_F(RunnerFixture, SetModeToTheRunningModeKeepsTheCommandTimeoutArmed) {
+  auto v = cmd(17, CommandKind::Velocity);
+  v.velocity = 20;
+  runner.command(v, now, out);
+  auto m = cmd(18, CommandKind::SetMode);
+  m.mode = Mode::ProfileVelocity;
+  runner.command(m, now + 10ms, out);
+  runner.update(now + 200ms, LinkState::Operational, out);
+  ASSERT_EQ(ctl.submitted.size(), 3u);
+  EXPECT_EQ(ctl.submitted[2].kind, CommandKind::QuickStop);
+}
+
+TEST_F(RunnerFixture, RelativeMovesBecomeAbsoluteAndAreCheckedAtTheirEnd) {
+  // Axis at 0; a move to 450 is in flight: a relative +40 ends at 490 (allowed), +60 at 510 (not).
+  auto a = cmd(20, CommandKind::Move);
+  a.position = 450;
+  runner.command(a, now, out);
+  auto r = cmd(21, CommandKind::Move);
+  r.relative = true;
+  r.position = 60;
+  runner.command(r, now, out);
+  EXPECT_EQ(out.replies.back().status, ReplyStatus::Rejected);
+  r.id = 22;
+  r.position = 40;
+  runner.command(r, now, out);
+  EXPECT_EQ(out.replies.back().status, ReplyStatus::Accepted);
+  EXPECT_EQ(ctl.submitted.back().target_position, 490000);
+  EXPECT_FALSE(ctl.submitted.back().relative);
+  // Once that move is done, relative moves count from the actual position.
+  ctl.complete_next = 22;
+  ctl.fb.position = 490000;
+  runner.update(now + 1ms, LinkState::Operational, out);
+  r.id = 23;
+  r.position = -10;
+  runner.command(r, now + 2ms, out);
+  EXPECT_EQ(ctl.submitted.back().target_position, 480000);
+}
+
+TEST_F(RunnerFixture, LeavingTheSoftLimitsInVelocityModeQuickStops) {
+  auto v = cmd(24, CommandKind::Velocity);
+  v.velocity = 20;
+  runner.command(v, now, out);
+  ctl.fb.velocity = 20000;
+  ctl.fb.position = 499000;  // 499 mm, inside
+  runner.update(now + 1ms, LinkState::Operational, out);
+  EXPECT_EQ(ctl.submitted.size(), 1u);
+  ctl.fb.position = 500500;  // 500.5 mm, outside and moving out
+  runner.update(now + 2ms, LinkState::Operational, out);
+  ASSERT_EQ(ctl.submitted.size(), 2u);
+  EXPECT_EQ(ctl.submitted[1].kind, CommandKind::QuickStop);
+  runner.update(now + 3ms, LinkState::Operational, out);
+  EXPECT_EQ(ctl.submitted.size(), 2u);  // once per excursion
+  // Moving back in is allowed.
+  ctl.fb.velocity = -20000;
+  runner.update(now + 4ms, LinkState::Operational, out);
   EXPECT_EQ(ctl.submitted.size(), 2u);
 }
 

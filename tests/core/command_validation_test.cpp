@@ -45,11 +45,14 @@ TEST(CommandValidation, PositionOutsideLimitsSaysWhichLimits) {
   const auto r = validate_and_convert(spec, move_to(600), 0);
   ASSERT_FALSE(r.ok);
   EXPECT_NE(r.reason.view().find("[-100, 500] mm"), std::string_view::npos) << r.reason.view();
-  // A relative move is checked at its end point.
+  // A relative move is checked at its end point and becomes an absolute target.
   auto rel = move_to(50);
   rel.relative = true;
   EXPECT_FALSE(validate_and_convert(spec, rel, 480).ok);
-  EXPECT_TRUE(validate_and_convert(spec, rel, 400).ok);
+  const auto ok = validate_and_convert(spec, rel, 400);
+  ASSERT_TRUE(ok.ok);
+  EXPECT_EQ(ok.drive.target_position, 450000);
+  EXPECT_FALSE(ok.drive.relative);
 }
 
 TEST(CommandValidation, RatesAboveLimitsAreRejectedNotClamped) {

@@ -26,3 +26,9 @@ TEST(FixedString, FormatsAndTruncates) {
   EXPECT_EQ(s.size(), 16u);
   EXPECT_EQ(s.view().substr(13), "...");
 }
+
+TEST(FixedString, FormattedTruncationKeepsUtf8Whole) {
+  FixedString<8> s;
+  s.format("%s", "abcd\xc3\xa4xyzw");
+  EXPECT_EQ(s.view(), "abcd...");
+}
