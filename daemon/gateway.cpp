@@ -13,9 +13,10 @@ namespace drivegate::daemon {
 using namespace std::chrono_literals;
 
 namespace {
+// States in which the power stage is off and stays off without a new command.
 bool is_disabled(core::AxisState s) noexcept {
   return s == core::AxisState::SwitchOnDisabled || s == core::AxisState::NotReadyToSwitchOn ||
-         s == core::AxisState::ReadyToSwitchOn || s == core::AxisState::Fault || s == core::AxisState::Unknown;
+         s == core::AxisState::Fault;
 }
 std::string_view severity_of(core::EventKind k) {
   switch (k) {
@@ -107,6 +108,16 @@ bool Gateway::submit_setpoint(std::size_t axis_id, const core::Setpoint& sp) {
 bool Gateway::submit_parameter(std::size_t axis_id, const core::ParamRequest& req) {
   if (axis_id >= refs_.size()) return false;
   std::lock_guard lock(submit_mutex_);
+  if (shutting_down_.load()) {
+    GlobalParamReply r;
+    r.axis_id = axis_id;
+    r.reply.id = req.id;
+    r.reply.axis = refs_[axis_id].axis;
+    r.reply.ok = false;
+    r.reply.error.assign("gateway is shutting down: no parameter access while axes are being disabled");
+    local_param_replies_.push_back(r);
+    return true;
+  }
   core::ParamRequest r = req;
   r.axis = refs_[axis_id].axis;
   return buses_[refs_[axis_id].bus].runner->push_parameter(r);
@@ -169,6 +180,8 @@ void Gateway::drain(Outbox& out) {
   std::lock_guard lock(submit_mutex_);
   out.replies.insert(out.replies.end(), local_replies_.begin(), local_replies_.end());
   local_replies_.clear();
+  out.param_replies.insert(out.param_replies.end(), local_param_replies_.begin(), local_param_replies_.end());
+  local_param_replies_.clear();
 }
 
 void Gateway::submit_internal(std::size_t axis_id, core::CommandKind kind) {
@@ -187,7 +200,7 @@ bool Gateway::wait_all(Pred pred, core::Duration budget) const {
   const auto deadline = std::chrono::steady_clock::now() + budget;
   for (;;) {
     bool all = true;
-    for (std::size_t i = 0; i < refs_.size() && all; ++i) all = pred(snapshot(i));
+    for (std::size_t i = 0; i < refs_.size() && all; ++i) all = pred(i, snapshot(i));
     if (all) return true;
     if (std::chrono::steady_clock::now() >= deadline) return false;
     // Polling the seqlocked snapshots: the cycle threads must not be made to signal anyone.
@@ -197,29 +210,46 @@ bool Gateway::wait_all(Pred pred, core::Duration budget) const {
 
 ShutdownReport Gateway::shutdown(core::Duration phase_budget) {
   ShutdownReport report;
-  shutting_down_ = true;
+  {
+    // From here on client commands are refused; what was queued before is still handled, in
+    // order, ahead of the stop and disable below.
+    std::lock_guard lock(submit_mutex_);
+    shutting_down_ = true;
+  }
   const auto reachable = [](const core::AxisSnapshot& s) { return s.link == core::LinkState::Operational; };
+  // A snapshot taken before a command was handled says nothing about its effect: wait for a
+  // cycle that started after the submission.
+  std::vector<std::uint64_t> submitted_at(refs_.size(), 0);
+  const auto fresh = [&](std::size_t i, const core::AxisSnapshot& s) { return s.cycle > submitted_at[i] + 1; };
 
   bool any_thread = false;
   for (const auto& b : buses_) any_thread = any_thread || (b.thread && b.thread->running());
   if (any_thread) {
-    // Phase 1: brake every moving/enabled axis on its quick-stop ramp.
+    // Phase 1: brake every enabled axis on its quick-stop ramp.
     for (std::size_t i = 0; i < refs_.size(); ++i) {
       const auto s = snapshot(i);
+      submitted_at[i] = s.cycle;
       if (reachable(s) && s.state == core::AxisState::OperationEnabled) {
         submit_internal(i, core::CommandKind::QuickStop);
         ++report.stopped;
       }
     }
     if (report.stopped > 0)
-      wait_all([&](const core::AxisSnapshot& s) { return !reachable(s) || s.state != core::AxisState::OperationEnabled; },
-               phase_budget);
-    // Phase 2: remove the power stage of every axis that still has one.
+      wait_all(
+          [&](std::size_t i, const core::AxisSnapshot& s) {
+            return !reachable(s) || (fresh(i, s) && s.state != core::AxisState::OperationEnabled);
+          },
+          phase_budget);
+    // Phase 2: disable every reachable axis, whatever state it showed: one that is half-way
+    // through an enable walk may still show switch_on_disabled. A disable of a disabled axis
+    // completes at once.
     for (std::size_t i = 0; i < refs_.size(); ++i) {
       const auto s = snapshot(i);
-      if (reachable(s) && !is_disabled(s.state)) submit_internal(i, core::CommandKind::Disable);
+      submitted_at[i] = s.cycle;
+      if (reachable(s)) submit_internal(i, core::CommandKind::Disable);
     }
-    wait_all([&](const core::AxisSnapshot& s) { return !reachable(s) || is_disabled(s.state); }, phase_budget);
+    wait_all([&](std::size_t i, const core::AxisSnapshot& s) { return !reachable(s) || (fresh(i, s) && is_disabled(s.state)); },
+             phase_budget);
     for (std::size_t i = 0; i < refs_.size(); ++i) {
       const auto s = snapshot(i);
       if (!reachable(s) || is_disabled(s.state))

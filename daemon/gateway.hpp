@@ -83,6 +83,7 @@ class Gateway final : public Runtime {
   std::mutex submit_mutex_;
   std::atomic<bool> shutting_down_{false};
   std::vector<GlobalReply> local_replies_;  // refusals made here; guarded by submit_mutex_
+  std::vector<GlobalParamReply> local_param_replies_;  // likewise
   core::CommandId next_internal_ = core::kInternalCommandBit | (core::CommandId{1} << 62);
 };
 

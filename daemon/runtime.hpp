@@ -2,8 +2,9 @@
 // What the control plane (the DDS bridge) sees of a running gateway. The implementation owns the
 // buses and their cycle threads; this interface hides them behind axis ids (an index into axes()).
 //
-// Threading: all submit_*() calls must come from ONE thread (the bridge thread): they feed
-// single-producer queues. snapshot(), bus_status() and drain() are for that same thread too.
+// Threading: submit_*() may be called from any control-plane thread (the implementation
+// serialises them in front of its single-producer queues); drain() from one thread only.
+// snapshot() and bus_status() from any thread.
 #include <cstddef>
 #include <cstdint>
 #include <span>
