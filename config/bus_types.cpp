@@ -7,7 +7,7 @@ namespace drivegate::config {
 BusTypeRegistry BusTypeRegistry::builtin() {
   BusTypeRegistry r;
   r.add({"sim", true, 1, 127,
-         {{"acyclic_latency_cycles", OptionKind::Integer, 0, 1000, std::int64_t{1},
+         {{"acyclic_latency_cycles", OptionKind::Integer, 1, 1000, std::int64_t{1},
            "cycles before a simulated drive answers an acyclic read/write"}},
          "sim"});
   // Node-ids 1..127 [CiA 301]; EtherCAT configured station addresses; PROFINET device numbers.

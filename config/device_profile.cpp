@@ -149,8 +149,9 @@ void read_profile(const MapReader& root, const fs::path& file, DeviceProfile& p)
       const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : std::string{"?"};
       const std::string path = faults.path() + "." + key;
       const std::int64_t code = parse_integer(key).value_or(-1);
-      if (code < 0 || code > 0xFFFFFFFF) {
-        src.error(kv.first.Mark(), path, "fault codes must be integers 0..0xFFFFFFFF, got " + describe_value(kv.first));
+      // CiA 402 error codes (603Fh, EMCY) are 16 bits wide.
+      if (code < 0 || code > 0xFFFF) {
+        src.error(kv.first.Mark(), path, "fault codes must be integers 0..0xFFFF, got " + describe_value(kv.first));
         continue;
       }
       if (const auto text = read_string(kv.second, path, src)) p.fault_texts[static_cast<std::uint32_t>(code)] = *text;

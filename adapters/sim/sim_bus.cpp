@@ -47,7 +47,7 @@ SimBus::SimBus(const config::BusPlan& plan) : name_(plan.name), cycle_time_(plan
     n.model = std::make_unique<cia402::sim::DriveModel>(drive_config_for(axis));
     n.mapped = axis.device.cyclic_objects;
     n.io = std::make_unique<cia402::sim::DirectObjectAccess>(
-        *n.model, n.mapped, static_cast<unsigned>(std::max(1, plan.sim.acyclic_latency_cycles)));
+        *n.model, n.mapped, static_cast<unsigned>(plan.sim.acyclic_latency_cycles));
     for (const auto& [code, text] : axis.device.fault_texts)
       n.faults.push_back({static_cast<std::uint16_t>(code), text});
     n.master = std::make_unique<cia402::Cia402Master>(*n.io, cia402::settings_from(axis.spec));

@@ -209,7 +209,7 @@ axes:
   EXPECT_REPORTED(e, "t.yaml:9:17: buses[0].cycle_time: must be a duration in 100us..1s");
   EXPECT_REPORTED(e, "t.yaml:10:15: buses[0].priority: must be an integer in 0..99, got \"100\"");
   EXPECT_REPORTED(e, "t.yaml:11:10: buses[0].cpu: must be an integer in -1..1023, got \"-2\"");
-  EXPECT_REPORTED(e, "t.yaml:12:40: buses[0].options.acyclic_latency_cycles: must be an integer in 0..1000");
+  EXPECT_REPORTED(e, "t.yaml:12:40: buses[0].options.acyclic_latency_cycles: must be an integer in 1..1000");
   EXPECT_REPORTED(e, "t.yaml:15:17: buses[1].cycle_time: must be a duration in 100us..1s");
   EXPECT_REPORTED(e, "t.yaml:19:14: axes[0].address: must be an integer in 1..127, got \"200\"");
   EXPECT_REPORTED(e, "t.yaml:21:22: axes[0].command_timeout: must be a duration > 0");
