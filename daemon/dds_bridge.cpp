@@ -32,8 +32,8 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 
-// Replies for commands that never reach a final state (e.g. an enable superseded by a disable) must
-// not pile up forever: the oldest bookkeeping entries are dropped beyond this many.
+// Every command gets a final reply, but a gateway that loses replies (its outbound queue full)
+// must not make this bookkeeping grow without bound: the oldest entries go beyond this many.
 constexpr std::size_t kMaxPending = 4096;
 // The Runtime has no wake-up signal, so its outbox is drained at least this often.
 constexpr auto kMaxPoll = std::chrono::milliseconds(5);
