@@ -34,6 +34,31 @@ std::vector<fs::path> default_device_dirs() {
 
 namespace {
 
+// The cyclic image must carry what the profile drives every cycle: the controlword and statusword
+// always, and the target object of each cyclic mode the profile offers (without it the mode could
+// not follow set-points and would jump to a stale target when enabled).
+void check_cyclic_image(const DeviceProfile& p, const MapReader& root) {
+  struct Need {
+    std::optional<core::Mode> mode;  // nullopt: needed whatever the modes
+    cia402::ObjectId object;
+    const char* what;
+  };
+  const Need needs[] = {
+      {std::nullopt, {0x6040, 0}, "0x6040 (controlword)"},
+      {std::nullopt, {0x6041, 0}, "0x6041 (statusword)"},
+      {core::Mode::InterpolatedPosition, {0x60C1, 1}, "0x60C1:1 (interpolation data record) for mode ip"},
+      {core::Mode::CyclicPosition, {0x607A, 0}, "0x607A (target position) for mode csp"},
+      {core::Mode::CyclicVelocity, {0x60FF, 0}, "0x60FF (target velocity) for mode csv"},
+      {core::Mode::CyclicTorque, {0x6071, 0}, "0x6071 (target torque) for mode cst"},
+  };
+  for (const auto& n : needs) {
+    if (n.mode && !p.modes.contains(*n.mode)) continue;
+    bool found = false;
+    for (const auto& id : p.cyclic_objects) found = found || id == n.object;
+    if (!found) root.error("cyclic_objects", std::string("must include ") + n.what);
+  }
+}
+
 const std::vector<std::string> kProfileKeys{"name", "vendor", "description", "identity", "modes", "units",
                                             "homing_methods", "fault_texts", "quirks", "cyclic_objects"};
 
@@ -175,6 +200,7 @@ void read_profile(const MapReader& root, const fs::path& file, DeviceProfile& p)
         p.cyclic_objects.push_back(*id);
     }
   }
+  check_cyclic_image(p, root);
 }
 
 }  // namespace

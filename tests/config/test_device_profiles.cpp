@@ -111,6 +111,21 @@ colour: red
   EXPECT_NE(e.find(f + ":12:1: colour: unknown field"), std::string::npos) << e;
 }
 
+TEST_F(BrokenProfile, CyclicModesNeedTheirTargetInTheCyclicImage) {
+  const fs::path p = write("thin-drive", R"(name: thin-drive
+vendor: test
+modes: [pp, ip, csv]
+units: { position: { per_rev: counts }, velocity: { unit: position_per_s }, acceleration: { unit: position_per_s2 } }
+cyclic_objects: ["0x6040", "0x6041", "0x607A"]
+)");
+  const std::string e = errors_of(p);
+  const std::string f = p.string();
+  EXPECT_NE(e.find(f + ":5:17: cyclic_objects: must include 0x60C1:1 (interpolation data record) for mode ip"),
+            std::string::npos) << e;
+  EXPECT_NE(e.find("must include 0x60FF (target velocity) for mode csv"), std::string::npos) << e;
+  EXPECT_EQ(e.find("0x6040 (controlword)"), std::string::npos) << e;
+}
+
 TEST_F(BrokenProfile, MissingRequiredSections) {
   const fs::path p = write("empty-drive", "name: empty-drive\n");
   const std::string e = errors_of(p);

@@ -117,7 +117,7 @@ TEST(LoadValid, AxisSpecIsFilledWithHandComputedFactors) {
   EXPECT_DOUBLE_EQ(*x.sim.positive_limit_switch_position, 510 * 78643.2);
   EXPECT_DOUBLE_EQ(x.sim.max_velocity, 300 * 78643.2);
   EXPECT_DOUBLE_EQ(x.sim.max_acceleration, 1000.0 * 131072.0);  // default: 1000 motor rev/s^2
-  ASSERT_EQ(x.device.cyclic_objects.size(), 11U);
+  ASSERT_EQ(x.device.cyclic_objects.size(), 12U);
   EXPECT_EQ(x.device.cyclic_objects[0], (cia402::ObjectId{0x6040, 0}));
 }
 
