@@ -70,7 +70,10 @@ void AxisRunner::command(const Command& cmd, TimePoint now, RunnerOutput& out) n
       last_activity_ = now;
       break;
     case CommandKind::SetMode:
+      // A switch to a live mode keeps (cyclic: arms) the watchdog; the profile accepts a switch
+      // to a resting mode only at standstill, so that one disarms it.
       if (mode_is_cyclic(cmd.mode)) live_armed_ = true;
+      if (!mode_needs_live_source(cmd.mode)) live_armed_ = false;
       last_activity_ = now;
       break;
     case CommandKind::Resume:
@@ -204,7 +207,9 @@ void AxisRunner::internal_stop(CommandKind kind, TimePoint now) noexcept {
 void AxisRunner::check_command_timeout(TimePoint now) noexcept {
   const DriveFeedback& fb = controller_.feedback();
   if (!live_armed_) return;
-  if (fb.state != AxisState::OperationEnabled || !mode_needs_live_source(fb.mode)) {
+  // Judged by the commands, not by the mode the drive shows: right after a velocity command the
+  // drive may still be switching over from another mode.
+  if (fb.state != AxisState::OperationEnabled) {
     live_armed_ = false;  // nothing live to stop any more
     return;
   }

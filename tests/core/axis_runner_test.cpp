@@ -353,3 +353,16 @@ TEST(AxisRunnerDefaultMode, SelectedOnceTheDriveReportsAndAgainAfterALinkLoss) {
   runner.update(t + 6ms, LinkState::Operational, out);
   EXPECT_EQ(ctl.submitted.size(), 2u);
 }
+
+TEST_F(RunnerFixture, TimeoutArmedWhileTheDriveStillSwitchesIntoTheLiveMode) {
+  ctl.fb.mode = Mode::ProfilePosition;
+  auto v = cmd(30, CommandKind::Velocity);
+  v.velocity = 20;
+  runner.command(v, now, out);
+  ctl.fb.mode = Mode::ProfilePosition;  // 6061h has not followed yet
+  runner.update(now + 1ms, LinkState::Operational, out);
+  ctl.fb.mode = Mode::ProfileVelocity;
+  runner.update(now + 200ms, LinkState::Operational, out);
+  ASSERT_EQ(ctl.submitted.size(), 2u);
+  EXPECT_EQ(ctl.submitted[1].kind, CommandKind::QuickStop);
+}

@@ -22,27 +22,32 @@ TEST(Seqlock, ReaderNeverSeesATornValue) {
   Payload first;
   first.b = ~first.a;
   lock.store(first);
-  std::atomic<bool> done{false};
+  // The writer runs until the reader has made its reads, so the two overlap however the
+  // threads are scheduled.
+  constexpr std::uint64_t kReads = 200000;
+  std::atomic<bool> reader_done{false};
+  std::atomic<std::uint64_t> written{0};
   std::thread writer([&] {
     Payload p;
-    for (std::uint64_t i = 1; i < 300000; ++i) {
+    for (std::uint64_t i = 1; !reader_done.load(std::memory_order_relaxed); ++i) {
       p.a = i;
       p.b = ~i;
       for (auto& x : p.c) x = i;
       lock.store(p);
+      written.store(i, std::memory_order_relaxed);
     }
-    done = true;
   });
-  std::uint64_t reads = 0;
-  while (!done) {
+  std::uint64_t last = 0;
+  for (std::uint64_t n = 0; n < kReads; ++n) {
     const Payload p = lock.load();
     ASSERT_EQ(p.b, ~p.a);
     for (auto x : p.c) ASSERT_EQ(x, p.a);
-    ++reads;
+    ASSERT_GE(p.a, last);  // never goes back in time
+    last = p.a;
   }
+  reader_done = true;
   writer.join();
-  EXPECT_GT(reads, 0u);
-  EXPECT_EQ(lock.load().a, 299999u);
+  EXPECT_EQ(lock.load().a, written.load());
 }
 
 TEST(Seqlock, CarriesAxisSnapshots) {
