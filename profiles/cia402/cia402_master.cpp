@@ -4,7 +4,9 @@
 #include <cstdint>
 
 #include "profiles/cia402/controlword.hpp"
+#include "profiles/cia402/master_helpers.hpp"
 #include "profiles/cia402/op_modes.hpp"
+#include "profiles/cia402/statusword.hpp"
 
 namespace drivegate::cia402 {
 
@@ -14,10 +16,6 @@ using core::CommandKind;
 using core::Mode;
 
 namespace {
-
-bool in_fault(AxisState s) noexcept { return s == AxisState::Fault || s == AxisState::FaultReactionActive; }
-
-std::string_view mode_name(Mode m) noexcept { return m == Mode::None ? std::string_view("none") : core::mode_short_name(m); }
 
 DataType param_type(std::uint8_t size, bool is_signed) noexcept {
   switch (size) {
@@ -54,13 +52,49 @@ Mode Cia402Master::motion_mode(const core::DriveCommand& cmd) const noexcept {
 
 bool Cia402Master::at_standstill() const noexcept {
   if (state_ != AxisState::OperationEnabled && state_ != AxisState::QuickStopActive) return true;  // no torque
-  const ObjectId vel = from_op_mode(display_mode_) == Mode::Velocity ? obj::kVlVelocityActual.id : obj::kVelocityActual.id;
+  const Mode mode = from_op_mode(display_mode_);
+  const ObjectId vel = mode == Mode::Velocity ? obj::kVlVelocityActual.id : obj::kVelocityActual.id;
   if (io_.mapped(vel)) {
     const std::int64_t v = io_.read(vel);
     return v >= -settings_.standstill_velocity && v <= settings_.standstill_velocity;
   }
-  // No velocity in the image: the best the drive tells us is "target reached" (SW bit 10).
-  return (statusword_ & (1U << 10)) != 0;
+  // No velocity in the image: bit 10 says standstill only where it means "target reached" at rest:
+  // after the quick stop ramp, with halt set [CiA 402 §6.4.2.2], and in pp/hm once no move or
+  // homing run is in flight. In pv it means "velocity reached", which is standstill only when the
+  // target is 0; in tq, vl and csv/cst it says nothing about the speed.
+  const bool reached = (statusword_ & sw::kTargetReached) != 0;
+  if (state_ == AxisState::QuickStopActive) return reached;
+  if (halt_ && cycle_ >= halt_settle_until_) return reached;
+  const bool moving_command =
+      motion_.slot.active && (motion_.slot.kind == CommandKind::Move || motion_.slot.kind == CommandKind::Home);
+  switch (mode) {
+    case Mode::ProfilePosition:
+    case Mode::Homing: return reached && !moving_command;
+    case Mode::ProfileVelocity: return velocity_target_ == 0 && cycle_ >= velocity_settle_until_ && reached;
+    // Holding the position the axis stood at (no client set-points since enable or stop).
+    case Mode::InterpolatedPosition:
+    case Mode::CyclicPosition: return !cyclic_has_setpoint_ && cyclic_hold_frozen_;
+    default: return false;
+  }
+}
+
+bool Cia402Master::profile_owns(ObjectId id) const noexcept {
+  // Whatever travels in the cyclic image is overwritten by it; the controlword and mode are the
+  // state machine's; a target written behind the profile's back moves the axis without a command
+  // (and without the command timeout that stops it).
+  if (io_.mapped(id)) return true;
+  switch (id.index) {
+    case 0x6040: case 0x6060: case 0x607A: case 0x60FF: case 0x6071: case 0x6042: case 0x60C1: return true;
+    default: break;
+  }
+  if (!motion_.slot.active) return false;
+  // Ramps, profile velocity, quick stop option and homing parameters the command in flight staged
+  // or relies on.
+  switch (id.index) {
+    case 0x605A: case 0x6081: case 0x6083: case 0x6084: case 0x6087:
+    case 0x607C: case 0x6098: case 0x6099: case 0x609A: return true;
+    default: return false;
+  }
 }
 
 Admission Cia402Master::admit_motion(const core::DriveCommand& cmd, Mode mode) const noexcept {
@@ -70,6 +104,38 @@ Admission Cia402Master::admit_motion(const core::DriveCommand& cmd, Mode mode) c
   if (!to_op_mode(mode)) {
     no.reason.format("mode %s is not a CiA 402 mode", mode_name(mode).data());
     return no;
+  }
+  if (cmd.kind != CommandKind::Stop && core::mode_is_cyclic(mode)) {
+    // The cyclic modes follow what the image holds from the first cycle on: without the target
+    // in the image the drive would chase a stale or zero target [AKD digest §8.3].
+    const char* needs = nullptr;
+    switch (mode) {
+      case Mode::InterpolatedPosition:
+        if (!io_.mapped(obj::kIpDataRecord.id)) needs = "60C1h:1";
+        break;
+      case Mode::CyclicPosition:
+        if (!io_.mapped(obj::kTargetPosition.id)) needs = "607Ah";
+        break;
+      case Mode::CyclicVelocity:
+        if (!io_.mapped(obj::kTargetVelocity.id)) needs = "60FFh";
+        break;
+      default:
+        if (!io_.mapped(obj::kTargetTorque.id)) needs = "6071h";
+        break;
+    }
+    // Position modes start from the position the axis stands at, which only 6064h tells.
+    if (needs == nullptr && (mode == Mode::InterpolatedPosition || mode == Mode::CyclicPosition) &&
+        !io_.mapped(obj::kPositionActual.id)) {
+      needs = "6064h";
+    }
+    if (needs != nullptr) {
+      const char* name = mode == Mode::InterpolatedPosition ? "interpolated position"
+                         : mode == Mode::CyclicPosition     ? "cyclic synchronous position"
+                         : mode == Mode::CyclicVelocity     ? "cyclic synchronous velocity"
+                                                            : "cyclic synchronous torque";
+      no.reason.format("%s needs %s in the cyclic image", name, needs);
+      return no;
+    }
   }
   if (cmd.kind != CommandKind::SetMode) {
     if (cmd.mode != Mode::None && cmd.mode != mode && cmd.kind != CommandKind::Stop) {
@@ -128,7 +194,7 @@ Admission Cia402Master::submit(const core::DriveCommand& cmd, core::TimePoint no
       abort_slot(device_slot_, cmd, sink);
       device_.start(DeviceGoal::Enable, state_, now);
       device_slot_ = incoming;
-      restart_cyclic_hold();
+      if (state_ != AxisState::OperationEnabled) write_safe_holds();  // a walk starts: no old motion
       return Admission::accept();
 
     case CommandKind::Disable:
@@ -136,19 +202,28 @@ Admission Cia402Master::submit(const core::DriveCommand& cmd, core::TimePoint no
       abort_slot(device_slot_, cmd, sink);
       abort_slot(motion_.slot, cmd, sink);
       abort_slot(halt_slot_, cmd, sink);
+      abandon_motion_requests();
       mode_switching_ = false;
       bit4_ = false;
       halt_ = false;
+      write_safe_holds();
+      if (cmd.kind == CommandKind::Disable && (in_fault(state_) || state_ == AxisState::NotReadyToSwitchOn)) {
+        // The power stage is already off [AKD digest §3.2, §3.7]: keep 0x0000 (no fault reset edge).
+        device_.hold(cw::kDisableVoltage);
+        sink.completed(cmd.id);
+        return Admission::accept();
+      }
       device_.start(cmd.kind == CommandKind::Disable ? DeviceGoal::Disable : DeviceGoal::QuickStop, state_, now);
       device_slot_ = incoming;
       return Admission::accept();
 
     case CommandKind::FaultReset:
-      abort_slot(device_slot_, cmd, sink);
       if (!in_fault(state_)) {
-        sink.completed(cmd.id);  // nothing to reset
+        // Nothing to reset; an enable or disable walk in progress goes on undisturbed.
+        sink.completed(cmd.id);
         return Admission::accept();
       }
+      abort_slot(device_slot_, cmd, sink);
       device_.start(DeviceGoal::FaultReset, state_, now);
       device_slot_ = incoming;
       return Admission::accept();
@@ -188,7 +263,7 @@ Admission Cia402Master::submit(const core::DriveCommand& cmd, core::TimePoint no
   const Mode mode = motion_mode(cmd);
   const Admission admission = admit_motion(cmd, mode);
   if (!admission.accepted) return admission;
-  abort_slot(motion_.slot, cmd, sink);
+  abort_slot(motion_.slot, cmd, sink);  // start_motion() cancels its requests in flight
   if (cmd.kind != CommandKind::SetMode && cmd.kind != CommandKind::Stop) {
     abort_slot(halt_slot_, cmd, sink);  // a new motion command implies resume
     halt_ = false;
@@ -214,6 +289,7 @@ void Cia402Master::setpoint(const core::DriveSetpoint& sp, core::TimePoint /*now
   }
   io_.write(target, value);
   cyclic_has_setpoint_ = true;
+  if (mode == Mode::InterpolatedPosition) ip_target_valid_ = true;
 }
 
 Admission Cia402Master::parameter(const core::ParamRequest& req, core::TimePoint /*now*/) noexcept {
@@ -226,6 +302,10 @@ Admission Cia402Master::parameter(const core::ParamRequest& req, core::TimePoint
   if (req.write && !fits(req.value, req.size, req.is_signed)) {
     no.reason.format("value %lld does not fit in a %u-byte %s object", static_cast<long long>(req.value),
                      static_cast<unsigned>(req.size), req.is_signed ? "signed" : "unsigned");
+    return no;
+  }
+  if (req.write && profile_owns(ObjectId{req.index, req.sub})) {
+    no.reason.format("%04Xh is driven by the CiA 402 profile; use the axis commands", static_cast<unsigned>(req.index));
     return no;
   }
   for (auto& p : params_) {
@@ -245,12 +325,19 @@ void Cia402Master::link_lost(core::TimePoint /*now*/, core::ControllerSink& sink
   for (auto& p : params_) {
     if (!p.active) continue;
     p.active = false;
+    io_.cancel(p.request);
     core::ParamReply reply;
     reply.id = p.req.id;
     reply.axis = p.req.axis;
     reply.error = kLost;
     sink.parameter_done(reply);
   }
+  // Nothing in flight is wanted any more: free the adapter's request slots.
+  abandon_motion_requests();
+  io_.cancel(status_read_);
+  io_.cancel(display_read_);
+  io_.cancel(cw_write_);
+  io_.cancel(fault_read_);
   // Forget the drive; it comes back disabled (DESIGN.md §4 safety rules).
   device_.reset();
   status_valid_ = false;
@@ -271,7 +358,7 @@ void Cia402Master::link_lost(core::TimePoint /*now*/, core::ControllerSink& sink
   last_warning_ = false;
   last_remote_ = true;
   flags_seen_ = false;
-  restart_cyclic_hold();
+  write_safe_holds();
   last_cw_ = cw::kDisableVoltage;
   if (io_.mapped(obj::kControlword.id)) io_.write(obj::kControlword.id, cw::kDisableVoltage);
   fb_ = core::DriveFeedback{};

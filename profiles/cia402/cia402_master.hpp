@@ -6,7 +6,12 @@
 // command (set_mode, move, velocity, torque, home, stop) and a halt command (halt, resume) can be in
 // flight at the same time. A newer command of the same kind supersedes the older one ("superseded
 // by command N"); a newer conflicting one aborts it ("aborted by <kind> command N"). Disable and
-// quick stop abort everything. A new motion command clears halt (it implies resume).
+// quick stop abort everything. A new motion command clears halt (it implies resume). Acyclic
+// requests of a command that ends early are cancelled (ObjectAccess::cancel).
+//
+// Safe holds: when an enable walk starts, and on disable, quick stop, fault and link loss, the
+// motion targets in the cyclic image are reset (60FFh/6071h/6042h = 0; 607Ah in csp and 60C1h:1 in
+// ip = actual position), so that a later bare enable does not resume an old motion.
 //
 // Nothing here allocates, locks or blocks: all state is inline, texts are FixedString.
 #include <array>
@@ -79,6 +84,7 @@ class Cia402Master final : public core::AxisController {
   core::Admission admit_motion(const core::DriveCommand& cmd, core::Mode mode) const noexcept;
   [[nodiscard]] core::Mode motion_mode(const core::DriveCommand& cmd) const noexcept;
   [[nodiscard]] bool at_standstill() const noexcept;
+  [[nodiscard]] bool profile_owns(ObjectId id) const noexcept;
   void abort_slot(Slot& slot, const core::DriveCommand& by, core::ControllerSink& sink) noexcept;
   void fail_slot(Slot& slot, std::string_view reason, core::ControllerSink& sink) noexcept;
   void complete_slot(Slot& slot, core::ControllerSink& sink) noexcept;
@@ -102,6 +108,9 @@ class Cia402Master final : public core::AxisController {
   [[nodiscard]] bool motion_done() const noexcept;
   void finish_motion(core::ControllerSink& sink) noexcept;
   void fail_motion(std::string_view reason, core::ControllerSink& sink) noexcept;
+  void abandon_motion_requests() noexcept;
+  void write_safe_holds() noexcept;
+  void set_velocity_target(std::int64_t value) noexcept;
   void run_halt(core::ControllerSink& sink) noexcept;
   void hold_cyclic() noexcept;
   void restart_cyclic_hold() noexcept;
@@ -137,6 +146,7 @@ class Cia402Master final : public core::AxisController {
   bool bit4_ = false;          // pp new set-point, hm homing start, ip enable interpolation
   std::uint16_t pp_bits_ = 0;  // pp change immediately / relative for the set-point in flight
   bool halt_ = false;
+  bool vl_armed_ = false;  // vl run bits 4..6: only once a velocity command was staged since enable
   std::uint16_t last_cw_ = 0;
   RequestId cw_write_ = kNoRequest;  // 6040h write when it is not mapped
   std::uint16_t cw_inflight_ = 0;
@@ -146,8 +156,13 @@ class Cia402Master final : public core::AxisController {
   // Cyclic modes: what the drive gets before the first set-point arrives.
   bool cyclic_has_setpoint_ = false;
   bool cyclic_hold_frozen_ = false;
+  bool ip_target_valid_ = false;  // 60C1h:1 holds the actual position or a client set-point
   std::int32_t hold_position_ = 0;
   std::uint64_t dropped_setpoints_ = 0;
+
+  // pv/vl velocity target the drive was last given (standstill check without 606Ch).
+  std::int64_t velocity_target_ = 0;
+  std::uint64_t velocity_settle_until_ = 0;
 
   // Faults and flags.
   bool fault_event_pending_ = false;

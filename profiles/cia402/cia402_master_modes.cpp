@@ -1,10 +1,10 @@
 // Cia402Master: mode selection and the per-mode handshakes [AKD digest §3.6, §5, §6, §8-§10;
 // NORD digest §5], halt, and the hold values of the cyclic modes.
-#include <chrono>
 #include <cstdlib>
 
 #include "profiles/cia402/cia402_master.hpp"
 #include "profiles/cia402/controlword.hpp"
+#include "profiles/cia402/master_helpers.hpp"
 #include "profiles/cia402/op_modes.hpp"
 #include "profiles/cia402/sdo_abort.hpp"
 #include "profiles/cia402/statusword.hpp"
@@ -15,17 +15,8 @@ using core::AxisState;
 using core::CommandKind;
 using core::Mode;
 
-namespace {
-
-long long ms(core::Duration d) noexcept {
-  return static_cast<long long>(std::chrono::duration_cast<std::chrono::milliseconds>(d).count());
-}
-
-std::string_view mode_name(Mode m) noexcept { return m == Mode::None ? std::string_view("none") : core::mode_short_name(m); }
-
-}  // namespace
-
 void Cia402Master::start_motion(const core::DriveCommand& cmd, Mode mode, core::TimePoint now) noexcept {
+  abandon_motion_requests();  // of the command this one supersedes
   motion_.slot = Slot{true, cmd.id, cmd.kind};
   motion_.cmd = cmd;
   motion_.mode = mode;
@@ -53,7 +44,7 @@ void Cia402Master::enter_stage(core::TimePoint now) noexcept {
   const core::DriveCommand& c = motion_.cmd;
   motion_.phase = Phase::Stage;
   motion_.since = now;
-  batch_.clear();
+  batch_.clear(io_);
   // A rate or ramp of 0 keeps what the drive has (the runner already substituted axis defaults).
   const auto add_nonzero = [this](ObjectDef def, std::uint32_t v) {
     if (v != 0) batch_.add(def, v);
@@ -113,7 +104,17 @@ void Cia402Master::run_motion(core::TimePoint now, core::ControllerSink& sink) n
   }
   if (motion_.phase == Phase::Stage) {
     const WriteBatch::Status st = batch_.run(io_);
-    if (st == WriteBatch::Status::Pending) return;
+    if (st == WriteBatch::Status::Pending) {
+      if (now - motion_.since > settings_.stage_timeout) {
+        core::Text reason;
+        reason.format("drive did not take %04Xh:%02X = %lld within %lld ms: %s (no answer, or no free request slot)",
+                      static_cast<unsigned>(batch_.pending_object().id.index),
+                      static_cast<unsigned>(batch_.pending_object().id.sub), static_cast<long long>(batch_.pending_value()),
+                      ms(settings_.stage_timeout), sdo_abort_text(0x05040000).data());
+        fail_motion(reason.view(), sink);
+      }
+      return;
+    }
     if (st == WriteBatch::Status::Failed) {
       core::Text reason;
       reason.format("drive refused %04Xh:%02X = %lld: %s (abort code 0x%08X)",
@@ -136,6 +137,7 @@ bool Cia402Master::run_mode_switch(core::TimePoint now, core::ControllerSink& si
       mode_req_.write = io_.submit_write(obj::kModesOfOperation, mode_req_.value);
     } else {
       const RequestResult r = io_.poll(mode_req_.write);
+      if (r.state != RequestState::Pending) mode_req_.write = kNoRequest;  // reported: nothing to cancel
       if (r.state == RequestState::Done) {
         mode_req_.written = true;
       } else if (r.state != RequestState::Pending) {
@@ -171,6 +173,14 @@ bool Cia402Master::run_mode_switch(core::TimePoint now, core::ControllerSink& si
 void Cia402Master::begin_handshake(core::TimePoint now, core::ControllerSink& sink) noexcept {
   motion_.since = now;
   motion_.settle_until = cycle_ + settings_.settle_cycles;
+  // The staged target has landed: from here on the drive runs (or stops) on it.
+  if (motion_.slot.kind == CommandKind::Velocity) {
+    set_velocity_target(motion_.cmd.target_velocity);
+    if (motion_.mode == Mode::Velocity) vl_armed_ = true;
+  } else if (motion_.slot.kind == CommandKind::Stop &&
+             (motion_.mode == Mode::ProfileVelocity || motion_.mode == Mode::Velocity)) {
+    set_velocity_target(0);
+  }
   switch (motion_.slot.kind) {
     case CommandKind::Move:
     case CommandKind::Home:
@@ -281,7 +291,46 @@ void Cia402Master::finish_motion(core::ControllerSink& sink) noexcept {
 void Cia402Master::fail_motion(std::string_view reason, core::ControllerSink& sink) noexcept {
   bit4_ = false;
   mode_switching_ = false;
+  abandon_motion_requests();
   fail_slot(motion_.slot, reason, sink);
+}
+
+void Cia402Master::abandon_motion_requests() noexcept {
+  batch_.clear(io_);
+  io_.cancel(mode_req_.write);
+  mode_req_.write = kNoRequest;
+}
+
+void Cia402Master::set_velocity_target(std::int64_t value) noexcept {
+  velocity_target_ = value;
+  velocity_settle_until_ = cycle_ + settings_.settle_cycles;  // bit 10 may still describe the old target
+}
+
+void Cia402Master::write_safe_holds() noexcept {
+  // Targets stay in the image through disable, quick stop, fault and link loss (the bus keeps
+  // sending them); a later bare enable would resume the old motion.
+  const auto write_if = [this](ObjectId id, std::int64_t v) {
+    if (io_.mapped(id)) io_.write(id, v);
+  };
+  write_if(obj::kTargetVelocity.id, 0);
+  write_if(obj::kTargetTorque.id, 0);
+  write_if(obj::kVlTargetVelocity.id, 0);
+  // An acyclically written target stays in the drive: the standstill check must not assume 0.
+  if (io_.mapped(obj::kTargetVelocity.id) || io_.mapped(obj::kVlTargetVelocity.id)) set_velocity_target(0);
+  vl_armed_ = false;
+  restart_cyclic_hold();
+  if (!io_.mapped(obj::kPositionActual.id)) return;
+  hold_position_ = static_cast<std::int32_t>(io_.read(obj::kPositionActual.id));
+  switch (from_op_mode(mode_switching_ ? mode_req_.value : display_mode_)) {
+    case Mode::CyclicPosition: write_if(obj::kTargetPosition.id, hold_position_); break;
+    case Mode::InterpolatedPosition:
+      if (io_.mapped(obj::kIpDataRecord.id)) {
+        io_.write(obj::kIpDataRecord.id, hold_position_);
+        ip_target_valid_ = true;
+      }
+      break;
+    default: break;
+  }
 }
 
 void Cia402Master::run_halt(core::ControllerSink& sink) noexcept {
@@ -293,6 +342,7 @@ void Cia402Master::run_halt(core::ControllerSink& sink) noexcept {
 void Cia402Master::restart_cyclic_hold() noexcept {
   cyclic_has_setpoint_ = false;
   cyclic_hold_frozen_ = false;
+  ip_target_valid_ = false;
 }
 
 void Cia402Master::hold_cyclic() noexcept {
@@ -302,15 +352,22 @@ void Cia402Master::hold_cyclic() noexcept {
   if (cyclic_has_setpoint_) return;
   // Until a client streams set-points the drive gets the position it stands at (captured once the
   // axis is enabled, so it does not follow a drifting axis), zero velocity or zero torque.
+  const bool position_known = io_.mapped(obj::kPositionActual.id);
   if (!cyclic_hold_frozen_) {
-    if (io_.mapped(obj::kPositionActual.id)) hold_position_ = static_cast<std::int32_t>(io_.read(obj::kPositionActual.id));
+    if (position_known) hold_position_ = static_cast<std::int32_t>(io_.read(obj::kPositionActual.id));
     cyclic_hold_frozen_ = state_ == AxisState::OperationEnabled;
   }
   const auto write_if = [this](ObjectId id, std::int64_t v) {
     if (io_.mapped(id)) io_.write(id, v);
   };
   switch (mode) {
-    case Mode::InterpolatedPosition: write_if(obj::kIpDataRecord.id, hold_position_); break;
+    case Mode::InterpolatedPosition:
+      // Bit 4 (enable interpolation) goes out only once 60C1h:1 holds where the axis stands.
+      if (position_known && io_.mapped(obj::kIpDataRecord.id)) {
+        io_.write(obj::kIpDataRecord.id, hold_position_);
+        ip_target_valid_ = true;
+      }
+      break;
     case Mode::CyclicPosition: write_if(obj::kTargetPosition.id, hold_position_); break;
     case Mode::CyclicVelocity: write_if(obj::kTargetVelocity.id, 0); break;
     default: write_if(obj::kTargetTorque.id, 0); break;

@@ -1,9 +1,9 @@
 // Cia402Master: the cycle. Inputs, state tracking and events, device control, outputs, parameters,
 // feedback.
-#include <chrono>
 
 #include "profiles/cia402/cia402_master.hpp"
 #include "profiles/cia402/controlword.hpp"
+#include "profiles/cia402/master_helpers.hpp"
 #include "profiles/cia402/op_modes.hpp"
 #include "profiles/cia402/sdo_abort.hpp"
 #include "profiles/cia402/statusword.hpp"
@@ -15,8 +15,6 @@ using core::EventKind;
 using core::Mode;
 
 namespace {
-
-bool in_fault(AxisState s) noexcept { return s == AxisState::Fault || s == AxisState::FaultReactionActive; }
 
 // Keeps one acyclic read of `def` in flight; true (and `value` set) when one came back.
 bool poll_read(ObjectAccess& io, RequestId& request, ObjectDef def, std::int64_t& value) noexcept {
@@ -98,13 +96,18 @@ void Cia402Master::track_state(core::TimePoint /*now*/, core::ControllerSink& si
       }
       fail_slot(motion_.slot, reason.view(), sink);
       fail_slot(halt_slot_, reason.view(), sink);
-      if (device_slot_.kind != core::CommandKind::FaultReset) {
+      abandon_motion_requests();
+      // A disable is done once the drive is in fault (power stage off): run_device() completes it.
+      const bool keeps_walk = device_slot_.active && (device_slot_.kind == core::CommandKind::FaultReset ||
+                                                      device_slot_.kind == core::CommandKind::Disable);
+      if (!keeps_walk) {
         fail_slot(device_slot_, reason.view(), sink);
         device_.hold(cw::kDisableVoltage);  // never re-enable by itself after the reset
       }
       mode_switching_ = false;
       bit4_ = false;
       halt_ = false;
+      write_safe_holds();
       fault_event_pending_ = true;
       fault_read_ = kNoRequest;
     } else if (in_fault(prev) && !in_fault(s) && prev != AxisState::Unknown) {
@@ -116,11 +119,15 @@ void Cia402Master::track_state(core::TimePoint /*now*/, core::ControllerSink& si
       // Not commanded: hardware enable lost, local control, or a drive-side stop.
       core::Text reason;
       reason.format("drive left operation enabled on its own (now %s): hardware enable lost?", core::to_string(s).data());
-      if (motion_.slot.kind != core::CommandKind::SetMode) fail_slot(motion_.slot, reason.view(), sink);
+      if (motion_.slot.kind != core::CommandKind::SetMode) {
+        fail_slot(motion_.slot, reason.view(), sink);
+        abandon_motion_requests();
+      }
       fail_slot(halt_slot_, reason.view(), sink);
       device_.hold(cw::kDisableVoltage);
       bit4_ = false;
       halt_ = false;
+      write_safe_holds();
     }
   }
 
@@ -187,10 +194,14 @@ void Cia402Master::write_outputs() noexcept {
         if (bit4_) cw = static_cast<std::uint16_t>(cw | cw::kHomingStart);
         break;
       case Mode::InterpolatedPosition:
-        if (!mode_switching_) cw = static_cast<std::uint16_t>(cw | cw::kEnableInterpolation);
+        // Only with 60C1h:1 holding the actual position (or a set-point): otherwise the drive would
+        // interpolate towards whatever the image held and jump.
+        if (!mode_switching_ && ip_target_valid_) cw = static_cast<std::uint16_t>(cw | cw::kEnableInterpolation);
         break;
       case Mode::Velocity:
-        cw = static_cast<std::uint16_t>(cw | cw::kVlRunBits);  // 0x007F [NORD digest §5.2]
+        // 0x007F runs from the bus set-point [NORD digest §5.2]: only for a velocity command given
+        // since the last enable, never for a 6042h left over from before.
+        if (vl_armed_) cw = static_cast<std::uint16_t>(cw | cw::kVlRunBits);
         break;
       default: break;
     }

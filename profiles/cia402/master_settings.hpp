@@ -2,6 +2,7 @@
 // What the CiA 402 master needs to know about its axis besides the drive itself: timeouts and the
 // few device-dependent choices. Built from the axis spec before the cycle thread starts.
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 
 #include "core/axis_spec.hpp"
@@ -14,8 +15,14 @@ struct MasterSettings {
   core::Duration mode_confirm_timeout = std::chrono::milliseconds(500);  // 6061h must echo 6060h
   core::Duration setpoint_ack_timeout = std::chrono::milliseconds(500);  // pp SW bit 12 handshake
   core::Duration homing_timeout = std::chrono::seconds(60);
-  // |velocity actual| at or below this counts as standstill for mode changes [AKD digest §3.6].
-  std::int32_t standstill_velocity = 0;
+  // Object writes a command stages before its handshake (acyclic when not mapped) must all have
+  // landed within this time, or the command fails naming the object.
+  core::Duration stage_timeout = std::chrono::seconds(1);
+  // |velocity actual| (606Ch, 6044h in vl) at or below this counts as standstill for mode changes
+  // [AKD digest §3.6], in drive units. Real drives jitter a few counts at rest, so 0 would refuse
+  // every mode change on a servo holding position; 10 is a few encoder counts/s (0.01 rpm on the
+  // AKD's 1/1000 rpm). settings_from() widens it to 0.2% of the axis' velocity limit.
+  std::int32_t standstill_velocity = 10;
   // Status words received within this many cycles after a new target was handed over may still
   // carry the previous target's "reached" bit; completion ignores them.
   std::uint32_t settle_cycles = 2;
@@ -31,6 +38,10 @@ inline MasterSettings settings_from(const core::AxisSpec& spec) {
   MasterSettings s;
   s.enable_step_timeout = spec.enable_step_timeout;
   s.homing_timeout = spec.homing.timeout;
+  // 0.2% of the velocity limit (6 rpm on a 3000 rpm axis): well below any commanded motion, well
+  // above encoder jitter.
+  const double window = std::fabs(spec.limits.max_velocity * spec.units.velocity_factor()) * 0.002;
+  if (window > s.standstill_velocity && window < 1e9) s.standstill_velocity = static_cast<std::int32_t>(window);
   return s;
 }
 

@@ -41,6 +41,10 @@ class ObjectAccess {
   virtual RequestId submit_write(ObjectDef def, std::int64_t value) noexcept = 0;
   // Done/Failed results are reported once and then forgotten (later polls say Unknown).
   virtual RequestResult poll(RequestId id) noexcept = 0;
+  // The caller no longer wants the result of `id` (command superseded or failed, link lost): the
+  // adapter frees the request's slot at once. A write already sent to the drive may still take
+  // effect. Unknown ids and kNoRequest are ignored; later polls of `id` say Unknown.
+  virtual void cancel(RequestId id) noexcept = 0;
 };
 
 }  // namespace drivegate::cia402

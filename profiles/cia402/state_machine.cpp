@@ -1,8 +1,7 @@
 #include "profiles/cia402/state_machine.hpp"
 
-#include <chrono>
-
 #include "profiles/cia402/controlword.hpp"
+#include "profiles/cia402/master_helpers.hpp"
 
 namespace drivegate::cia402 {
 
@@ -19,12 +18,6 @@ int enable_rank(AxisState s) noexcept {
     case AxisState::OperationEnabled: return 4;
     default: return 0;
   }
-}
-
-bool is_fault(AxisState s) noexcept { return s == AxisState::Fault || s == AxisState::FaultReactionActive; }
-
-long long ms(core::Duration d) noexcept {
-  return static_cast<long long>(std::chrono::duration_cast<std::chrono::milliseconds>(d).count());
 }
 
 }  // namespace
@@ -68,11 +61,14 @@ DeviceProgress DeviceControl::step(AxisState state, core::TimePoint now) noexcep
     case DeviceGoal::FaultReset: return step_fault_reset(state, now);
     case DeviceGoal::Disable:
       cw_ = cw::kDisableVoltage;
-      if (state == AxisState::SwitchOnDisabled) return finish(cw::kDisableVoltage);
+      // Not ready to switch on and Fault have the power stage off as well [AKD digest §3.2].
+      if (state == AxisState::SwitchOnDisabled || state == AxisState::NotReadyToSwitchOn || in_fault(state)) {
+        return finish(cw::kDisableVoltage);
+      }
       break;
     case DeviceGoal::QuickStop:
       if (state == AxisState::QuickStopActive || state == AxisState::SwitchOnDisabled ||
-          state == AxisState::NotReadyToSwitchOn || is_fault(state)) {
+          state == AxisState::NotReadyToSwitchOn || in_fault(state)) {
         // Keep bit 2 low so that the drive does not take transition 16 back to Operation enabled.
         return finish(cw::kQuickStop);
       }
@@ -89,7 +85,7 @@ DeviceProgress DeviceControl::step(AxisState state, core::TimePoint now) noexcep
 }
 
 DeviceProgress DeviceControl::step_enable(AxisState state, core::TimePoint now) noexcept {
-  if (is_fault(state)) {
+  if (in_fault(state)) {
     failure_.format("drive went to %s during enable", core::to_string(state).data());
     hold(cw::kDisableVoltage);
     return DeviceProgress::Failed;
@@ -122,7 +118,7 @@ DeviceProgress DeviceControl::step_enable(AxisState state, core::TimePoint now) 
 }
 
 DeviceProgress DeviceControl::step_fault_reset(AxisState state, core::TimePoint now) noexcept {
-  if (!is_fault(state)) {
+  if (!in_fault(state)) {
     // Left Fault (or never was in it): clear bit 7 again [AKD digest §3.2 #15].
     return finish(cw::kDisableVoltage);
   }

@@ -72,6 +72,14 @@ class FakeObjectAccess final : public ObjectAccess {
     }
     return {RequestState::Unknown, 0, 0};
   }
+  void cancel(RequestId id) noexcept override {
+    for (auto& r : requests_) {
+      if (!r.used || r.id != id) continue;
+      r.used = false;
+      ++cancels_;
+    }
+  }
+  [[nodiscard]] std::size_t cancels() const noexcept { return cancels_; }
 
  private:
   struct Object {
@@ -117,6 +125,7 @@ class FakeObjectAccess final : public ObjectAccess {
   std::array<Logged, 256> log_{};
   std::size_t log_count_ = 0;
   std::size_t reads_ = 0;
+  std::size_t cancels_ = 0;
   RequestId next_id_ = 0;
   int latency_ = 2;
   bool queue_full_ = false;

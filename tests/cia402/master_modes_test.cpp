@@ -215,11 +215,12 @@ TEST(VelocityVl, NordControlwordAndTarget) {
   h.io.map(obj::kVlVelocityActual.id);
   h.set_mode_display(op_mode::kVelocity);
   h.enable();
-  EXPECT_EQ(h.cycle(kSwEnabled), 0x007F);  // NORD digest §5.2: 0x007F runs from the bus set-point
+  // No velocity command since the enable: the run bits stay low, whatever 6042h held before.
+  EXPECT_EQ(h.cycle(kSwEnabled), 0x000F);
   auto c = command(7, CommandKind::Velocity, Mode::Velocity);
   c.target_velocity = 1500;
   ASSERT_TRUE(h.submit(c).accepted);
-  h.cycle(kSwEnabled);
+  EXPECT_EQ(h.cycle(kSwEnabled), 0x007F);  // NORD digest §5.2: 0x007F runs from the bus set-point
   EXPECT_EQ(h.io.value(obj::kVlTargetVelocity.id), 1500);
   for (int i = 0; i < 5; ++i) h.cycle(kSwEnabled);
   EXPECT_FALSE(h.sink.done(7));  // no bit 10 in vl: compares 6044h with 6042h

@@ -1,14 +1,8 @@
 // The master against the simulated drive (profiles/cia402/sim) through DirectObjectAccess, with
-// virtual time: begin_cycle(); master.update(); end_cycle(); model.step(1 ms).
+// virtual time (tests/cia402/model_bench.hpp).
 #include <gtest/gtest.h>
 
-#include <array>
-#include <cmath>
-#include <functional>
-
-#include "profiles/cia402/sim/direct_access.hpp"
-#include "profiles/cia402/sim/drive_model.hpp"
-#include "tests/cia402/master_harness.hpp"
+#include "tests/cia402/model_bench.hpp"
 
 namespace drivegate::cia402::test {
 namespace {
@@ -16,57 +10,7 @@ namespace {
 using core::CommandKind;
 using core::Mode;
 
-const std::array kMapped = {obj::kControlword.id,    obj::kStatusword.id,     obj::kModesOfOperation.id,
-                            obj::kModesOfOperationDisplay.id, obj::kPositionActual.id, obj::kVelocityActual.id,
-                            obj::kTorqueActual.id,   obj::kTargetPosition.id, obj::kProfileVelocity.id,
-                            obj::kTargetVelocity.id, obj::kTargetTorque.id,   obj::kErrorCode.id};
-
-sim::DriveModelConfig config() {
-  sim::DriveModelConfig c;
-  c.negative_limit_position = -5000.0;
-  c.positive_limit_position = 200000.0;
-  return c;
-}
-
-struct Bench {
-  sim::DriveModel model{config()};
-  sim::DirectObjectAccess io{model, kMapped, 2};
-  Cia402Master master{io, MasterSettings{}};
-  RecordingSink sink;
-  core::TimePoint now{};
-
-  void cycle() {
-    io.begin_cycle();
-    master.update(now, sink);
-    io.end_cycle();
-    model.step(1ms);
-    now += 1ms;
-  }
-  // Cycles until `id` completed or failed; false on timeout or failure.
-  bool run(core::CommandId id, int max_cycles) {
-    for (int i = 0; i < max_cycles; ++i) {
-      cycle();
-      if (sink.done(id)) return true;
-      if (!sink.failure(id).empty()) {
-        ADD_FAILURE() << "command " << id << " failed: " << sink.failure(id);
-        return false;
-      }
-    }
-    ADD_FAILURE() << "command " << id << " did not finish within " << max_cycles << " cycles";
-    return false;
-  }
-  bool submit(const core::DriveCommand& c) {
-    const auto a = master.submit(c, now, sink);
-    EXPECT_TRUE(a.accepted) << a.reason.view();
-    return a.accepted;
-  }
-  void enable(core::CommandId id = 1) {
-    for (int i = 0; i < 20; ++i) cycle();  // boot: not ready -> switch on disabled
-    ASSERT_TRUE(submit(command(id, CommandKind::Enable)));
-    ASSERT_TRUE(run(id, 100));
-    ASSERT_EQ(model.state(), sim::DriveState::OperationEnabled);
-  }
-};
+using Bench = ModelBench;
 
 TEST(MasterVsModel, Enable) {
   Bench b;

@@ -141,5 +141,22 @@ TEST(DirectAccessLatency, ZeroLatencyCompletesAtSubmit) {
   EXPECT_EQ(access.poll(id).state, RequestState::Done);
 }
 
+TEST_F(DirectAccess, CancelFreesTheSlotAndAnUndueWriteNeverLands) {
+  std::array<RequestId, DirectObjectAccess::kMaxRequests> ids{};
+  for (auto& id : ids) {
+    id = access.submit_write(obj::kProfileAcceleration, 4321);
+    ASSERT_NE(id, kNoRequest);
+  }
+  EXPECT_EQ(access.submit_read(obj::kStatusword), kNoRequest);  // queue full
+  for (const auto id : ids) access.cancel(id);
+  access.cancel(kNoRequest);  // ignored
+  EXPECT_EQ(access.requests_in_use(), 0U);
+  EXPECT_EQ(access.poll(ids[0]).state, RequestState::Unknown);
+  for (int i = 0; i < 4; ++i) cycle();
+  EXPECT_NE(drive.dictionary().get(obj::kProfileAcceleration.id), 4321);
+  const RequestId read = access.submit_read(obj::kStatusword);
+  EXPECT_NE(read, kNoRequest);
+}
+
 }  // namespace
 }  // namespace drivegate::cia402::sim::test

@@ -138,4 +138,15 @@ RequestResult DirectObjectAccess::poll(RequestId id) noexcept {
   return {};
 }
 
+void DirectObjectAccess::cancel(RequestId id) noexcept {
+  if (id == kNoRequest) return;
+  for (Request& r : requests_) {
+    if (r.in_use && r.id == id) r.in_use = false;
+  }
+}
+
+std::size_t DirectObjectAccess::requests_in_use() const noexcept {
+  return static_cast<std::size_t>(std::count_if(requests_.begin(), requests_.end(), [](const Request& r) { return r.in_use; }));
+}
+
 }  // namespace drivegate::cia402::sim

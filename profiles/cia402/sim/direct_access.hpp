@@ -8,7 +8,8 @@
 // an RPDO. Every mapped object is read back in the snapshot (inputs, and outputs as the drive
 // holds them). Acyclic requests behave like SDO: they complete `acyclic_latency_cycles` cycles
 // after submission with the drive's abort code, or with 0x05040000 (timeout) while the link is
-// down. No allocation after construction.
+// down. A cancelled request frees its slot at once; if it was not due yet it never reaches the
+// drive. No allocation after construction.
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -38,6 +39,10 @@ class DirectObjectAccess final : public ObjectAccess {
   RequestId submit_read(ObjectDef def) noexcept override;
   RequestId submit_write(ObjectDef def, std::int64_t value) noexcept override;
   RequestResult poll(RequestId id) noexcept override;
+  void cancel(RequestId id) noexcept override;
+
+  // Requests submitted and neither reported nor cancelled yet (leak checks in tests).
+  [[nodiscard]] std::size_t requests_in_use() const noexcept;
 
   // False when a mapped object does not exist in the drive (a real drive would refuse the map).
   [[nodiscard]] bool mapping_valid() const noexcept { return mapping_valid_; }
