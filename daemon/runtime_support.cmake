@@ -1,7 +1,6 @@
 # Cycle threads, real-time set-up and systemd notification for the daemon. Included from
-# daemon/CMakeLists.txt; kept separate so tests and benchmarks can link it without the daemon.
-# Tests and bench include it too; the guard makes whichever comes first define the target.
-include_guard(GLOBAL)
+# daemon/CMakeLists.txt; a library of its own so tests and benchmarks can link it without the
+# daemon.
 add_library(drivegate_runtime_support STATIC
   ${CMAKE_CURRENT_LIST_DIR}/cycle_thread.cpp
   ${CMAKE_CURRENT_LIST_DIR}/realtime.cpp
