@@ -10,16 +10,15 @@ namespace {
 using core::CommandKind;
 using core::Mode;
 
-using Bench = ModelBench;
 
 TEST(MasterVsModel, Enable) {
-  Bench b;
+  ModelBench b;
   b.enable();
   EXPECT_EQ(b.master.feedback().state, core::AxisState::OperationEnabled);
 }
 
 TEST(MasterVsModel, ProfilePositionMove) {
-  Bench b;
+  ModelBench b;
   b.enable();
   auto c = command(2, CommandKind::Move);
   c.target_position = 10000;
@@ -39,7 +38,7 @@ TEST(MasterVsModel, ProfilePositionMove) {
 }
 
 TEST(MasterVsModel, ProfileVelocityThenStopAndQuickStop) {
-  Bench b;
+  ModelBench b;
   b.enable();
   auto c = command(2, CommandKind::Velocity, Mode::ProfileVelocity);
   c.target_velocity = 5000;
@@ -61,7 +60,7 @@ TEST(MasterVsModel, ProfileVelocityThenStopAndQuickStop) {
 }
 
 TEST(MasterVsModel, ProfileTorque) {
-  Bench b;
+  ModelBench b;
   b.enable();
   auto c = command(2, CommandKind::Torque);
   c.target_torque = 100;
@@ -74,7 +73,7 @@ TEST(MasterVsModel, ProfileTorque) {
 }
 
 TEST(MasterVsModel, HomingCurrentPosition) {
-  Bench b;
+  ModelBench b;
   b.enable();
   auto c = command(2, CommandKind::Home);
   c.homing_method = 35;
@@ -85,7 +84,7 @@ TEST(MasterVsModel, HomingCurrentPosition) {
 }
 
 TEST(MasterVsModel, HomingOnNegativeLimitSwitch) {
-  Bench b;
+  ModelBench b;
   b.enable();
   auto c = command(2, CommandKind::Home);
   c.homing_method = 17;
@@ -98,7 +97,7 @@ TEST(MasterVsModel, HomingOnNegativeLimitSwitch) {
 }
 
 TEST(MasterVsModel, FaultThenReset) {
-  Bench b;
+  ModelBench b;
   b.enable();
   b.model.inject_fault(0x2310);
   for (int i = 0; i < 20; ++i) b.cycle();
@@ -117,7 +116,7 @@ TEST(MasterVsModel, FaultThenReset) {
 }
 
 TEST(MasterVsModel, CyclicSynchronousPosition) {
-  Bench b;
+  ModelBench b;
   b.enable();
   ASSERT_TRUE(b.submit(command(2, CommandKind::SetMode, Mode::CyclicPosition)));
   ASSERT_TRUE(b.run(2, 100));

@@ -286,6 +286,7 @@ void DriveModel::update_state(std::uint16_t cw) noexcept {
     return;
   }
   switch (state_) {
+    case DriveState::Unknown:             // never entered by the drive
     case DriveState::NotReadyToSwitchOn:  // transition 1: self-test done
       enter_state(DriveState::SwitchOnDisabled);
       if (fault_cause_active_) pending_fault_ = cause_code_;  // the cause outlived the power cycle
@@ -376,6 +377,7 @@ void DriveModel::publish() noexcept {
   // be on; bit 5 (quick stop, active low) set only where the table requires it.
   std::uint16_t sw = 0;
   switch (state_) {
+    case DriveState::Unknown:  // never entered by the drive
     case DriveState::NotReadyToSwitchOn: sw = 0x0000; break;
     case DriveState::SwitchOnDisabled: sw = 0x0040; break;
     case DriveState::ReadyToSwitchOn: sw = 0x0031; break;

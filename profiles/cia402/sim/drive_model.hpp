@@ -18,22 +18,15 @@
 #include <optional>
 #include <vector>
 
+#include "core/axis_types.hpp"
 #include "core/clock.hpp"
 #include "profiles/cia402/objects.hpp"
 #include "profiles/cia402/sim/object_dictionary.hpp"
 
 namespace drivegate::cia402::sim {
 
-enum class DriveState : std::uint8_t {
-  NotReadyToSwitchOn,
-  SwitchOnDisabled,
-  ReadyToSwitchOn,
-  SwitchedOn,
-  OperationEnabled,
-  QuickStopActive,
-  FaultReactionActive,
-  Fault,
-};
+// The drive runs the same CiA 402 states the master reports (never Unknown).
+using DriveState = core::AxisState;
 
 struct DriveIdentity {  // 1018h:1..4
   std::uint32_t vendor_id = 0;

@@ -79,6 +79,7 @@ void DriveModel::run_motion(std::uint16_t cw, double dt) noexcept {
   }
   control_ = Control::Coast;
   switch (state_) {
+    case DriveState::Unknown:  // never entered by the drive
     case DriveState::NotReadyToSwitchOn:
     case DriveState::SwitchOnDisabled:
     case DriveState::ReadyToSwitchOn:
