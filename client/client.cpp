@@ -394,10 +394,7 @@ class Client::Impl : public dds::DataReaderListener {
   }
 
   void take_states() {
-    msg::AxisState in;
-    dds::SampleInfo si;
-    while (state_r_->take_next_sample(&in, &si) == ReturnCode_t::RETCODE_OK) {
-      if (!si.valid_data) continue;
+    msg::take_valid<msg::AxisState>(*state_r_, [&](const msg::AxisState& in) {
       AxisState s;
       s.gateway = in.gateway();
       s.axis = in.axis();
@@ -422,37 +419,29 @@ class Client::Impl : public dds::DataReaderListener {
       s.received = SteadyClock::now();
       std::lock_guard lock(mutex_);
       states_[{s.gateway, s.axis}] = std::move(s);
-    }
+    });
   }
 
   void take_replies() {
-    msg::CommandReply in;
-    dds::SampleInfo si;
-    while (reply_r_->take_next_sample(&in, &si) == ReturnCode_t::RETCODE_OK) {
-      if (!si.valid_data || in.client() != opt_.name) continue;
+    msg::take_valid<msg::CommandReply>(*reply_r_, [&](const msg::CommandReply& in) {
+      if (in.client() != opt_.name) return;
       std::lock_guard lock(mutex_);
       const auto it = replies_.find(in.id());
       if (it != replies_.end()) it->second.push_back({in.gateway(), in.status(), in.reason()});
-    }
+    });
   }
 
   void take_events() {
-    msg::AxisEvent in;
-    dds::SampleInfo si;
-    while (event_r_->take_next_sample(&in, &si) == ReturnCode_t::RETCODE_OK) {
-      if (!si.valid_data) continue;
+    msg::take_valid<msg::AxisEvent>(*event_r_, [&](const msg::AxisEvent& in) {
       std::lock_guard lock(mutex_);
       events_.push_back({in.gateway(), in.axis(), in.bus(), in.kind(), in.state(), in.code(), in.text(), in.stamp()});
       ++events_end_;
       if (events_.size() > kMaxEvents) events_.pop_front();
-    }
+    });
   }
 
   void take_buses() {
-    msg::BusStatus in;
-    dds::SampleInfo si;
-    while (bus_r_->take_next_sample(&in, &si) == ReturnCode_t::RETCODE_OK) {
-      if (!si.valid_data) continue;
+    msg::take_valid<msg::BusStatus>(*bus_r_, [&](const msg::BusStatus& in) {
       BusStatus b{in.gateway(),        in.bus(),         in.type(),
                   in.running(),        in.healthy(),     in.period_ns(),
                   in.achieved_period_ns(), in.lateness_p50_ns(), in.lateness_p99_ns(),
@@ -461,19 +450,17 @@ class Client::Impl : public dds::DataReaderListener {
                   in.frames_dropped(), in.errors()};
       std::lock_guard lock(mutex_);
       buses_[{b.gateway, b.bus}] = std::move(b);
-    }
+    });
   }
 
   void take_param_replies() {
-    msg::ParamReply in;
-    dds::SampleInfo si;
-    while (param_r_->take_next_sample(&in, &si) == ReturnCode_t::RETCODE_OK) {
-      if (!si.valid_data || in.client() != opt_.name) continue;
+    msg::take_valid<msg::ParamReply>(*param_r_, [&](const msg::ParamReply& in) {
+      if (in.client() != opt_.name) return;
       std::lock_guard lock(mutex_);
       const auto it = param_replies_.find(in.id());
       if (it != param_replies_.end())
         it->second = ParamResult{in.ok(), in.gateway(), in.value(), in.error_code(), in.error()};
-    }
+    });
   }
 
   ClientOptions opt_;

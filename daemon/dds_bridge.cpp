@@ -238,19 +238,16 @@ std::string DdsBridge::Impl::axis_list() const {
 }
 
 void DdsBridge::Impl::take_commands() {
-  msg::AxisCommand in;
-  dds::SampleInfo info;
-  while (cmd_r_->take_next_sample(&in, &info) == ReturnCode_t::RETCODE_OK) {
-    if (!info.valid_data) continue;
+  msg::take_valid<msg::AxisCommand>(*cmd_r_, [&](const msg::AxisCommand& in) {
     if (in.gateway() != gateway_) {
       // Another gateway's axis: the owner answers, we stay silent.
       spdlog::debug("dds: ignoring {} for {}/{} from '{}' (not our gateway)", in.kind(), in.gateway(), in.axis(),
                     in.client());
       count([](Stats& s) { ++s.commands_ignored; });
-      continue;
+      return;
     }
     handle_command(in);
-  }
+  });
 }
 
 void DdsBridge::Impl::reject(const msg::AxisCommand& in, const std::string& reason) {
@@ -308,10 +305,8 @@ void DdsBridge::Impl::handle_command(const msg::AxisCommand& in) {
 }
 
 void DdsBridge::Impl::take_setpoints() {
-  msg::Setpoint in;
-  dds::SampleInfo info;
-  while (sp_r_->take_next_sample(&in, &info) == ReturnCode_t::RETCODE_OK) {
-    if (!info.valid_data || in.gateway() != gateway_) continue;
+  msg::take_valid<msg::Setpoint>(*sp_r_, [&](const msg::Setpoint& in) {
+    if (in.gateway() != gateway_) return;
     const auto axis = find_axis(in.axis());
     core::Setpoint sp;
     sp.position = in.position();
@@ -319,23 +314,21 @@ void DdsBridge::Impl::take_setpoints() {
     sp.torque = in.torque();
     if (axis && rt_.submit_setpoint(*axis, sp)) {
       count([](Stats& s) { ++s.setpoints_routed; });
-      continue;
+      return;
     }
     count([](Stats& s) { ++s.setpoints_dropped; });
     // Set-points stream at high rate: log the first drop per client and axis only.
     if (warned_setpoints_.emplace(in.client(), in.axis()).second)
       spdlog::warn("dds: dropping set-points from '{}' for axis '{}': {}", in.client(), in.axis(),
                    axis ? "queue full" : "unknown axis; axes here: " + axis_list());
-  }
+  });
 }
 
 void DdsBridge::Impl::take_params() {
-  msg::ParamRequest in;
-  dds::SampleInfo info;
-  while (param_r_->take_next_sample(&in, &info) == ReturnCode_t::RETCODE_OK) {
-    if (!info.valid_data || in.gateway() != gateway_) continue;
+  msg::take_valid<msg::ParamRequest>(*param_r_, [&](const msg::ParamRequest& in) {
+    if (in.gateway() != gateway_) return;
     handle_param(in);
-  }
+  });
 }
 
 void DdsBridge::Impl::handle_param(const msg::ParamRequest& in) {
@@ -372,14 +365,12 @@ void DdsBridge::Impl::handle_param(const msg::ParamRequest& in) {
 }
 
 void DdsBridge::Impl::take_gateway_infos() {
-  msg::GatewayInfo in;
-  dds::SampleInfo info;
-  while (info_r_->take_next_sample(&in, &info) == ReturnCode_t::RETCODE_OK) {
-    if (!info.valid_data || in.gateway() == gateway_) continue;
+  msg::take_valid<msg::GatewayInfo>(*info_r_, [&](const msg::GatewayInfo& in) {
+    if (in.gateway() == gateway_) return;
     spdlog::info("dds: gateway '{}' on {} (pid {}) owns {} axes", in.gateway(), in.host(), in.pid(), in.axes().size());
     for (const auto& other : in.axes()) {
-      if (!find_axis(other.name())) continue;
-      if (!warned_duplicates_.emplace(in.gateway(), other.name()).second) continue;
+      if (!find_axis(other.name())) return;
+      if (!warned_duplicates_.emplace(in.gateway(), other.name()).second) return;
       const std::string text = "axis '" + other.name() + "' is claimed by gateway '" + gateway_ + "' and by gateway '" +
                                in.gateway() + "'; clients must name the gateway for this axis";
       spdlog::warn("dds: {}", text);
@@ -392,7 +383,7 @@ void DdsBridge::Impl::take_gateway_infos() {
       ev.stamp(std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch()).count());
       event_w_->write(&ev);
     }
-  }
+  });
 }
 
 void DdsBridge::Impl::publish_outbox() {

@@ -9,6 +9,8 @@
 #include <string_view>
 
 #include <fastdds/dds/core/status/StatusMask.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
 
 namespace eprosima::fastdds::dds {
 class DomainParticipant;
@@ -16,7 +18,6 @@ class Publisher;
 class Subscriber;
 class Topic;
 class DataWriter;
-class DataReader;
 class DataReaderListener;
 class DataWriterListener;
 }  // namespace eprosima::fastdds::dds
@@ -66,5 +67,16 @@ class DdsNode {
   eprosima::fastdds::dds::Subscriber* subscriber_ = nullptr;
   std::array<eprosima::fastdds::dds::Topic*, kTopicCount> topics_{};
 };
+
+// Takes every sample waiting in `reader` and hands each one that carries data to `fn`; samples
+// that only announce an instance's end (disposed, no writers) are dropped. Readers that must see
+// those use take_next_sample themselves.
+template <typename T, typename Fn>
+void take_valid(eprosima::fastdds::dds::DataReader& reader, Fn&& fn) {
+  T sample;
+  eprosima::fastdds::dds::SampleInfo info;
+  while (reader.take_next_sample(&sample, &info) == eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK)
+    if (info.valid_data) fn(static_cast<const T&>(sample));
+}
 
 }  // namespace drivegate::msg
