@@ -9,7 +9,8 @@
 
 namespace drivegate::core {
 
-// Where a controller reports the outcome of commands and what happened to its drive.
+// Where a controller reports the outcome of commands and what happened to its drive: every change
+// of state and of the drive's mode (StateChanged, ModeChanged), faults and warnings.
 class ControllerSink {
  public:
   virtual void completed(CommandId id) noexcept = 0;

@@ -281,18 +281,6 @@ void AxisRunner::build_snapshot(TimePoint now) noexcept {
   s.stamp_ns = to_ns(now);
   s.cycle = cycle_;
 
-  if (fb.valid && fb.state != last_state_) {
-    Text t;
-    t.format("%s -> %s", to_string(last_state_).data(), to_string(fb.state).data());
-    last_state_ = fb.state;
-    emit(EventKind::StateChanged, 0, t.view());
-  }
-  if (fb.valid && fb.mode != last_mode_) {
-    Text t;
-    t.format("mode %s", to_string(fb.mode).data());
-    last_mode_ = fb.mode;
-    emit(EventKind::ModeChanged, 0, t.view());
-  }
 }
 
 void AxisRunner::completed(CommandId id) noexcept {
@@ -315,12 +303,7 @@ void AxisRunner::failed(CommandId id, std::string_view reason) noexcept {
   send_reply(id, ReplyStatus::Failed, reason);
 }
 
-void AxisRunner::event(EventKind kind, std::uint32_t code, std::string_view text) noexcept {
-  // The runner reports state and mode changes itself from the feedback; the controller's own
-  // state-change events would duplicate them.
-  if (kind == EventKind::StateChanged || kind == EventKind::ModeChanged) return;
-  emit(kind, code, text);
-}
+void AxisRunner::event(EventKind kind, std::uint32_t code, std::string_view text) noexcept { emit(kind, code, text); }
 
 void AxisRunner::parameter_done(const ParamReply& reply) noexcept {
   if (out_ == nullptr) return;

@@ -86,8 +86,6 @@ class AxisRunner final : private ControllerSink {
   int default_mode_attempts_ = 0;
 
   LinkState last_link_ = LinkState::Offline;
-  AxisState last_state_ = AxisState::Unknown;
-  Mode last_mode_ = Mode::None;
   CommandId active_command_ = 0;
   CommandId submitting_ = 0;    // id inside controller_.submit(), for inline completion
   bool accepted_sent_ = false;  // Accepted already queued for submitting_

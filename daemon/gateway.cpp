@@ -165,7 +165,10 @@ void Gateway::drain(Outbox& out) {
       const std::string who = e.axis_id == SIZE_MAX ? "bus " + e.bus : "axis " + axes_[e.axis_id].name;
       const auto sev = severity_of(e.event.kind);
       const auto level = sev == "error" ? spdlog::level::err : sev == "warning" ? spdlog::level::warn : spdlog::level::info;
-      if (e.event.code != 0)
+      // Codes are drive error codes for faults and warnings; other events use them internally.
+      const bool has_code = e.event.kind == core::EventKind::Fault || e.event.kind == core::EventKind::Warning ||
+                            e.event.kind == core::EventKind::FaultCleared;
+      if (has_code && e.event.code != 0)
         spdlog::log(level, "{}: {} 0x{:04X}: {}", who, core::to_string(e.event.kind), e.event.code, e.event.text.view());
       else
         spdlog::log(level, "{}: {}: {}", who, core::to_string(e.event.kind), e.event.text.view());

@@ -77,14 +77,18 @@ void Cia402Master::track_state(core::TimePoint /*now*/, core::ControllerSink& si
   const Mode mode_before = fb_.mode;
   const Mode mode_now = display_known_ ? from_op_mode(display_mode_) : Mode::None;
   if (display_known_ && mode_now != mode_before) {
-    sink.event(EventKind::ModeChanged, static_cast<std::uint32_t>(static_cast<std::uint8_t>(display_mode_)),
-               mode_now == Mode::None ? std::string_view("none or manufacturer mode") : core::to_string(mode_now));
+    core::Text t;
+    t.format("mode %s -> %s", core::to_string(mode_before).data(),
+             mode_now == Mode::None ? "none or manufacturer mode" : core::to_string(mode_now).data());
+    sink.event(EventKind::ModeChanged, static_cast<std::uint32_t>(static_cast<std::uint8_t>(display_mode_)), t.view());
   }
 
   if (s != state_) {
     const AxisState prev = state_;
     state_ = s;
-    sink.event(EventKind::StateChanged, static_cast<std::uint32_t>(s), core::to_string(s));
+    core::Text t;
+    t.format("%s -> %s", core::to_string(prev).data(), core::to_string(s).data());
+    sink.event(EventKind::StateChanged, static_cast<std::uint32_t>(s), t.view());
     if (in_fault(s) && !in_fault(prev)) {
       core::Text reason;
       if (io_.mapped(obj::kErrorCode.id)) {
