@@ -7,25 +7,24 @@ namespace drivegate::core {
 
 namespace {
 
-// Human form of the supported modes, e.g. "pp, pv, hm".
+// Appends the supported modes in their short form, e.g. " (this axis supports: pp, pv, hm)".
 void append_modes(Text& t, const ModeSet& modes) noexcept {
-  FixedString<96> list;
-  char buf[96] = {};
+  char list[64] = "none";
   std::size_t n = 0;
   for (std::size_t i = 1; i < kModeCount; ++i) {
     const auto m = static_cast<Mode>(i);
     if (!modes.contains(m)) continue;
     const auto name = mode_short_name(m);
-    if (n + name.size() + 2 >= sizeof(buf)) break;
+    if (n + name.size() + 3 > sizeof(list)) break;  // ", " + name + NUL
     if (n != 0) {
-      buf[n++] = ',';
-      buf[n++] = ' ';
+      list[n++] = ',';
+      list[n++] = ' ';
     }
-    for (char c : name) buf[n++] = c;
+    for (char c : name) list[n++] = c;
+    list[n] = '\0';
   }
-  list.assign(std::string_view(buf, n));
   Text out;
-  out.format("%s (this axis supports: %s)", t.c_str(), n == 0 ? "none" : list.c_str());
+  out.format("%s (this axis supports: %s)", t.c_str(), list);
   t = out;
 }
 
