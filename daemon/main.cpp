@@ -236,8 +236,13 @@ int run(const Args& args) {
     spdlog::error("axis {} did not confirm it is disabled", a);
     rc = 1;
   }
-  // Let the bridge publish the final states and events before it goes.
-  std::this_thread::sleep_for(std::chrono::milliseconds(static_cast<int>(1000.0 / plan.gateway.status_rate_hz) + 50));
+  // Let the bridge publish one more round of axis states, taken after the axes were disabled,
+  // before it goes (bounded, in case DDS is stuck).
+  const auto published = bridge.stats().states_published;
+  const auto until = std::chrono::steady_clock::now() + 1s;
+  while (bridge.stats().states_published < published + 2 * gateway->axes().size() &&
+         std::chrono::steady_clock::now() < until)
+    std::this_thread::sleep_for(5ms);
   bridge.stop();
   gateway.reset();
   spdlog::info("stopped");
