@@ -51,6 +51,73 @@ struct DeviceIdentity {
   std::optional<std::uint32_t> product_code;
 };
 
+// The `canopen:` section of a device profile (profiles/devices/README.md): how a CANopen master
+// brings the drive up. Everything vendor-specific about CANopen is here as data.
+struct PdoEntrySpec {
+  cia402::ObjectId object;
+  std::uint8_t bits = 0;  // 8, 16 or 32
+};
+
+struct PdoSpec {
+  int number = 1;  // 1..4: RPDO n (1400h+n-1 / 1600h+n-1) or TPDO n (1800h+n-1 / 1A00h+n-1)
+  std::vector<PdoEntrySpec> entries;  // at most 8 entries and 64 bits
+  int transmission_type = 1;          // 0..240 synchronous, 254/255 event-driven
+  int inhibit_time_100us = 0;         // TPDO only; 0 = none
+  int event_timer_ms = 0;             // TPDO only; 0 = none
+};
+
+enum class PdoPolicy : std::uint8_t {
+  Write,   // disable, clear count, write entries, set count, enable [CiA 301; AKD part 1 §12.6]
+  Verify,  // read back and compare only; a mismatch fails the boot (SD6: fixed count, mapping
+           // needs save + restart: stoeber-sd6-canopen.md quirk 4)
+};
+
+enum class ErrorControl : std::uint8_t {
+  Heartbeat,  // drive produces 1017h; the master consumes and, if the drive has 1016h, the drive
+              // consumes the master's heartbeat
+  Guarding,   // master sends RTRs every guard time; the drive's life guarding notices a dead master
+              // (SD6: no consumer heartbeat, quirk 7)
+};
+
+struct StartupWrite {
+  cia402::ObjectDef def;
+  std::int64_t value = 0;
+  std::string why;  // shown when the write fails
+};
+
+// A vendor byte of the EMCY frame (bytes 3..7) with a name, shown with the fault text
+// ("event 52, cause 1"). SD6: byte 3 event (E82), byte 4 cause (E43).
+struct EmcyVendorField {
+  int byte = 3;
+  std::string name;
+};
+
+// Manufacturer parameters addressable by a name: <letter><line>[<element>] -> index
+// base + group * group_stride + line, sub-index element (SD6 digest §2.2: A83 -> 2053h:00).
+struct ParameterNaming {
+  std::uint16_t base = 0x2000;
+  std::uint16_t group_stride = 0x200;
+  int max_line = 511;
+};
+
+struct CanopenDeviceSpec {
+  bool present = false;                 // the profile has a canopen section
+  std::optional<std::uint32_t> device_type;  // 1000h expected value, compared under the mask
+  std::uint32_t device_type_mask = 0x00FFFFFF;  // AKD: upper "mode bits" may change (quirk 13)
+  std::vector<PdoSpec> rpdos;
+  std::vector<PdoSpec> tpdos;
+  PdoPolicy pdo_policy = PdoPolicy::Write;
+  bool disable_unused_pdos = true;      // switch off PDOs the maps do not use (AKD part 1 §16 step 7)
+  ErrorControl error_control = ErrorControl::Heartbeat;
+  bool consumer_heartbeat = true;       // the drive has 1016h (watches the master's heartbeat)
+  std::vector<StartupWrite> startup_writes;
+  std::vector<EmcyVendorField> emcy_fields;
+  bool emcy_zero_needs_clear_register = true;  // EMCY 0000h means "no more errors" only with register 0
+  std::optional<ParameterNaming> parameter_naming;
+  int sdo_channels = 1;                 // SDO server channels (SD6: 4, channels 2..4 need node-ID <= 31)
+  std::string persona;                  // simulator persona for this drive (akd, nord-sk500p, stoeber-sd6, generic)
+};
+
 struct DeviceProfile {
   std::string name;
   std::string vendor;
@@ -63,6 +130,7 @@ struct DeviceProfile {
   std::map<std::uint32_t, std::string> fault_texts;
   std::map<std::string, bool> quirks;  // only names from known_quirks()
   std::vector<cia402::ObjectId> cyclic_objects;
+  CanopenDeviceSpec canopen;
   [[nodiscard]] bool quirk(const std::string& flag) const {
     const auto it = quirks.find(flag);
     return it != quirks.end() && it->second;
@@ -80,6 +148,13 @@ struct SimAxisOptions {
   double max_acceleration = 0;  // drive acceleration units
 };
 
+// The per-axis `canopen:` section (axes on a canopen bus; `address` is the node-ID).
+struct CanopenAxisOptions {
+  std::string eds;  // EDS file (made absolute); objects and mappings are checked against it
+  int sdo_channel = 1;  // SDO server channel the gateway uses (1..device sdo_channels)
+  std::vector<StartupWrite> startup_writes;  // after the device profile's
+};
+
 struct AxisPlan {
   core::AxisSpec spec;
   int address = 0;
@@ -88,6 +163,7 @@ struct AxisPlan {
   core::NativeUnits native;
   double encoder_counts_per_rev = 0;
   SimAxisOptions sim;  // meaningful for axes on a sim bus only
+  CanopenAxisOptions canopen;  // meaningful for axes on a canopen bus only
 };
 
 // A bus-type option value after validation (see BusTypeRegistry for which keys a type takes).
@@ -98,6 +174,28 @@ struct SimBusOptions {
   int acyclic_latency_cycles = 1;  // cycles before an acyclic request is answered
 };
 
+// Options of the `canopen` bus type, typed (the bus `cycle_time` is the SYNC period).
+enum class CanTransportKind : std::uint8_t { SocketCan, UdpMulticast, Simulated };
+
+struct CanopenBusOptions {
+  CanTransportKind transport = CanTransportKind::SocketCan;
+  std::string interface = "can0";      // socketcan: interface; udp-multicast: local IPv4 address
+  std::uint32_t bitrate = 500000;      // bit/s (for load estimates and the simulated wire)
+  std::string group = "239.74.163.2";  // udp-multicast group [python-can udp_multicast default]
+  int port = 43113;
+  int gateway_node_id = 127;           // the master's own heartbeat COB-ID 700h + this
+  core::Duration heartbeat_period = std::chrono::milliseconds(100);   // master's heartbeat
+  core::Duration drive_heartbeat = std::chrono::milliseconds(100);    // 1017h written to drives
+  int heartbeat_misses = 3;            // a drive is lost after this many periods of silence
+  core::Duration guard_time = std::chrono::milliseconds(100);         // 100Ch for guarding drives
+  int life_time_factor = 3;            // 100Dh
+  core::Duration sdo_timeout = std::chrono::milliseconds(100);
+  int sdo_retries = 2;
+  core::Duration boot_retry = std::chrono::seconds(1);       // first back-off after a failed boot
+  core::Duration boot_retry_max = std::chrono::seconds(10);  // back-off doubles up to this
+  bool sync = true;                    // produce SYNC every cycle
+};
+
 struct BusPlan {
   std::string name;
   std::string type;
@@ -106,6 +204,7 @@ struct BusPlan {
   int cpu = -1;      // CPU affinity; -1 = any
   std::map<std::string, OptionValue> options;  // every option of the type, defaults filled in
   SimBusOptions sim;  // the typed view of `options` when type == "sim"
+  CanopenBusOptions canopen;  // the typed view of `options` when type == "canopen"
   std::vector<AxisPlan> axes;
 };
 

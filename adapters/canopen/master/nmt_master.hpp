@@ -1,0 +1,124 @@
+#pragma once
+// NMT master and error control (CiA 301 §7.2.8): NMT commands, node states from boot-up,
+// heartbeat and node-guard replies, heartbeat consumer timeouts, node guarding with the toggle bit
+// (for drives without a consumer heartbeat, e.g. the SD6: stoeber-sd6-canopen.md §6.8, quirk 7),
+// and the master's own heartbeat producer (so drives with a consumer heartbeat notice a dead
+// gateway: AKD part 1 §16 step 10).
+//
+// Nodes are registered at construction. Each node is watched either by heartbeat (a timeout after
+// the last heartbeat) or by guarding (an RTR on 700h+n every guard time; a missing reply or a
+// wrong toggle is a miss; `life_time_factor` consecutive misses make the node lost). Watching
+// starts with watch() once the node is configured; before that only boot-ups and states are
+// tracked.
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "adapters/canopen/master/tx_queue.hpp"
+#include "adapters/canopen/wire/can_frame.hpp"
+#include "adapters/canopen/wire/nmt_codec.hpp"
+#include "core/clock.hpp"
+
+namespace drivegate::canopen {
+
+enum class Watch : std::uint8_t { None, Heartbeat, Guarding };
+
+struct NmtNodeConfig {
+  NodeId node = 0;
+  Watch watch = Watch::Heartbeat;
+  core::Duration heartbeat_timeout = std::chrono::milliseconds(300);  // Heartbeat: silence allowed
+  core::Duration guard_time = std::chrono::milliseconds(100);         // Guarding: RTR period
+  int life_time_factor = 3;                                           // Guarding: misses allowed
+};
+
+struct NmtMasterConfig {
+  NodeId own_node = 127;  // master heartbeat on 700h + own_node
+  core::Duration heartbeat_period = std::chrono::milliseconds(100);  // 0 = no own heartbeat
+};
+
+enum class NmtEventKind : std::uint8_t {
+  BootUp,        // 700h+n: 00 received (node (re)started, its configuration is lost)
+  StateChanged,  // a heartbeat/guard reply reported another state
+  Lost,          // heartbeat timeout, or guarding misses reached the life time factor
+  Recovered,     // a lost node was heard again (without boot-up)
+  ToggleError,   // a guard reply with the wrong toggle bit (counted as a miss)
+};
+
+struct NmtEvent {
+  NmtEventKind kind = NmtEventKind::BootUp;
+  NodeId node = 0;
+  NmtState state = NmtState::Unknown;
+};
+
+struct NmtCounters {
+  std::uint64_t boot_ups = 0;
+  std::uint64_t heartbeats = 0;
+  std::uint64_t guard_replies = 0;
+  std::uint64_t toggle_errors = 0;
+  std::uint64_t losses = 0;
+  std::uint64_t unexpected = 0;  // error-control frames from nodes that are not registered
+  std::uint64_t malformed = 0;   // wrong DLC or unknown state byte
+  std::uint64_t events_dropped = 0;
+  std::uint64_t tx_full = 0;
+};
+
+class NmtMaster {
+ public:
+  static constexpr std::size_t kEventCapacity = 256;
+
+  NmtMaster(NmtMasterConfig config, std::span<const NmtNodeConfig> nodes);
+
+  // Queue an NMT command (node 0 = all nodes). Returns false when the TxQueue is full.
+  bool command(NmtCommand cs, NodeId node, TxQueue& tx) noexcept;
+
+  // Start / stop supervising a node (heartbeat timeout or guarding RTRs). watch() restarts the
+  // timers from `now`; a lost node stays lost until it is heard again.
+  void watch(NodeId node, core::TimePoint now) noexcept;
+  void unwatch(NodeId node) noexcept;
+
+  [[nodiscard]] NmtState state(NodeId node) const noexcept;  // last reported state
+  [[nodiscard]] bool lost(NodeId node) const noexcept;
+  [[nodiscard]] core::TimePoint last_heard(NodeId node) const noexcept;
+
+  // Events in order of occurrence; returns false when there is none.
+  bool next_event(NmtEvent& out) noexcept;
+
+  // Engine interface. on_frame takes 700h+n frames (returns false for other COB-IDs).
+  bool on_frame(const CanFrame& frame, core::TimePoint now) noexcept;
+  void poll(core::TimePoint now, TxQueue& tx) noexcept;  // heartbeat, RTRs, timeouts
+  [[nodiscard]] core::TimePoint next_deadline() const noexcept;
+
+  [[nodiscard]] const NmtCounters& counters() const noexcept { return counters_; }
+
+ private:
+  NmtMasterConfig config_;
+  NmtCounters counters_;
+  // Implementation state (fixed capacity, allocated in the constructor) follows in the .cpp's
+  // private section; the implementation may add members here.
+};
+
+// SYNC producer (CiA 301 §7.2.5): COB-ID 080h, DLC 0 (the reference drives use no SYNC counter:
+// SD6 digest §6.1). Deadlines are start + k * period, so the period never drifts; a poll that
+// comes more than one period late sends one SYNC and counts the skipped ones.
+class SyncProducer {
+ public:
+  SyncProducer(std::uint32_t cob_id, core::Duration period) noexcept : cob_id_(cob_id), period_(period) {}
+  void start(core::TimePoint now) noexcept;
+  void stop() noexcept;
+  // Sends the SYNC if one is due; returns true when it did (RPDOs follow it).
+  bool poll(core::TimePoint now, TxQueue& tx) noexcept;
+  [[nodiscard]] core::TimePoint next_deadline() const noexcept;
+  [[nodiscard]] std::uint64_t sent() const noexcept { return sent_; }
+  [[nodiscard]] std::uint64_t skipped() const noexcept { return skipped_; }
+
+ private:
+  std::uint32_t cob_id_;
+  core::Duration period_;
+  bool running_ = false;
+  core::TimePoint next_{};
+  std::uint64_t sent_ = 0;
+  std::uint64_t skipped_ = 0;
+};
+
+}  // namespace drivegate::canopen

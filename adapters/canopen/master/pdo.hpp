@@ -1,0 +1,138 @@
+#pragma once
+// Process data (CiA 301 §7.2.2): the byte layout of a mapped PDO, the per-node process image the
+// CiA 402 profile reads and writes, and the master's PDO exchange: RPDOs sent right after each
+// SYNC (or on change/event timer for event-driven ones), TPDOs received with their time stamp and
+// a length check.
+//
+// Length rules for received TPDOs [CiA 301 §7.2.2.2; EMCY 8210h/8220h]: a frame shorter than its
+// mapping is dropped and counted (short); a longer one is used and counted (long), because some
+// drives pad to 8 bytes (NORD: RxPDO1 sent with DLC 8 although 5 bytes are mapped,
+// nord-sk500p-ds402.md §8.1).
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <span>
+
+#include "adapters/canopen/master/tx_queue.hpp"
+#include "adapters/canopen/wire/can_frame.hpp"
+#include "adapters/canopen/wire/cob_id.hpp"
+#include "adapters/canopen/wire/pdo_mapping.hpp"
+#include "core/clock.hpp"
+#include "profiles/cia402/objects.hpp"
+
+namespace drivegate::canopen {
+
+inline constexpr std::size_t kMaxPdoEntries = 8;
+inline constexpr std::size_t kPdosPerDirection = 4;
+
+// One mapped object inside a PDO.
+struct PdoField {
+  cia402::ObjectDef def{};
+  std::uint8_t offset = 0;  // byte offset in the frame
+};
+
+// A PDO's layout, built from its mapping entries. Only byte-granular objects of 8, 16 or 32 bits.
+struct PdoLayout {
+  std::array<PdoField, kMaxPdoEntries> fields{};
+  std::uint8_t count = 0;
+  std::uint8_t bytes = 0;  // mapped length
+
+  enum class Error : std::uint8_t { None, TooManyEntries, TooLong, BadLength };
+  // Appends an object; fails (and leaves the layout unchanged) past 8 entries or 8 bytes, or for a
+  // bit length that is not 8/16/32 or does not match the type's size.
+  Error add(cia402::ObjectDef def, std::uint8_t bits) noexcept;
+};
+const char* to_string(PdoLayout::Error e) noexcept;
+
+// Values of the objects a node exchanges cyclically, by ObjectId (linear search over <= 64
+// entries; the image is small and the search cache-friendly).
+class ProcessImage {
+ public:
+  static constexpr std::size_t kCapacity = 2 * kPdosPerDirection * kMaxPdoEntries;
+
+  // Registers an object (construction phase); false when full. Duplicates are merged.
+  bool add(cia402::ObjectDef def) noexcept;
+  [[nodiscard]] bool contains(cia402::ObjectId id) const noexcept;
+  [[nodiscard]] std::int64_t get(cia402::ObjectId id) const noexcept;  // sign-extended per type
+  void set(cia402::ObjectId id, std::int64_t value) noexcept;          // truncated to the type
+
+  // Encode the fields of `layout` into `out` (little-endian); decode them from `in`.
+  void pack(const PdoLayout& layout, std::span<std::uint8_t, 8> out) const noexcept;
+  void unpack(const PdoLayout& layout, std::span<const std::uint8_t> in) noexcept;
+
+ private:
+  struct Entry {
+    cia402::ObjectDef def{};
+    std::int64_t value = 0;
+  };
+  std::array<Entry, kCapacity> entries_{};
+  std::size_t size_ = 0;
+};
+
+struct RpdoConfig {  // master -> drive
+  std::uint32_t cob_id = 0;
+  PdoLayout layout;
+  std::uint8_t transmission_type = 1;  // 0..240: sent after each SYNC; 254/255: on change / event timer
+  core::Duration event_timer{};        // 254/255: resend at least this often (0 = only on change)
+  std::uint8_t dlc = 0;                // frame length to send (0 = the mapped length; NORD pads to 8)
+};
+
+struct TpdoConfig {  // drive -> master
+  std::uint32_t cob_id = 0;
+  PdoLayout layout;
+  std::uint8_t transmission_type = 1;  // 1..240: expected every n-th SYNC; 254/255: event-driven
+  core::Duration event_timer{};        // event-driven: the drive sends at least this often
+};
+
+struct PdoCounters {
+  std::uint64_t rpdos_sent = 0;
+  std::uint64_t tpdos_received = 0;
+  std::uint64_t short_frames = 0;  // dropped
+  std::uint64_t long_frames = 0;   // used, counted
+  std::uint64_t missed = 0;        // synchronous TPDO that did not arrive in its cycle
+  std::uint64_t tx_full = 0;
+};
+
+// The PDOs of one node.
+class NodePdos {
+ public:
+  // Replace the configuration (construction or after a reboot). Registers every mapped object in
+  // the image. Returns false when the image is full.
+  bool configure(std::span<const RpdoConfig> rpdos, std::span<const TpdoConfig> tpdos) noexcept;
+  void enable(bool on, core::TimePoint now) noexcept;  // PDOs flow only while the node is operational
+  [[nodiscard]] bool enabled() const noexcept { return enabled_; }
+
+  ProcessImage& image() noexcept { return image_; }
+  [[nodiscard]] const ProcessImage& image() const noexcept { return image_; }
+
+  // After a SYNC: queue the synchronous RPDOs (and due event-driven ones).
+  void after_sync(core::TimePoint now, TxQueue& tx) noexcept;
+  // Without SYNC (or between SYNCs): event-driven RPDOs whose data changed or whose timer ran out.
+  void poll(core::TimePoint now, TxQueue& tx) noexcept;
+  // A TPDO of this node (returns false for other COB-IDs).
+  bool on_frame(const CanFrame& frame, core::TimePoint now) noexcept;
+
+  // True when every synchronous TPDO arrived since the last after_sync() and every event-driven
+  // one within twice its event timer (or at all, when it has none).
+  [[nodiscard]] bool inputs_fresh(core::TimePoint now) const noexcept;
+  [[nodiscard]] core::TimePoint last_received() const noexcept { return last_rx_; }
+
+  [[nodiscard]] const PdoCounters& counters() const noexcept { return counters_; }
+
+ private:
+  ProcessImage image_;
+  bool enabled_ = false;
+  core::TimePoint last_rx_{};
+  PdoCounters counters_;
+  // The implementation adds its fixed-size per-PDO state here.
+};
+
+// Estimated bus occupation of one SYNC cycle (for --check-config and the benchmarks).
+struct CycleLoad {
+  std::uint32_t frames = 0;
+  std::uint64_t bits = 0;
+  core::Duration time{};
+  double fraction = 0;  // of the cycle time
+};
+
+}  // namespace drivegate::canopen
