@@ -136,12 +136,16 @@ void AxisRunner::parameter(const ParamRequest& req, TimePoint now, RunnerOutput&
   }
 }
 
-void AxisRunner::observe_link(TimePoint now, LinkState link, RunnerOutput& out) noexcept {
+void AxisRunner::observe_link(TimePoint now, LinkState link, std::string_view detail, RunnerOutput& out) noexcept {
   out_ = &out;
   now_ = now;
   if (link != last_link_) {
     Text t;
-    t.format("link %s -> %s", to_string(last_link_).data(), to_string(link).data());
+    if (detail.empty())
+      t.format("link %s -> %s", to_string(last_link_).data(), to_string(link).data());
+    else
+      t.format("link %s -> %s: %.*s", to_string(last_link_).data(), to_string(link).data(),
+               static_cast<int>(detail.size()), detail.data());
     const bool was_up = last_link_ == LinkState::Operational;
     last_link_ = link;
     if (link == LinkState::Operational) {

@@ -37,12 +37,12 @@ class AxisRunner final : private ControllerSink {
 
   // Start of a cycle, right after the bus delivered inputs: takes note of the link state, so
   // commands handled in this cycle see it.
-  void observe_link(TimePoint now, LinkState link, RunnerOutput& out) noexcept;
+  void observe_link(TimePoint now, LinkState link, std::string_view detail, RunnerOutput& out) noexcept;
   // One cycle, after commands were handled and before the bus sends outputs.
   void update(TimePoint now, RunnerOutput& out) noexcept;
   // Both, for callers without commands in between.
   void update(TimePoint now, LinkState link, RunnerOutput& out) noexcept {
-    observe_link(now, link, out);
+    observe_link(now, link, {}, out);
     update(now, out);
   }
 

@@ -12,7 +12,7 @@ BusRunner::BusRunner(Bus& bus, const std::vector<AxisSpec>& specs)
 
 void BusRunner::cycle(TimePoint now) noexcept {
   bus_.receive(now);
-  for (std::size_t i = 0; i < axes_.size(); ++i) axes_[i].observe_link(now, bus_.link_state(i), *this);
+  for (std::size_t i = 0; i < axes_.size(); ++i) axes_[i].observe_link(now, bus_.link_state(i), bus_.link_detail(i), *this);
 
   Command cmd;
   for (std::size_t n = 0; n < kMaxCommandsPerCycle && commands_.pop(cmd); ++n)

@@ -151,6 +151,16 @@ void Cia402Master::track_state(core::TimePoint /*now*/, core::ControllerSink& si
 
 void Cia402Master::track_fault_code(core::ControllerSink& sink) noexcept {
   if (!fault_event_pending_) return;
+  if (const DriveFaultReport report = io_.fault_report(); report.valid) {
+    // The drive announced the fault itself (EMCY): code and text with its vendor details.
+    if (fault_read_ != kNoRequest) io_.cancel(fault_read_);
+    fault_read_ = kNoRequest;
+    fault_event_pending_ = false;
+    fb_.fault_code = report.code;
+    fb_.fault_text.assign(report.text);
+    sink.event(EventKind::Fault, report.code, fb_.fault_text.view());
+    return;
+  }
   std::uint16_t code = 0;
   if (io_.mapped(obj::kErrorCode.id)) {
     code = static_cast<std::uint16_t>(io_.read(obj::kErrorCode.id));

@@ -5,6 +5,7 @@
 //
 // All calls happen on the bus' cycle thread and must not allocate or block.
 #include <cstdint>
+#include <string_view>
 
 #include "profiles/cia402/objects.hpp"
 
@@ -14,6 +15,14 @@ using RequestId = std::uint32_t;
 inline constexpr RequestId kNoRequest = 0;
 
 enum class RequestState : std::uint8_t { Pending, Done, Failed, Unknown };
+
+// A fault as the drive itself reported it outside the object dictionary (CANopen EMCY), with the
+// text already resolved from the device profile's tables and vendor bytes.
+struct DriveFaultReport {
+  bool valid = false;
+  std::uint16_t code = 0;
+  std::string_view text;  // valid until the next cycle
+};
 
 struct RequestResult {
   RequestState state = RequestState::Unknown;
@@ -45,6 +54,11 @@ class ObjectAccess {
   // adapter frees the request's slot at once. A write already sent to the drive may still take
   // effect. Unknown ids and kNoRequest are ignored; later polls of `id` say Unknown.
   virtual void cancel(RequestId id) noexcept = 0;
+
+  // --- Diagnostics ---
+  // The drive's present fault as it announced it (EMCY), if the bus has such a channel. The
+  // master prefers it to reading 603Fh, which some drives lack (NORD digest §9).
+  [[nodiscard]] virtual DriveFaultReport fault_report() const noexcept { return {}; }
 };
 
 }  // namespace drivegate::cia402

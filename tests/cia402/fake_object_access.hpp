@@ -30,6 +30,8 @@ class FakeObjectAccess final : public ObjectAccess {
   void set_latency(int polls) noexcept { latency_ = polls; }
   void set_queue_full(bool full) noexcept { queue_full_ = full; }
   void set_fresh(bool fresh) noexcept { fresh_ = fresh; }
+  void set_fault_report(DriveFaultReport r) noexcept { report_ = r; }
+  DriveFaultReport fault_report() const noexcept override { return report_; }
 
   // Acyclic writes in the order they were submitted (kept up to kLog entries).
   [[nodiscard]] std::size_t acyclic_writes() const noexcept { return log_count_; }
@@ -130,6 +132,7 @@ class FakeObjectAccess final : public ObjectAccess {
   int latency_ = 2;
   bool queue_full_ = false;
   bool fresh_ = true;
+  DriveFaultReport report_{};
 };
 
 }  // namespace drivegate::cia402::test

@@ -65,6 +65,22 @@ TEST(Faults, DriveWithout603FStillReportsTheFault) {
   EXPECT_EQ(ev.text, "drive fault (603Fh unreadable: object does not exist in the object dictionary)");
 }
 
+// A bus with its own fault channel (CANopen EMCY) gives code and text; 603Fh is not read.
+TEST(Faults, DriveReportedFaultWinsOverReading603F) {
+  Harness h;
+  h.io.unmap(obj::kErrorCode.id);
+  h.io.set_latency(3);
+  h.cycle(kSwSwitchOnDisabled);
+  h.cycle(kSwFault);  // 603Fh read submitted
+  EXPECT_EQ(h.io.acyclic_reads(), 1U);
+  h.io.set_fault_report({true, 0x7500, "0x7500 Communication (event 52, cause 1)"});
+  h.cycle(kSwFault);
+  ASSERT_EQ(h.sink.count(EventKind::Fault), 1U);
+  EXPECT_EQ(find_event(h.sink, EventKind::Fault).code, 0x7500U);
+  EXPECT_EQ(h.master.feedback().fault_text.view(), "0x7500 Communication (event 52, cause 1)");
+  EXPECT_EQ(h.io.pending_requests(), 0U);  // the 603Fh read was cancelled
+}
+
 TEST(Faults, VendorTextsComeFirst) {
   Harness h;
   const std::array table = {FaultText{0xFF00, "F501 bus overvoltage"}};
