@@ -56,6 +56,7 @@ struct DeviceIdentity {
 struct PdoEntrySpec {
   cia402::ObjectId object;
   std::uint8_t bits = 0;  // 8, 16 or 32
+  cia402::DataType type = cia402::DataType::U8;  // from the entry's type name (i8 u8 i16 u16 i32 u32)
 };
 
 struct PdoSpec {
@@ -64,6 +65,8 @@ struct PdoSpec {
   int transmission_type = 1;          // 0..240 synchronous, 254/255 event-driven
   int inhibit_time_100us = 0;         // TPDO only; 0 = none
   int event_timer_ms = 0;             // TPDO only; 0 = none
+  int dlc = 0;                        // RPDO frame length to send; 0 = the mapped length (NORD pads
+                                      // RxPDO1 to 8 bytes: nord-sk500p-ds402.md §8.1)
 };
 
 enum class PdoPolicy : std::uint8_t {

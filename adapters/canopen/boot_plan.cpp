@@ -1,0 +1,165 @@
+#include "adapters/canopen/boot_plan.hpp"
+
+#include <chrono>
+
+#include "adapters/canopen/wire/cob_id.hpp"
+#include "adapters/canopen/wire/pdo_mapping.hpp"
+
+namespace drivegate::canopen {
+namespace {
+
+using cia402::DataType;
+using cia402::ObjectDef;
+
+ObjectDef u8(std::uint16_t index, std::uint8_t sub) { return {{index, sub}, DataType::U8}; }
+ObjectDef i8(std::uint16_t index, std::uint8_t sub) { return {{index, sub}, DataType::I8}; }
+ObjectDef u16(std::uint16_t index, std::uint8_t sub) { return {{index, sub}, DataType::U16}; }
+ObjectDef u32(std::uint16_t index, std::uint8_t sub) { return {{index, sub}, DataType::U32}; }
+
+long long ms(core::Duration d) { return std::chrono::duration_cast<std::chrono::milliseconds>(d).count(); }
+
+struct Steps {
+  std::vector<BootStep> list;
+  void write(std::string stage, ObjectDef def, std::int64_t value, bool optional = false, std::string why = {}) {
+    list.push_back({BootStep::Kind::Write, def, value, 0xFFFFFFFF, optional, std::move(stage), std::move(why)});
+  }
+  void expect(std::string stage, ObjectDef def, std::int64_t value, std::uint32_t mask = 0xFFFFFFFF,
+              std::string why = {}) {
+    list.push_back({BootStep::Kind::Expect, def, value, mask, false, std::move(stage), std::move(why)});
+  }
+};
+
+const config::PdoSpec* find_pdo(const std::vector<config::PdoSpec>& pdos, int number) {
+  for (const auto& p : pdos)
+    if (p.number == number) return &p;
+  return nullptr;
+}
+
+// One direction's PDOs. CiA 301 §7.5.2.35/36 and AKD part 1 §12.6: invalidate (bit 31), clear
+// the count, write the entries, set the count, set the communication parameters, validate.
+void pdo_steps(Steps& s, const config::CanopenDeviceSpec& dev, bool transmit, NodeId node) {
+  const auto& pdos = transmit ? dev.tpdos : dev.rpdos;
+  for (int n = 0; n < 4; ++n) {
+    const std::uint16_t comm = transmit ? tpdo_comm_index(n) : rpdo_comm_index(n);
+    const std::uint16_t map = transmit ? tpdo_map_index(n) : rpdo_map_index(n);
+    // TPDOs: no RTR (bit 30), as the AKD's own procedure writes them (AKD part 1 §14 vectors 3, 8).
+    const std::uint32_t cob = (transmit ? cob::tpdo(n, node) : cob::rpdo(n, node)) | (transmit ? cob::kNoRtr : 0U);
+    const std::string name = std::string(transmit ? "TPDO" : "RPDO") + std::to_string(n + 1);
+    const config::PdoSpec* p = find_pdo(pdos, n + 1);
+    if (dev.pdo_policy == config::PdoPolicy::Verify) {
+      if (!p) continue;
+      const std::string stage = name + " verification";
+      const std::string why = "this drive's mapping is fixed or needs save and restart: set it in the drive's tool";
+      for (std::size_t k = 0; k < p->entries.size(); ++k)
+        s.expect(stage, u32(map, static_cast<std::uint8_t>(k + 1)),
+                 encode_mapping({p->entries[k].object, p->entries[k].bits}), 0xFFFFFFFF, why);
+      s.expect(stage, u8(comm, 2), p->transmission_type, 0xFF, why);
+      s.expect(stage, u32(comm, 1), cob & cob::kIdMask, cob::kInvalid | cob::kIdMask, why);
+      continue;
+    }
+    if (!p) {
+      // Unused PDOs are switched off so drive defaults (e.g. AKD event-driven TPDO3/4) do not flood
+      // the bus (AKD part 1 §16 step 7). A drive with fewer PDOs may lack the object.
+      if (dev.disable_unused_pdos) s.write(name + " disable", u32(comm, 1), cob | cob::kInvalid, true);
+      continue;
+    }
+    const std::string stage = name + " mapping";
+    s.write(stage, u32(comm, 1), cob | cob::kInvalid);
+    s.write(stage, u8(map, 0), 0);
+    for (std::size_t k = 0; k < p->entries.size(); ++k)
+      s.write(stage, u32(map, static_cast<std::uint8_t>(k + 1)), encode_mapping({p->entries[k].object, p->entries[k].bits}));
+    s.write(stage, u8(map, 0), static_cast<std::int64_t>(p->entries.size()));
+    s.write(stage, u8(comm, 2), p->transmission_type);
+    if (transmit && p->inhibit_time_100us > 0) s.write(stage, u16(comm, 3), p->inhibit_time_100us);
+    if (transmit && p->event_timer_ms > 0) s.write(stage, u16(comm, 5), p->event_timer_ms);
+    s.write(stage, u32(comm, 1), cob);
+  }
+}
+
+}  // namespace
+
+std::vector<BootStep> build_boot_steps(const config::AxisPlan& axis, const config::BusPlan& bus) {
+  Steps s;
+  const auto& dev = axis.device.canopen;
+  const auto node = static_cast<NodeId>(axis.address);
+  const auto& opt = bus.canopen;
+
+  // Identity (AKD part 1 §16 step 4, SD6 gateway step B3).
+  if (dev.device_type)
+    s.expect("identity", u32(0x1000, 0), *dev.device_type, dev.device_type_mask,
+             "device type (1000h) of a " + axis.device.name);
+  if (axis.device.identity.vendor_id)
+    s.expect("identity", u32(0x1018, 1), *axis.device.identity.vendor_id, 0xFFFFFFFF,
+             "vendor-ID (1018h:01) of a " + axis.device.name);
+  if (axis.device.identity.product_code)
+    s.expect("identity", u32(0x1018, 2), *axis.device.identity.product_code, 0xFFFFFFFF,
+             "product code (1018h:02) of a " + axis.device.name);
+
+  for (const auto& w : dev.startup_writes) s.write("start-up write", w.def, w.value, false, w.why);
+  for (const auto& w : axis.canopen.startup_writes) s.write("start-up write (axis)", w.def, w.value, false, w.why);
+
+  pdo_steps(s, dev, false, node);
+  pdo_steps(s, dev, true, node);
+
+  // SYNC period: 1006h in us (SD6 §6.1 wants it to match A150); optional, not every drive has it.
+  if (opt.sync)
+    s.write("SYNC", u32(0x1006, 0),
+            std::chrono::duration_cast<std::chrono::microseconds>(bus.cycle_time).count(), true);
+  // ip/csp interpolation period = SYNC period, whole ms, both sub-indices (AKD part 2 §14 step 5).
+  const bool cyclic_position = axis.device.modes.contains(core::Mode::InterpolatedPosition) ||
+                               axis.device.modes.contains(core::Mode::CyclicPosition);
+  const auto cycle_ms = ms(bus.cycle_time);
+  if (cyclic_position && cycle_ms >= 1 && bus.cycle_time == std::chrono::milliseconds(cycle_ms)) {
+    s.write("interpolation period", u8(0x60C2, 1), cycle_ms, true);
+    s.write("interpolation period", i8(0x60C2, 2), -3, true);
+  }
+
+  // Error control (AKD part 1 §16 step 10; SD6 gateway step B6: exactly one of the two).
+  if (dev.error_control == config::ErrorControl::Heartbeat) {
+    s.write("error control", u16(0x1017, 0), ms(opt.drive_heartbeat));
+    if (dev.consumer_heartbeat) {
+      // The drive watches the gateway: timeout well above the gateway's heartbeat period.
+      const auto timeout = ms(opt.heartbeat_period) * opt.heartbeat_misses;
+      s.write("error control", u32(0x1016, 1), (std::int64_t{opt.gateway_node_id} << 16) | timeout, false,
+              "consumer heartbeat: the drive stops when the gateway is silent");
+    }
+  } else {
+    s.write("error control", u16(0x1017, 0), 0, true, "heartbeat off: guarding and heartbeat are exclusive");
+    s.write("error control", u16(0x100C, 0), ms(opt.guard_time));
+    s.write("error control", u8(0x100D, 0), opt.life_time_factor);
+  }
+  return std::move(s.list);
+}
+
+NodePdoConfig build_pdo_config(const config::AxisPlan& axis) {
+  NodePdoConfig out;
+  const auto node = static_cast<NodeId>(axis.address);
+  const auto& dev = axis.device.canopen;
+  auto layout_of = [](const config::PdoSpec& p) {
+    PdoLayout l;
+    for (const auto& e : p.entries) {
+      const auto bytes = static_cast<std::uint8_t>(e.bits / 8);
+      (void)l.add({e.object, e.type}, static_cast<std::uint8_t>(bytes * 8));
+    }
+    return l;
+  };
+  for (const auto& p : dev.rpdos) {
+    RpdoConfig c;
+    c.cob_id = cob::rpdo(p.number - 1, node);
+    c.layout = layout_of(p);
+    c.transmission_type = static_cast<std::uint8_t>(p.transmission_type);
+    c.dlc = static_cast<std::uint8_t>(p.dlc);
+    out.rpdos.push_back(c);
+  }
+  for (const auto& p : dev.tpdos) {
+    TpdoConfig c;
+    c.cob_id = cob::tpdo(p.number - 1, node);
+    c.layout = layout_of(p);
+    c.transmission_type = static_cast<std::uint8_t>(p.transmission_type);
+    c.event_timer = std::chrono::milliseconds(p.event_timer_ms);
+    out.tpdos.push_back(c);
+  }
+  return out;
+}
+
+}  // namespace drivegate::canopen

@@ -1,0 +1,389 @@
+#include "adapters/canopen/canopen_bus.hpp"
+
+#include <algorithm>
+
+#include "adapters/canopen/boot_plan.hpp"
+#include "profiles/cia402/master_settings.hpp"
+#include "profiles/cia402/sdo_abort.hpp"
+
+namespace drivegate::canopen {
+namespace {
+
+using Phase = CanopenBus::Phase;
+
+// How long to wait for a boot-up after NMT reset communication before probing by SDO.
+constexpr core::Duration kBootUpWait = std::chrono::milliseconds(500);
+
+std::vector<SdoChannelConfig> sdo_channels_for(const config::BusPlan& plan) {
+  std::vector<SdoChannelConfig> out;
+  for (const auto& a : plan.axes) {
+    const auto node = static_cast<NodeId>(a.address);
+    const int ch = a.canopen.sdo_channel;
+    out.push_back({node, ch, cob::sdo_rx(ch, node), cob::sdo_tx(ch, node)});
+  }
+  return out;
+}
+
+std::vector<NmtNodeConfig> nmt_nodes_for(const config::BusPlan& plan) {
+  std::vector<NmtNodeConfig> out;
+  const auto& o = plan.canopen;
+  for (const auto& a : plan.axes) {
+    NmtNodeConfig c;
+    c.node = static_cast<NodeId>(a.address);
+    c.watch = a.device.canopen.error_control == config::ErrorControl::Guarding ? Watch::Guarding : Watch::Heartbeat;
+    c.heartbeat_timeout = o.drive_heartbeat * o.heartbeat_misses;
+    c.guard_time = o.guard_time;
+    c.life_time_factor = o.life_time_factor;
+    out.push_back(c);
+  }
+  return out;
+}
+
+}  // namespace
+
+CanopenBus::CanopenBus(const config::BusPlan& plan, std::unique_ptr<Transport> transport,
+                       std::unique_ptr<CyclePeer> peer)
+    : name_(plan.name),
+      options_(plan.canopen),
+      cycle_time_(plan.cycle_time),
+      transport_(std::move(transport)),
+      peer_(std::move(peer)),
+      tables_([&] {
+        std::vector<Tables> t;
+        for (const auto& a : plan.axes) {
+          Tables x;
+          for (const auto& [code, text] : a.device.fault_texts) x.faults.push_back({static_cast<std::uint16_t>(code), text});
+          for (const auto& f : a.device.canopen.emcy_fields) x.fields.push_back({static_cast<std::uint8_t>(f.byte), f.name});
+          t.push_back(std::move(x));
+        }
+        return t;
+      }()),
+      sdo_channels_(sdo_channels_for(plan)),
+      nmt_nodes_(nmt_nodes_for(plan)),
+      emcy_nodes_([&] {
+        std::vector<EmcyNodeConfig> e;
+        for (std::size_t i = 0; i < plan.axes.size(); ++i)
+          e.push_back({static_cast<NodeId>(plan.axes[i].address), tables_[i].faults, tables_[i].fields,
+                       plan.axes[i].device.canopen.emcy_zero_needs_clear_register});
+        return e;
+      }()),
+      sdo_(sdo_channels_, SdoTiming{plan.canopen.sdo_timeout, plan.canopen.sdo_retries}),
+      nmt_(NmtMasterConfig{static_cast<NodeId>(plan.canopen.gateway_node_id), plan.canopen.heartbeat_period},
+           nmt_nodes_),
+      emcy_(emcy_nodes_),
+      sync_(cob::kSync, plan.cycle_time) {
+  for (std::size_t i = 0; i < plan.axes.size(); ++i) {
+    const auto& a = plan.axes[i];
+    auto n = std::make_unique<Node>(static_cast<int>(i), build_boot_steps(a, plan));
+    n->id = static_cast<NodeId>(a.address);
+    n->channel = static_cast<int>(i);
+    const NodePdoConfig pdo = build_pdo_config(a);
+    if (!n->pdos.configure(pdo.rpdos, pdo.tpdos))
+      throw core::BusError("bus '" + name_ + "' axis '" + a.spec.name + "': PDO maps exceed the process image");
+    n->io = std::make_unique<NodeAccess>(n->id, n->channel, n->pdos, sdo_, emcy_);
+    n->master = std::make_unique<cia402::Cia402Master>(*n->io, cia402::settings_from(a.spec));
+    n->master->set_fault_table(tables_[i].faults);
+    by_id_[n->id] = n.get();
+    nodes_.push_back(std::move(n));
+  }
+}
+
+CanopenBus::~CanopenBus() = default;
+
+void CanopenBus::open(core::TimePoint now) {
+  try {
+    transport_->open();
+  } catch (const TransportError& e) {
+    throw core::BusError("bus '" + name_ + "': " + e.what());
+  }
+  open_ = true;
+  controller_ = transport_->controller_state();
+  if (options_.sync) sync_.start(now);
+  for (auto& n : nodes_) enter(*n, Phase::Start, now);
+}
+
+void CanopenBus::close() noexcept {
+  if (!open_) return;
+  // Leave the drives pre-operational (SD6 gateway step B15: before guarding and SYNC stop, so a
+  // life-guarding fault is not raised), then release the transport.
+  for (auto& n : nodes_) nmt_.command(NmtCommand::EnterPreOperational, n->id, tx_);
+  flush(core::TimePoint{});
+  sync_.stop();
+  transport_->close();
+  open_ = false;
+  for (auto& n : nodes_) n->link.store(core::LinkState::Offline, std::memory_order_relaxed);
+}
+
+core::LinkState CanopenBus::link_state(std::size_t axis) const noexcept {
+  return nodes_[axis]->link.load(std::memory_order_relaxed);
+}
+
+std::string_view CanopenBus::link_detail(std::size_t axis) const noexcept { return nodes_[axis]->detail.view(); }
+
+void CanopenBus::enter(Node& n, Phase p, core::TimePoint now) noexcept {
+  n.phase = p;
+  n.since = now;
+  core::LinkState link = core::LinkState::Offline;
+  switch (p) {
+    case Phase::Start:
+    case Phase::WaitBootUp:
+    case Phase::Probe: link = n.had_link ? core::LinkState::Lost : core::LinkState::Booting; break;
+    case Phase::Configuring: link = core::LinkState::Configuring; break;
+    case Phase::Operational: link = core::LinkState::Operational; break;
+    case Phase::Backoff: link = n.had_link ? core::LinkState::Lost : core::LinkState::Offline; break;
+    case Phase::Lost: link = core::LinkState::Lost; break;
+  }
+  n.link.store(link, std::memory_order_relaxed);
+}
+
+// The node is gone (or must be brought up again): stop its PDOs, forget its transfers and its
+// fault, stop supervising it.
+void CanopenBus::drop_node(Node& n, Phase next, core::TimePoint now) noexcept {
+  n.boot.abandon(sdo_);
+  if (n.probe != kNoSdoRequest) sdo_.cancel(n.probe);
+  n.probe = kNoSdoRequest;
+  sdo_.reset_channel(n.channel);
+  n.io->forget_requests();
+  n.pdos.enable(false, now);
+  nmt_.unwatch(n.id);
+  emcy_.reset(n.id);
+  enter(n, next, now);
+}
+
+void CanopenBus::fail_node(Node& n, core::TimePoint now) noexcept {
+  // Back-off doubles from boot_retry up to boot_retry_max.
+  n.backoff = n.backoff == core::Duration::zero() ? options_.boot_retry
+                                                  : std::min(n.backoff * 2, options_.boot_retry_max);
+  drop_node(n, Phase::Backoff, now);
+}
+
+void CanopenBus::receive(core::TimePoint now) noexcept {
+  if (!open_) return;
+  if (peer_) peer_->step(now);
+  for (;;) {
+    const std::size_t got = transport_->receive(rx_buffer_, now);
+    for (std::size_t i = 0; i < got; ++i) dispatch(rx_buffer_[i], now);
+    if (got < rx_buffer_.size()) break;
+  }
+  handle_controller_state(now);
+  handle_nmt_events(now);
+  EmcyReport report;
+  while (emcy_.next_report(report)) {
+  }
+  for (auto& n : nodes_) {
+    advance(*n, now);
+    n->io->begin_cycle(now, n->phase == Phase::Operational);
+  }
+}
+
+void CanopenBus::dispatch(const CanFrame& f, core::TimePoint now) noexcept {
+  received_.fetch_add(1, std::memory_order_relaxed);
+  if (f.extended) {
+    ++unexpected_;
+    return;
+  }
+  const CobSplit c = split_cob_id(f.id);
+  bool used = false;
+  switch (c.function) {
+    case Function::SdoTx: used = sdo_.on_frame(f, now); break;
+    case Function::ErrorControl: used = !f.remote && nmt_.on_frame(f, now); break;
+    case Function::Emcy: used = emcy_.on_frame(f, now); break;
+    case Function::Tpdo:
+      if (Node* n = node_by_id(c.node)) used = n->pdos.on_frame(f, now);
+      break;
+    default: break;  // NMT, SYNC, RPDOs, SDO requests of another master: not for us
+  }
+  if (!used) ++unexpected_;
+}
+
+void CanopenBus::handle_controller_state(core::TimePoint now) noexcept {
+  const ControllerState s = transport_->controller_state();
+  if (s == controller_) return;
+  const bool was_off = controller_ == ControllerState::BusOff;
+  controller_ = s;
+  if (s == ControllerState::BusOff) {
+    for (auto& n : nodes_) {
+      n->detail.assign("the gateway's CAN controller is bus-off");
+      if (n->phase == Phase::Operational) n->had_link = true;
+      drop_node(*n, Phase::Lost, now);
+    }
+    tx_.clear();
+  } else if (was_off) {
+    // The controller is back: check every node again from scratch.
+    for (auto& n : nodes_) {
+      n->detail.assign("CAN controller recovered from bus-off: checking the node again");
+      n->backoff = core::Duration::zero();
+      enter(*n, Phase::Start, now);
+    }
+  }
+}
+
+void CanopenBus::handle_nmt_events(core::TimePoint now) noexcept {
+  NmtEvent e;
+  while (nmt_.next_event(e)) {
+    Node* n = node_by_id(e.node);
+    if (!n) continue;
+    switch (e.kind) {
+      case NmtEventKind::BootUp:
+        // The node (re)started: its configuration is gone. Reconfigure it from scratch.
+        if (n->phase == Phase::Operational) n->had_link = true;
+        if (n->phase == Phase::Operational || n->phase == Phase::Configuring)
+          n->detail.format("node %u rebooted: configuring it again", unsigned{n->id});
+        drop_node(*n, Phase::Configuring, now);
+        ++n->boots;
+        n->boot.start();
+        break;
+      case NmtEventKind::Lost:
+        if (n->phase == Phase::Operational) {
+          n->had_link = true;
+          n->detail.format("node %u stopped answering (%s)", unsigned{n->id},
+                           nmt_nodes_[static_cast<std::size_t>(n->channel)].watch == Watch::Guarding
+                               ? "node guarding"
+                               : "heartbeat timeout");
+          drop_node(*n, Phase::Lost, now);
+        }
+        break;
+      case NmtEventKind::StateChanged:
+        if (n->phase == Phase::Operational && e.state != NmtState::Operational) {
+          // Someone else switched the node out of Operational: its PDOs stopped. Bring it up again.
+          n->had_link = true;
+          n->detail.format("node %u left operational (now %s): configuring it again", unsigned{n->id},
+                           to_string(e.state));
+          drop_node(*n, Phase::Probe, now);
+        }
+        break;
+      case NmtEventKind::Recovered:
+        if (n->phase == Phase::Lost || n->phase == Phase::Backoff) enter(*n, Phase::Probe, now);
+        break;
+      case NmtEventKind::ToggleError: break;  // counted by the NMT master; misses decide
+    }
+  }
+}
+
+void CanopenBus::advance(Node& n, core::TimePoint now) noexcept {
+  if (controller_ == ControllerState::BusOff) return;
+  switch (n.phase) {
+    case Phase::Start:
+      // Reset communication: the node sends a boot-up and is pre-operational with default
+      // communication parameters, whatever state it was left in.
+      nmt_.command(NmtCommand::ResetCommunication, n.id, tx_);
+      enter(n, Phase::WaitBootUp, now);
+      break;
+    case Phase::WaitBootUp:
+      if (now - n.since >= kBootUpWait) enter(n, Phase::Probe, now);  // boot-up not repeated (SD6 quirk 9)
+      break;
+    case Phase::Probe:
+      if (n.probe == kNoSdoRequest) {
+        n.probe = sdo_.read(n.channel, {0x1000, 0}, 4);
+        break;
+      }
+      switch (sdo_.result(n.probe).status) {
+        case SdoStatus::Queued:
+        case SdoStatus::InFlight: break;
+        case SdoStatus::Done:
+          sdo_.take(n.probe);
+          n.probe = kNoSdoRequest;
+          nmt_.command(NmtCommand::EnterPreOperational, n.id, tx_);
+          enter(n, Phase::Configuring, now);
+          ++n.boots;
+          n.boot.start();
+          break;
+        case SdoStatus::Failed: {
+          const auto code = sdo_.take(n.probe).abort_code;
+          n.probe = kNoSdoRequest;
+          n.detail.format("node %u does not answer (SDO read of 1000h: %s)", unsigned{n.id},
+                          cia402::sdo_abort_text(code).data());
+          fail_node(n, now);
+          break;
+        }
+        case SdoStatus::Unknown: n.probe = kNoSdoRequest; break;
+      }
+      break;
+    case Phase::Configuring:
+      switch (n.boot.step(sdo_)) {
+        case NodeBoot::Status::Done:
+          nmt_.command(NmtCommand::Start, n.id, tx_);
+          nmt_.watch(n.id, now);
+          n.pdos.enable(true, now);
+          n.backoff = core::Duration::zero();
+          n.detail.assign("");
+          enter(n, Phase::Operational, now);
+          break;
+        case NodeBoot::Status::Failed:
+          n.detail.format("node %u: %.*s", unsigned{n.id}, static_cast<int>(n.boot.failure().view().size()),
+                          n.boot.failure().view().data());
+          fail_node(n, now);
+          break;
+        default: break;
+      }
+      break;
+    case Phase::Backoff:
+    case Phase::Lost:
+      // Probe again after the back-off (Lost: after boot_retry); a boot-up or heartbeat may come first.
+      if (now - n.since >= (n.backoff == core::Duration::zero() ? options_.boot_retry : n.backoff))
+        enter(n, Phase::Probe, now);
+      break;
+    case Phase::Operational: break;
+  }
+}
+
+void CanopenBus::transmit(core::TimePoint now) noexcept {
+  if (!open_) return;
+  if (controller_ == ControllerState::BusOff) {
+    tx_.clear();
+    return;
+  }
+  // SYNC first, then the RPDOs of every operational node inside the SYNC window. The cycle
+  // thread keeps the period; the producer only guards against sending twice in one cycle.
+  const bool synced = options_.sync && sync_.poll(now + cycle_time_ / 2, tx_);
+  for (auto& n : nodes_) {
+    if (n->phase != Phase::Operational) continue;
+    if (synced)
+      n->pdos.after_sync(now, tx_);
+    else
+      n->pdos.poll(now, tx_);
+  }
+  nmt_.poll(now, tx_);
+  sdo_.poll(now, tx_);
+  flush(now);
+  publish_counters();
+}
+
+void CanopenBus::flush(core::TimePoint now) noexcept {
+  while (!tx_.empty()) {
+    const SendResult r = transport_->send(tx_.front(), now);
+    if (r == SendResult::Busy) break;  // the rest goes next cycle; timeouts cover what is late
+    if (r == SendResult::Sent)
+      sent_.fetch_add(1, std::memory_order_relaxed);
+    else
+      ++tx_dropped_;
+    tx_.pop();
+  }
+}
+
+void CanopenBus::publish_counters() noexcept {
+  std::uint64_t missed = 0;
+  std::uint64_t bad = unexpected_ + tx_dropped_ + sdo_.counters().malformed + sdo_.counters().unexpected +
+                      nmt_.counters().malformed + nmt_.counters().unexpected + emcy_.counters().malformed +
+                      emcy_.counters().unexpected;
+  for (const auto& n : nodes_) {
+    missed += n->pdos.counters().missed;
+    bad += n->pdos.counters().short_frames;
+  }
+  lost_.store(missed, std::memory_order_relaxed);
+  dropped_.store(bad, std::memory_order_relaxed);
+  const auto t = transport_->counters();
+  errors_.store(t.error_frames + t.bus_off, std::memory_order_relaxed);
+}
+
+core::BusCounters CanopenBus::counters() const noexcept {
+  core::BusCounters c;
+  c.frames_sent = sent_.load(std::memory_order_relaxed);
+  c.frames_received = received_.load(std::memory_order_relaxed);
+  c.frames_lost = lost_.load(std::memory_order_relaxed);
+  c.frames_dropped = dropped_.load(std::memory_order_relaxed);
+  c.errors = errors_.load(std::memory_order_relaxed);
+  return c;
+}
+
+}  // namespace drivegate::canopen

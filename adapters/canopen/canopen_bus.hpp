@@ -1,0 +1,148 @@
+#pragma once
+// A CANopen bus (core::Bus): one transport, the master's engines (NMT and error control, SDO
+// client, SYNC, EMCY, PDOs) and a CiA 402 profile per axis over NodeAccess. Each axis is one node.
+//
+// Per node the bus runs the life cycle the issue asks for:
+//   start:        NMT reset communication, wait for the boot-up (or probe 1000h by SDO when the
+//                 drive does not repeat its boot-up: SD6 quirk 9), NMT pre-operational
+//   configuring:  NodeBoot (identity, start-up writes, PDOs, error control), then NMT start
+//   operational:  PDOs after each SYNC, heartbeat or guarding supervision, EMCY
+//   lost / failed: link Lost or Offline with the reason; probed again with back-off, and on its
+//                 next boot-up or answer reconfigured from scratch, coming back disabled
+// A bus-off of the gateway's controller takes every node to Lost; when the controller is back,
+// every node is probed and reconfigured. Nothing needs a daemon restart.
+//
+// receive() and transmit() are the cyclic path: no allocation, lock, logging or blocking.
+#include <array>
+#include <atomic>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "adapters/canopen/master/emcy_consumer.hpp"
+#include "adapters/canopen/master/nmt_master.hpp"
+#include "adapters/canopen/master/node_boot.hpp"
+#include "adapters/canopen/master/pdo.hpp"
+#include "adapters/canopen/master/sdo_client.hpp"
+#include "adapters/canopen/master/tx_queue.hpp"
+#include "adapters/canopen/node_access.hpp"
+#include "adapters/canopen/transport/transport.hpp"
+#include "config/plan.hpp"
+#include "core/bus.hpp"
+#include "profiles/cia402/cia402_master.hpp"
+
+namespace drivegate::canopen {
+
+// Something the bus steps every cycle besides its own engines: the simulated drives of a
+// `transport: sim` bus, which live on the same in-process wire.
+class CyclePeer {
+ public:
+  virtual ~CyclePeer() = default;
+  virtual void step(core::TimePoint now) noexcept = 0;
+};
+
+// Transport for a plan's options (socketcan or udp-multicast); `sim` buses get theirs from
+// make_canopen_bus(). Throws TransportError.
+std::unique_ptr<Transport> make_transport(const config::BusPlan& plan);
+
+class CanopenBus final : public core::Bus {
+ public:
+  enum class Phase : std::uint8_t { Start, WaitBootUp, Probe, Configuring, Operational, Backoff, Lost };
+
+  CanopenBus(const config::BusPlan& plan, std::unique_ptr<Transport> transport,
+             std::unique_ptr<CyclePeer> peer = nullptr);
+  ~CanopenBus() override;
+
+  std::string_view name() const noexcept override { return name_; }
+  std::string_view type() const noexcept override { return "canopen"; }
+  void open(core::TimePoint now) override;
+  void close() noexcept override;
+  std::size_t axis_count() const noexcept override { return nodes_.size(); }
+  core::AxisController& controller(std::size_t axis) noexcept override { return *nodes_[axis]->master; }
+  core::LinkState link_state(std::size_t axis) const noexcept override;
+  std::string_view link_detail(std::size_t axis) const noexcept override;
+  void receive(core::TimePoint now) noexcept override;
+  void transmit(core::TimePoint now) noexcept override;
+  core::BusCounters counters() const noexcept override;
+
+  // Diagnostics (bus thread only, or while the bus is not cycling).
+  [[nodiscard]] Phase phase(std::size_t axis) const noexcept { return nodes_[axis]->phase; }
+  [[nodiscard]] const SdoClient& sdo() const noexcept { return sdo_; }
+  [[nodiscard]] const NmtMaster& nmt() const noexcept { return nmt_; }
+  [[nodiscard]] const EmcyConsumer& emcy() const noexcept { return emcy_; }
+  [[nodiscard]] const NodePdos& pdos(std::size_t axis) const noexcept { return nodes_[axis]->pdos; }
+  [[nodiscard]] std::uint64_t unexpected_frames() const noexcept { return unexpected_; }
+  [[nodiscard]] std::uint64_t boots(std::size_t axis) const noexcept { return nodes_[axis]->boots; }
+  [[nodiscard]] Transport& transport() noexcept { return *transport_; }
+
+ private:
+  struct Node {
+    NodeId id = 0;
+    int channel = 0;  // SdoClient channel index
+    NodeBoot boot;
+    NodePdos pdos;
+    std::unique_ptr<NodeAccess> io;
+    std::unique_ptr<cia402::Cia402Master> master;
+    Phase phase = Phase::Start;
+    core::TimePoint since{};
+    core::Duration backoff{};
+    SdoRequestId probe = kNoSdoRequest;
+    bool had_link = false;  // was operational before: a loss shows as Lost, not Offline
+    std::uint64_t boots = 0;
+    core::FixedString<200> detail;
+    std::atomic<core::LinkState> link{core::LinkState::Offline};
+    Node(int sdo_channel, std::vector<BootStep> steps) : boot(sdo_channel, std::move(steps)) {}
+  };
+
+  void dispatch(const CanFrame& f, core::TimePoint now) noexcept;
+  void handle_nmt_events(core::TimePoint now) noexcept;
+  void handle_controller_state(core::TimePoint now) noexcept;
+  void advance(Node& n, core::TimePoint now) noexcept;
+  void enter(Node& n, Phase p, core::TimePoint now) noexcept;
+  void drop_node(Node& n, Phase next, core::TimePoint now) noexcept;
+  void fail_node(Node& n, core::TimePoint now) noexcept;
+  Node* node_by_id(NodeId id) noexcept { return id <= kMaxNodeId ? by_id_[id] : nullptr; }
+  void flush(core::TimePoint now) noexcept;
+  void publish_counters() noexcept;
+
+  std::string name_;
+  config::CanopenBusOptions options_;
+  core::Duration cycle_time_;
+  std::unique_ptr<Transport> transport_;
+  std::unique_ptr<CyclePeer> peer_;
+  // Per axis: the device profile's fault texts and EMCY fields (views into the plan, which the
+  // daemon keeps alive as long as the bus), referenced by the EMCY consumer and the masters.
+  struct Tables {
+    std::vector<cia402::FaultText> faults;
+    std::vector<EmcyField> fields;
+  };
+  std::vector<Tables> tables_;
+  std::vector<SdoChannelConfig> sdo_channels_;
+  std::vector<NmtNodeConfig> nmt_nodes_;
+  std::vector<EmcyNodeConfig> emcy_nodes_;
+  SdoClient sdo_;
+  NmtMaster nmt_;
+  EmcyConsumer emcy_;
+  SyncProducer sync_;
+  std::vector<std::unique_ptr<Node>> nodes_;
+  std::array<Node*, 128> by_id_{};
+  TxQueue tx_;
+  std::array<CanFrame, 64> rx_buffer_{};
+  bool open_ = false;
+  ControllerState controller_ = ControllerState::Active;
+  std::uint64_t unexpected_ = 0;
+  std::uint64_t tx_dropped_ = 0;
+
+  // counters() may be called from any thread.
+  std::atomic<std::uint64_t> sent_{0};
+  std::atomic<std::uint64_t> received_{0};
+  std::atomic<std::uint64_t> lost_{0};
+  std::atomic<std::uint64_t> dropped_{0};
+  std::atomic<std::uint64_t> errors_{0};
+};
+
+// A bus for the plan, with its transport (and, for `transport: sim`, its simulated drives).
+std::unique_ptr<CanopenBus> make_canopen_bus(const config::BusPlan& plan);
+
+}  // namespace drivegate::canopen

@@ -1,0 +1,94 @@
+#include "adapters/canopen/master/node_boot.hpp"
+
+#include "profiles/cia402/sdo_abort.hpp"
+
+namespace drivegate::canopen {
+namespace {
+
+bool missing_object(std::uint32_t code) noexcept {
+  return code == sdo_abort_code::kNoObject || code == sdo_abort_code::kNoSubIndex;
+}
+
+std::int64_t sign_extend(std::uint32_t raw, cia402::DataType t) noexcept {
+  switch (t) {
+    case cia402::DataType::I8: return static_cast<std::int8_t>(raw & 0xFF);
+    case cia402::DataType::I16: return static_cast<std::int16_t>(raw & 0xFFFF);
+    case cia402::DataType::I32: return static_cast<std::int32_t>(raw);
+    case cia402::DataType::U8: return raw & 0xFF;
+    case cia402::DataType::U16: return raw & 0xFFFF;
+    case cia402::DataType::U32: return raw;
+  }
+  return raw;
+}
+
+}  // namespace
+
+NodeBoot::NodeBoot(int sdo_channel, std::vector<BootStep> steps) : channel_(sdo_channel), steps_(std::move(steps)) {}
+
+void NodeBoot::start() noexcept {
+  status_ = steps_.empty() ? Status::Done : Status::Running;
+  next_ = 0;
+  request_ = kNoSdoRequest;
+  failure_.assign("");
+}
+
+void NodeBoot::abandon(SdoClient& sdo) noexcept {
+  if (request_ != kNoSdoRequest) sdo.cancel(request_);
+  request_ = kNoSdoRequest;
+  status_ = Status::Idle;
+}
+
+void NodeBoot::fail_abort(const BootStep& s, std::uint32_t code) noexcept {
+  status_ = Status::Failed;
+  const char* verb = s.kind == BootStep::Kind::Write ? "write" : "read";
+  if (s.kind == BootStep::Kind::Write)
+    failure_.format("%s: %s %04Xh:%02X := 0x%llX failed: %s (abort 0x%08X)%s%s", s.stage.c_str(), verb,
+                    s.def.id.index, s.def.id.sub, static_cast<unsigned long long>(s.value) & 0xFFFFFFFFULL,
+                    cia402::sdo_abort_text(code).data(), code, s.why.empty() ? "" : "; ", s.why.c_str());
+  else
+    failure_.format("%s: %s %04Xh:%02X failed: %s (abort 0x%08X)", s.stage.c_str(), verb, s.def.id.index,
+                    s.def.id.sub, cia402::sdo_abort_text(code).data(), code);
+}
+
+NodeBoot::Status NodeBoot::step(SdoClient& sdo) noexcept {
+  if (status_ != Status::Running) return status_;
+  if (next_ >= steps_.size()) return status_ = Status::Done;
+  const BootStep& s = steps_[next_];
+  const auto size = cia402::size_of(s.def.type);
+  if (request_ == kNoSdoRequest) {
+    request_ = s.kind == BootStep::Kind::Write
+                   ? sdo.write(channel_, s.def.id, static_cast<std::uint32_t>(s.value & 0xFFFFFFFF), size)
+                   : sdo.read(channel_, s.def.id, size);
+    return status_;  // queue full: kNoSdoRequest, tried again next step()
+  }
+  const SdoResult r = sdo.result(request_);
+  if (r.status == SdoStatus::Queued || r.status == SdoStatus::InFlight) return status_;
+  sdo.take(request_);
+  request_ = kNoSdoRequest;
+  if (r.status == SdoStatus::Unknown) {  // dropped by a channel reset: try the step again
+    return status_;
+  }
+  if (r.status == SdoStatus::Failed) {
+    if (s.optional && missing_object(r.abort_code)) {
+      ++next_;
+      return status_ = next_ >= steps_.size() ? Status::Done : Status::Running;
+    }
+    fail_abort(s, r.abort_code);
+    return status_;
+  }
+  if (s.kind == BootStep::Kind::Expect) {
+    const auto got = static_cast<std::uint32_t>(sign_extend(r.value, s.def.type) & 0xFFFFFFFF);
+    const auto want = static_cast<std::uint32_t>(s.value & 0xFFFFFFFF);
+    if ((got & s.mask) != (want & s.mask)) {
+      status_ = Status::Failed;
+      failure_.format("%s: %04Xh:%02X reads 0x%08X, expected 0x%08X%s%s%s", s.stage.c_str(), s.def.id.index,
+                      s.def.id.sub, got, want, s.mask != 0xFFFFFFFF ? " (compared under a mask)" : "",
+                      s.why.empty() ? "" : "; ", s.why.c_str());
+      return status_;
+    }
+  }
+  ++next_;
+  return status_ = next_ >= steps_.size() ? Status::Done : Status::Running;
+}
+
+}  // namespace drivegate::canopen

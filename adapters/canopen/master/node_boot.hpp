@@ -1,0 +1,66 @@
+#pragma once
+// The configuration sequence of one node, run over the SDO client while the node is
+// pre-operational: identity check, start-up writes, PDO configuration (written with the
+// disable / clear count / entries / count / enable sequence, or only verified), error control.
+// NMT (pre-operational before, start after) is the bus' business; this sequencer only walks the
+// steps it was given, one SDO transfer at a time, and stops at the first failure with a sentence
+// that names the step, the object and the abort text (issue: "reported with the step, object and
+// abort text"). The bus retries a failed boot with back-off.
+//
+// The step list is built once (construction may allocate); start()/step() do not allocate.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "adapters/canopen/master/sdo_client.hpp"
+#include "core/clock.hpp"
+#include "core/fixed_string.hpp"
+#include "profiles/cia402/objects.hpp"
+
+namespace drivegate::canopen {
+
+struct BootStep {
+  enum class Kind : std::uint8_t {
+    Write,   // write `value`
+    Expect,  // read and compare (value & mask) == (expected & mask)
+  };
+  Kind kind = Kind::Write;
+  cia402::ObjectDef def{};
+  std::int64_t value = 0;        // Write: value; Expect: expected value
+  std::uint32_t mask = 0xFFFFFFFF;
+  bool optional = false;         // a missing object (06020000h / 06090011h) is not an error
+  std::string stage;             // "identity", "start-up write", "RPDO1 mapping", "error control"
+  std::string why;               // shown with a failure ("FBUS.PARAM05: fault reset only via ...")
+};
+
+class NodeBoot {
+ public:
+  enum class Status : std::uint8_t { Idle, Running, Done, Failed };
+
+  NodeBoot(int sdo_channel, std::vector<BootStep> steps);
+
+  // Start (or restart) from the first step.
+  void start() noexcept;
+  // Drive the sequence: submit the next transfer, check the finished one. Returns the status.
+  Status step(SdoClient& sdo) noexcept;
+  // Stop without a verdict (node lost mid-way): the transfer in flight is cancelled.
+  void abandon(SdoClient& sdo) noexcept;
+
+  [[nodiscard]] Status status() const noexcept { return status_; }
+  [[nodiscard]] std::size_t position() const noexcept { return next_; }
+  [[nodiscard]] std::size_t size() const noexcept { return steps_.size(); }
+  [[nodiscard]] const core::FixedString<200>& failure() const noexcept { return failure_; }
+  [[nodiscard]] const std::vector<BootStep>& steps() const noexcept { return steps_; }
+
+ private:
+  void fail_abort(const BootStep& s, std::uint32_t code) noexcept;
+
+  int channel_;
+  std::vector<BootStep> steps_;
+  Status status_ = Status::Idle;
+  std::size_t next_ = 0;
+  SdoRequestId request_ = kNoSdoRequest;
+  core::FixedString<200> failure_;
+};
+
+}  // namespace drivegate::canopen
