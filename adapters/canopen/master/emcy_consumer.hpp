@@ -36,7 +36,10 @@ struct EmcyReport {
   NodeId node = 0;
   Emcy emcy{};
   bool cleared = false;       // "no more errors" (0000h with register 0)
-  core::FixedString<160> text;  // "F702 Fieldbus communication lost (event 52, cause 3)"
+  // "0x7500 communication (event 52, cause 1)": code in hex, its text (vendor table first), then
+  // the named vendor bytes in decimal. A 0000h update that leaves errors pending says so instead
+  // of "no error": "0x0000 error state update, errors pending (register 0x10)".
+  core::FixedString<160> text;
   core::TimePoint time{};
 };
 
@@ -51,19 +54,35 @@ class EmcyConsumer {
  public:
   static constexpr std::size_t kReportCapacity = 64;
 
+  // Throws std::invalid_argument for a node-ID outside 1..127, one registered twice, or a field
+  // outside bytes 3..7.
   explicit EmcyConsumer(std::span<const EmcyNodeConfig> nodes);
 
   // Takes 080h+n frames of any node (returns false for other COB-IDs, including SYNC 080h).
   bool on_frame(const CanFrame& frame, core::TimePoint now) noexcept;
   bool next_report(EmcyReport& out) noexcept;
-  // The last fault EMCY of a node that was not cleared since, if any.
+  // The last fault EMCY of a node that was not cleared since, if any. A 0000h update with errors
+  // pending keeps it (AKD part 1 §9.2 transition 2); with none known yet, the update becomes it.
   [[nodiscard]] const EmcyReport* active(NodeId node) const noexcept;
   void reset(NodeId node) noexcept;  // node rebooted: forget its active fault
 
   [[nodiscard]] const EmcyCounters& counters() const noexcept { return counters_; }
 
  private:
+  struct Node {
+    EmcyNodeConfig config;
+    EmcyReport active;
+    bool has_active = false;
+  };
+
+  void describe(const Node& n, const Emcy& e, bool cleared, EmcyReport& out) const noexcept;
+
   EmcyCounters counters_;
+  std::vector<Node> nodes_;                           // sized in the constructor
+  std::array<std::uint8_t, kMaxNodeId + 1> index_{};  // node-ID -> position in nodes_ + 1 (0: none)
+  std::vector<EmcyReport> reports_;                   // ring of kReportCapacity
+  std::size_t report_head_ = 0;
+  std::size_t report_count_ = 0;
 };
 
 }  // namespace drivegate::canopen

@@ -10,6 +10,14 @@
 // wrong toggle is a miss; `life_time_factor` consecutive misses make the node lost). Watching
 // starts with watch() once the node is configured; before that only boot-ups and states are
 // tracked.
+//
+// A boot-up ends the watch: the node's error-control objects are back at their defaults, so the
+// owner reconfigures the node and calls watch() again (otherwise a heartbeat node would be
+// declared lost in the middle of its own configuration). The state after a boot-up is
+// PreOperational, the state a node enters when it sends 00h [CiA 301 §7.3.2.2]. Heartbeat bytes
+// have bit 7 masked (SD6 digest §6.8: the drive's figure shows a toggle there). A guard reply with
+// the wrong toggle is a miss and resynchronises the expected toggle to the reply's, so that one
+// lost reply costs two misses (its absence and the toggle error after it), not every following one.
 #include <array>
 #include <cstdint>
 #include <span>
@@ -67,9 +75,14 @@ class NmtMaster {
  public:
   static constexpr std::size_t kEventCapacity = 256;
 
+  // Throws std::invalid_argument for a node-ID outside 1..127 or registered twice, or an own
+  // node-ID outside 1..127 with a heartbeat period.
   NmtMaster(NmtMasterConfig config, std::span<const NmtNodeConfig> nodes);
 
-  // Queue an NMT command (node 0 = all nodes). Returns false when the TxQueue is full.
+  // Queue an NMT command (node 0 = all nodes). Returns false when the TxQueue is full or the
+  // node-ID is above 127. Reset Node / Reset Communication restart the expected guard toggle at
+  // 0 for the nodes they address (the responder restarts it even when it sends no boot-up, SD6
+  // quirk 9).
   bool command(NmtCommand cs, NodeId node, TxQueue& tx) noexcept;
 
   // Start / stop supervising a node (heartbeat timeout or guarding RTRs). watch() restarts the
@@ -92,10 +105,38 @@ class NmtMaster {
   [[nodiscard]] const NmtCounters& counters() const noexcept { return counters_; }
 
  private:
+  struct Node {
+    NmtNodeConfig config;
+    NmtState state = NmtState::Unknown;
+    core::TimePoint last_heard{};
+    bool watching = false;
+    bool lost = false;
+    core::TimePoint heartbeat_deadline{};  // Heartbeat: lost when nothing is heard by then
+    core::TimePoint next_rtr{};            // Guarding: next request
+    bool awaiting_reply = false;           // Guarding: an RTR is out and unanswered
+    bool expected_toggle = false;
+    int misses = 0;                        // Guarding: consecutive
+  };
+
+  Node* find(NodeId node) noexcept;
+  [[nodiscard]] const Node* find(NodeId node) const noexcept;
+  void push_event(NmtEventKind kind, const Node& n) noexcept;
+  void on_boot_up(Node& n, core::TimePoint now) noexcept;
+  void on_heartbeat(Node& n, NmtState state, core::TimePoint now) noexcept;
+  void on_guard_reply(Node& n, ErrorControlFrame reply, core::TimePoint now) noexcept;
+  void heard(Node& n, NmtState state, core::TimePoint now) noexcept;
+  void miss(Node& n) noexcept;
+  void poll_guarding(Node& n, core::TimePoint now, TxQueue& tx) noexcept;
+
   NmtMasterConfig config_;
   NmtCounters counters_;
-  // Implementation state (fixed capacity, allocated in the constructor) follows in the .cpp's
-  // private section; the implementation may add members here.
+  std::vector<Node> nodes_;                           // sized in the constructor
+  std::array<std::uint8_t, kMaxNodeId + 1> index_{};  // node-ID -> position in nodes_ + 1 (0: none)
+  std::array<NmtEvent, kEventCapacity> events_{};
+  std::size_t event_head_ = 0;
+  std::size_t event_count_ = 0;
+  bool own_heartbeat_started_ = false;
+  core::TimePoint next_own_heartbeat_{};
 };
 
 // SYNC producer (CiA 301 §7.2.5): COB-ID 080h, DLC 0 (the reference drives use no SYNC counter:
