@@ -6,12 +6,17 @@
 //
 // Channels are registered at construction time (node, channel number, COB-IDs); SD6 channels 2..4
 // use the STÖBER COB-IDs (cob::sdo_rx(channel, node)). Requests carry up to kMaxData bytes, enough
-// for identity strings and EDS-named objects; values of 1..4 bytes are the common case.
+// for identity strings and EDS-named objects; values of 1..4 bytes are the common case. A segmented
+// upload longer than kMaxData is aborted with 05040005h (out of memory) and fails with that code.
 //
 // Timeouts and retries: a request whose server does not answer within `timeout` is sent again from
 // its initiate frame up to `retries` times; then (or on a timeout in the middle of a segmented
-// transfer) the client sends abort 05040000h to the server and fails the request with that code.
-// A toggle error aborts with 05030000h. A server abort fails the request with the server's code.
+// transfer: the server's segment state is unknown then, and a fresh initiate would meet a server
+// still waiting for a segment) the client sends abort 05040000h to the server and fails the
+// request with that code.
+// A toggle error aborts with 05030000h; a segmented upload whose segments do not add up to the size
+// the server announced aborts with 06070012h / 06070013h (too long / too short, like Lely's csdo).
+// A server abort fails the request with the server's code.
 //
 // Unexpected frames (wrong DLC, unknown specifier, a response while idle, a response for another
 // object, a segment with the wrong toggle outside the transfer rules) are counted and dropped.
@@ -59,8 +64,8 @@ struct SdoClientCounters {
   std::uint64_t completed = 0;
   std::uint64_t failed = 0;
   std::uint64_t aborts_received = 0;
-  std::uint64_t timeouts = 0;
-  std::uint64_t retries = 0;
+  std::uint64_t timeouts = 0;   // requests failed with 05040000h (retries exhausted, or mid-segment)
+  std::uint64_t retries = 0;    // initiate frames sent again after a timeout
   std::uint64_t unexpected = 0;  // well-formed but not expected now (dropped)
   std::uint64_t malformed = 0;   // wrong DLC, unknown specifier (dropped)
   std::uint64_t queue_full = 0;  // submit refused
@@ -72,6 +77,9 @@ class SdoClient {
   static constexpr std::size_t kMaxData = 64;        // bytes per request
   static constexpr std::size_t kQueueDepth = 32;     // waiting requests per channel
 
+  // Throws std::invalid_argument for a channel list that cannot work (node outside 1..127, channel
+  // outside 1..4, a derived channel 2..4 COB-ID for a node above 31, COB-IDs that collide) or a
+  // timing without a positive timeout.
   SdoClient(std::span<const SdoChannelConfig> channels, SdoTiming timing);
 
   // Index of the channel for (node, channel number), or -1.
@@ -98,21 +106,78 @@ class SdoClient {
   // transfer in flight is not aborted on the wire.
   void reset_channel(int channel) noexcept;
 
-  // Number of requests queued or in flight on a channel.
+  // Number of requests queued or in flight on a channel (a cancelled transfer still on the wire
+  // counts: the channel is busy until it ends).
   [[nodiscard]] std::size_t pending(int channel) const noexcept;
 
   // Engine interface (adapters/canopen/README.md).
   // True when the frame's COB-ID is one of this client's response COB-IDs (consumed).
   bool on_frame(const CanFrame& frame, core::TimePoint now) noexcept;
   void poll(core::TimePoint now, TxQueue& tx) noexcept;
+  // TimePoint::min() while a frame waits for poll() (a request submitted, a response that asks for
+  // the next segment, an abort), else the earliest timeout, else TimePoint::max().
   [[nodiscard]] core::TimePoint next_deadline() const noexcept;
 
   [[nodiscard]] const SdoClientCounters& counters() const noexcept { return counters_; }
 
  private:
-  struct Impl;  // implementation detail (fixed-size storage, see sdo_client.cpp)
-  // The implementation may replace these members; the public interface above is the contract.
-  std::vector<SdoChannelConfig> channels_;
+  // One request from submit to take(): what to transfer and, once finished, the outcome. Slots
+  // are recycled; `generation` makes a stale id (taken, cancelled, reset) report Unknown.
+  enum class SlotState : std::uint8_t { Free, Queued, InFlight, Cancelled, Done, Failed };
+  enum class Kind : std::uint8_t { Upload, Download };
+  struct Slot {
+    SlotState state = SlotState::Free;
+    Kind kind = Kind::Upload;
+    std::uint16_t generation = 0;
+    ObjectId object{};
+    std::uint8_t expected_size = 0;  // uploads: length of a 42h response (0 = all four bytes)
+    std::uint16_t size = 0;          // downloads: bytes to send; uploads: bytes received
+    std::uint32_t abort_code = 0;
+    std::array<std::uint8_t, kMaxData> data{};
+  };
+  // Where the transfer in flight stands: which response the client waits for.
+  enum class Phase : std::uint8_t { Idle, Initiate, Segment };
+  // Slots per channel: a full FIFO, the transfer in flight and as many finished results waiting
+  // for take(). When they are all in use, submit is refused (counted as queue_full).
+  static constexpr std::size_t kSlotsPerChannel = 2 * kQueueDepth + 1;
+  struct Channel {
+    SdoChannelConfig config{};
+    std::array<Slot, kSlotsPerChannel> slots{};
+    std::array<std::uint8_t, kQueueDepth> fifo{};  // slot numbers, oldest at fifo_head
+    std::size_t fifo_head = 0;
+    std::size_t fifo_size = 0;
+    // The transfer in flight.
+    Phase phase = Phase::Idle;
+    std::uint8_t active = 0;        // slot number, valid when phase != Idle
+    bool toggle = false;            // toggle bit of the segment sent / requested last
+    bool last_sent = false;         // segmented download: the segment sent last had c = 1
+    std::uint16_t offset = 0;       // bytes sent (download) or received (upload) so far
+    std::uint32_t total = 0;        // segmented upload: size the server indicated ...
+    bool total_indicated = false;   // ... if it did (s = 1)
+    int retries_left = 0;
+    core::TimePoint deadline = core::TimePoint::max();
+    bool frame_due = false;         // `frame` is to be sent by the next poll()
+    SdoBytes frame{};
+    bool abort_due = false;         // `abort_frame` is to be sent by the next poll()
+    SdoBytes abort_frame{};
+  };
+
+  SdoRequestId submit(int channel, Kind kind, ObjectId object, std::uint8_t expected_size,
+                      std::span<const std::uint8_t> data) noexcept;
+  [[nodiscard]] const Slot* find(SdoRequestId id) const noexcept;
+  [[nodiscard]] Slot* find(SdoRequestId id) noexcept;
+  void start(Channel& ch, core::TimePoint now, TxQueue& tx) noexcept;
+  [[nodiscard]] static SdoBytes initiate_frame(const Slot& slot) noexcept;
+  void send(Channel& ch, const SdoBytes& bytes, TxQueue& tx) noexcept;
+  void on_response(Channel& ch, const SdoMessage& m) noexcept;
+  void on_upload(Channel& ch, Slot& slot, const SdoMessage& m) noexcept;
+  void on_download(Channel& ch, Slot& slot, const SdoMessage& m) noexcept;
+  void next_download_segment(Channel& ch, const Slot& slot) noexcept;
+  void finish(Channel& ch, Slot& slot, SlotState state, std::uint32_t abort_code) noexcept;
+  void fail_and_abort(Channel& ch, Slot& slot, std::uint32_t abort_code) noexcept;
+
+  std::vector<Channel> channels_;
+  std::array<std::int16_t, kMaxStandardId + 1> by_tx_cob_{};  // response COB-ID -> channel, -1 = none
   SdoTiming timing_;
   SdoClientCounters counters_;
 };
