@@ -13,6 +13,7 @@
 #include <optional>
 #include <span>
 
+#include "adapters/canopen/master/bus_load.hpp"
 #include "adapters/canopen/master/tx_queue.hpp"
 #include "adapters/canopen/wire/can_frame.hpp"
 #include "adapters/canopen/wire/cob_id.hpp"
@@ -50,7 +51,8 @@ class ProcessImage {
  public:
   static constexpr std::size_t kCapacity = 2 * kPdosPerDirection * kMaxPdoEntries;
 
-  // Registers an object (construction phase); false when full. Duplicates are merged.
+  // Registers an object (construction phase); false when full, or when the object is already
+  // registered with another type. Duplicates are merged.
   bool add(cia402::ObjectDef def) noexcept;
   [[nodiscard]] bool contains(cia402::ObjectId id) const noexcept;
   [[nodiscard]] std::int64_t get(cia402::ObjectId id) const noexcept;  // sign-extended per type
@@ -91,13 +93,17 @@ struct PdoCounters {
   std::uint64_t long_frames = 0;   // used, counted
   std::uint64_t missed = 0;        // synchronous TPDO that did not arrive in its cycle
   std::uint64_t tx_full = 0;
+  std::uint64_t ignored = 0;       // on a TPDO COB-ID while not enabled, RTRs, DLC > 8 (dropped)
 };
 
 // The PDOs of one node.
 class NodePdos {
  public:
   // Replace the configuration (construction or after a reboot). Registers every mapped object in
-  // the image. Returns false when the image is full.
+  // the image; objects mapped before and after keep their value. Returns false (and keeps the old
+  // configuration) when the image is full, or for more than kPdosPerDirection PDOs per direction, a
+  // COB-ID that is not an 11-bit id, a transmission type 241..253 (RTR-only TPDOs: no reference
+  // drive answers RTRs, AKD part 1 quirk 7), or an RPDO dlc shorter than its mapping or above 8.
   bool configure(std::span<const RpdoConfig> rpdos, std::span<const TpdoConfig> tpdos) noexcept;
   void enable(bool on, core::TimePoint now) noexcept;  // PDOs flow only while the node is operational
   [[nodiscard]] bool enabled() const noexcept { return enabled_; }
@@ -109,30 +115,53 @@ class NodePdos {
   void after_sync(core::TimePoint now, TxQueue& tx) noexcept;
   // Without SYNC (or between SYNCs): event-driven RPDOs whose data changed or whose timer ran out.
   void poll(core::TimePoint now, TxQueue& tx) noexcept;
-  // A TPDO of this node (returns false for other COB-IDs).
+  // When an event-driven RPDO is due: at once when it was not sent since enable(), else when its
+  // event timer runs out (TimePoint::max() when none is running). Changed data is found by poll()
+  // itself, so the bus polls at least once per cycle anyway.
+  [[nodiscard]] core::TimePoint next_deadline() const noexcept;
+  // A TPDO of this node (returns false for other COB-IDs). `now` is the frame's reception time.
   bool on_frame(const CanFrame& frame, core::TimePoint now) noexcept;
 
-  // True when every synchronous TPDO arrived since the last after_sync() and every event-driven
-  // one within twice its event timer (or at all, when it has none).
+  // False while not enabled. Else true when every synchronous TPDO arrived since the last
+  // after_sync() and every event-driven one within twice its event timer (or at all, when it has
+  // none). A TPDO of type n > 1 counts as arrived in the n - 1 cycles after its frame, when it is
+  // not due; type 0 (sent on SYNC only when the drive's data changed) counts like an event-driven
+  // one without a timer.
   [[nodiscard]] bool inputs_fresh(core::TimePoint now) const noexcept;
   [[nodiscard]] core::TimePoint last_received() const noexcept { return last_rx_; }
+  // Reception time of TPDO `index` (0..tpdo count-1), TimePoint{} before the first one.
+  [[nodiscard]] core::TimePoint last_received(std::size_t index) const noexcept;
 
   [[nodiscard]] const PdoCounters& counters() const noexcept { return counters_; }
 
  private:
+  struct RpdoState {
+    RpdoConfig config;
+    std::array<std::uint8_t, 8> sent{};  // bytes of the last frame sent (change detection)
+    core::TimePoint sent_at{};
+    bool ever_sent = false;
+  };
+  struct TpdoState {
+    TpdoConfig config;
+    core::TimePoint received_at{};
+    bool seen = false;        // a frame arrived since enable()
+    bool due = false;         // synchronous: a frame is expected before the next SYNC
+    bool stale = false;       // synchronous: no frame since the last SYNC at which one was due
+    std::uint8_t countdown = 0;  // synchronous: SYNCs until the next one is due
+  };
+
+  void restart() noexcept;
+  void send_event_driven(core::TimePoint now, TxQueue& tx) noexcept;
+  void send(RpdoState& r, const std::array<std::uint8_t, 8>& bytes, core::TimePoint now, TxQueue& tx) noexcept;
+
   ProcessImage image_;
   bool enabled_ = false;
   core::TimePoint last_rx_{};
   PdoCounters counters_;
-  // The implementation adds its fixed-size per-PDO state here.
-};
-
-// Estimated bus occupation of one SYNC cycle (for --check-config and the benchmarks).
-struct CycleLoad {
-  std::uint32_t frames = 0;
-  std::uint64_t bits = 0;
-  core::Duration time{};
-  double fraction = 0;  // of the cycle time
+  std::array<RpdoState, kPdosPerDirection> rpdos_{};
+  std::array<TpdoState, kPdosPerDirection> tpdos_{};
+  std::size_t rpdo_count_ = 0;
+  std::size_t tpdo_count_ = 0;
 };
 
 }  // namespace drivegate::canopen
