@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "config/canopen_axis.hpp"
 #include "config/text_util.hpp"
 
 namespace drivegate::config {
@@ -223,7 +224,8 @@ ReadAxis read_axis(const MapReader& axis, AxisContext& ctx) {
 
   const std::int64_t lo = bus_type ? bus_type->min_address : 0;
   const std::int64_t hi = bus_type ? bus_type->max_address : std::numeric_limits<std::int32_t>::max();
-  a.address = static_cast<int>(axis.integer("address", Need::Required, lo, hi).value_or(0));
+  a.address = static_cast<int>(
+      axis.integer("address", Need::Required, lo, hi, bus_type ? bus_type->address_words : "an integer").value_or(0));
 
   const DeviceProfile* device = read_device(axis, ctx);
   if (device) {
@@ -259,6 +261,8 @@ ReadAxis read_axis(const MapReader& axis, AxisContext& ctx) {
       axis.error(section, "only allowed for axes on a " + section + " bus; bus is of type " + bus_type->name);
   }
   if (bus_type && bus_type->axis_section == "sim") read_sim(axis.map("sim", Need::Optional), a, scaled);
+  if (bus_type && bus_type->axis_section == "canopen")
+    read_canopen_axis(axis, ctx.buses[*out.bus], device, ctx.base_dir, a);
   return out;
 }
 

@@ -1,6 +1,7 @@
 #pragma once
 // Reading one entry of `axes:` into an AxisPlan, checked against its bus and device profile.
 #include <cstddef>
+#include <filesystem>
 #include <optional>
 #include <vector>
 
@@ -15,6 +16,7 @@ struct AxisContext {
   const std::vector<BusPlan>& buses;
   const BusTypeRegistry& bus_types;
   DeviceCatalog& devices;
+  std::filesystem::path base_dir;  // the config file's directory: relative paths (EDS files) start here
 };
 
 struct ReadAxis {

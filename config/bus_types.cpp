@@ -2,16 +2,18 @@
 
 #include <algorithm>
 
+#include "config/canopen_bus.hpp"
+
 namespace drivegate::config {
 
 BusTypeRegistry BusTypeRegistry::builtin() {
   BusTypeRegistry r;
-  r.add({"sim", true, 1, 127,
-         {{"acyclic_latency_cycles", OptionKind::Integer, 1, 1000, std::int64_t{1},
-           "cycles before a simulated drive answers an acyclic read/write"}},
-         "sim"});
-  // Node-ids 1..127 [CiA 301]; EtherCAT configured station addresses; PROFINET device numbers.
-  r.add({"canopen", false, 1, 127, {}, ""});
+  BusTypeInfo sim{"sim", true, 1, 127, {}, "sim"};
+  sim.options.push_back({"acyclic_latency_cycles", OptionKind::Integer, 1, 1000, std::int64_t{1},
+                         "cycles before a simulated drive answers an acyclic read/write", {}});
+  r.add(std::move(sim));
+  r.add(canopen_bus_type());
+  // EtherCAT configured station addresses; PROFINET device numbers.
   r.add({"ethercat", false, 1, 65535, {}, ""});
   r.add({"profinet", false, 1, 65535, {}, ""});
   return r;

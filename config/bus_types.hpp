@@ -12,15 +12,17 @@
 
 namespace drivegate::config {
 
-enum class OptionKind : std::uint8_t { Integer, Number, Boolean, String, Duration };
+// Choice: a string out of `choices` (stored as that string).
+enum class OptionKind : std::uint8_t { Integer, Number, Boolean, String, Duration, Choice };
 
 struct OptionSpec {
   std::string name;
   OptionKind kind = OptionKind::Integer;
-  double min = 0;  // for Integer and Number
+  double min = 0;  // Integer and Number; Duration: seconds (both 0: any duration > 0 up to 1 h)
   double max = 0;
   OptionValue default_value;
   std::string help;
+  std::vector<std::string> choices;  // Choice only
 };
 
 struct BusTypeInfo {
@@ -30,11 +32,14 @@ struct BusTypeInfo {
   std::int64_t max_address = 127;
   std::vector<OptionSpec> options;
   std::string axis_section;  // per-axis section only axes on this bus type may have ("sim")
+  std::string address_words = "an integer";  // what an address is, for messages ("a CANopen node-ID")
+  core::Duration min_cycle_time = std::chrono::microseconds(100);
+  core::Duration max_cycle_time = std::chrono::seconds(1);
 };
 
 class BusTypeRegistry {
  public:
-  // sim (available), canopen, ethercat, profinet (known, not yet available).
+  // sim and canopen (available), ethercat, profinet (known, not yet available).
   static BusTypeRegistry builtin();
   void add(BusTypeInfo info);  // replaces an entry with the same name
   [[nodiscard]] const BusTypeInfo* find(std::string_view name) const noexcept;

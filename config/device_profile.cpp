@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <set>
 
+#include "config/canopen_profile.hpp"
+#include "config/object_text.hpp"
 #include "config/scalars.hpp"
 #include "config/text_util.hpp"
 #include "config/yaml_reader.hpp"
@@ -13,7 +15,7 @@ namespace fs = std::filesystem;
 
 const std::vector<std::string>& known_quirks() {
   // Behaviours where a reference device departs from plain CiA 402; the digest sections give the
-  // facts (akd-canopen-part2-ds402.md §15, nord-sk500p-ds402.md §14).
+  // facts (akd-canopen-part2-ds402.md §15, nord-sk500p-ds402.md §14, stoeber-sd6-canopen.md quirks).
   static const std::vector<std::string> kQuirks{
       "switched_on_energises_power_stage",  // AKD §15.1: torque already in Switched on
       "fault_reset_needs_bit7_release",     // AKD §15.6: host must clear CW bit 7 after the reset
@@ -24,6 +26,9 @@ const std::vector<std::string>& known_quirks() {
       "homing_objects_not_pdo_mappable",    // AKD §15.15: 6098h/6099h/609Ah/607Ch by SDO only
       "setpoints_only_in_operation_enabled",  // AKD §15.23
       "no_sync_producer",                   // AKD §15.20: the drive cannot produce SYNC
+      "mode_object_always_valid",           // NORD §13 step 6, quirk 18: 6060h in RxPDO1 must always
+                                            // hold a valid mode (0 is reserved), even before enabling
+      "no_transmission_type_255",           // SD6 quirk 3: PDO transmission type 255 is reserved
   };
   return kQuirks;
 }
@@ -36,8 +41,9 @@ namespace {
 
 // The cyclic image must carry what the profile drives every cycle: the controlword and statusword
 // always, and the target object of each cyclic mode the profile offers (without it the mode could
-// not follow set-points and would jump to a stale target when enabled).
-void check_cyclic_image(const DeviceProfile& p, const MapReader& root) {
+// not follow set-points and would jump to a stale target when enabled). When the image was derived
+// from the canopen PDO maps, the maps are what is missing the object.
+void check_cyclic_image(const DeviceProfile& p, const MapReader& root, bool derived) {
   struct Need {
     std::optional<core::Mode> mode;  // nullopt: needed whatever the modes
     cia402::ObjectId object;
@@ -55,28 +61,16 @@ void check_cyclic_image(const DeviceProfile& p, const MapReader& root) {
     if (n.mode && !p.modes.contains(*n.mode)) continue;
     bool found = false;
     for (const auto& id : p.cyclic_objects) found = found || id == n.object;
-    if (!found) root.error("cyclic_objects", std::string("must include ") + n.what);
+    if (!found && derived)
+      root.error("canopen", std::string("the PDO maps (the cyclic image) must include ") + n.what);
+    else if (!found)
+      root.error("cyclic_objects", std::string("must include ") + n.what);
   }
 }
 
-const std::vector<std::string> kProfileKeys{"name", "vendor", "description", "identity", "modes", "units",
-                                            "homing_methods", "fault_texts", "quirks", "cyclic_objects"};
-
-// "0x6040" or "0x6099:1" (index hex with 0x, sub-index decimal or 0x hex).
-std::optional<cia402::ObjectId> parse_object_id(std::string_view text) {
-  const auto colon = text.find(':');
-  const std::string_view index_text = text.substr(0, colon);
-  if (!index_text.starts_with("0x") && !index_text.starts_with("0X")) return std::nullopt;
-  const auto index = parse_integer(index_text);
-  if (!index || *index < 0 || *index > 0xFFFF) return std::nullopt;
-  std::int64_t sub = 0;
-  if (colon != std::string_view::npos) {
-    const auto s = parse_integer(text.substr(colon + 1));
-    if (!s || *s < 0 || *s > 0xFF) return std::nullopt;
-    sub = *s;
-  }
-  return cia402::ObjectId{static_cast<std::uint16_t>(*index), static_cast<std::uint8_t>(sub)};
-}
+const std::vector<std::string> kProfileKeys{"name",           "vendor",      "description", "identity",
+                                            "modes",          "units",       "homing_methods", "fault_texts",
+                                            "quirks",         "cyclic_objects", "canopen"};
 
 void read_units(const MapReader& units, NativeUnitsSpec& out) {
   units.check_keys({"position", "velocity", "acceleration", "torque"});
@@ -200,7 +194,9 @@ void read_profile(const MapReader& root, const fs::path& file, DeviceProfile& p)
         p.cyclic_objects.push_back(*id);
     }
   }
-  check_cyclic_image(p, root);
+  const bool cyclic_given = root.has("cyclic_objects");
+  read_canopen_device(root, p, cyclic_given);
+  check_cyclic_image(p, root, !cyclic_given && !p.cyclic_objects.empty());
 }
 
 }  // namespace

@@ -1,10 +1,12 @@
 #include "config/loader.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <thread>
 
 #include "config/axis_reader.hpp"
+#include "config/canopen_bus.hpp"
 #include "config/text_util.hpp"
 #include "config/yaml_reader.hpp"
 
@@ -69,8 +71,16 @@ void read_options(const MapReader& m, const BusTypeInfo& type, BusPlan& bus) {
       case OptionKind::String:
         if (const auto s = m.string(o.name, Need::Optional)) v = *s;
         break;
-      case OptionKind::Duration:
-        if (const auto d = m.duration(o.name, Need::Optional, 0ns, std::chrono::hours(1))) v = *d;
+      case OptionKind::Duration: {
+        const auto seconds = [](double s) { return core::Duration{std::llround(s * 1e9)}; };
+        const bool ranged = o.min > 0 || o.max > 0;
+        if (const auto d = m.duration(o.name, Need::Optional, ranged ? seconds(o.min) : 0ns,
+                                      ranged ? seconds(o.max) : std::chrono::hours(1)))
+          v = *d;
+        break;
+      }
+      case OptionKind::Choice:
+        if (const auto c = m.choice(o.name, Need::Optional, o.choices)) v = *c;
         break;
     }
     bus.options[o.name] = v;
@@ -96,7 +106,10 @@ void read_bus(const MapReader& b, const BusTypeRegistry& registry, BusPlan& bus)
       bus.type = *t;
     }
   }
-  bus.cycle_time = b.duration("cycle_time", Need::Required, 100us, 1s).value_or(bus.cycle_time);
+  // Each bus type bounds its cycle (canopen: the SYNC period); unknown types get the widest range.
+  bus.cycle_time = b.duration("cycle_time", Need::Required, type ? type->min_cycle_time : 100us,
+                              type ? type->max_cycle_time : 1s)
+                       .value_or(bus.cycle_time);
   if (const auto p = b.integer("priority", Need::Optional, 0, 99)) bus.priority = static_cast<int>(*p);
   // CPU_SETSIZE is 1024 on Linux; whether the CPU exists is only known on the target machine.
   if (const auto c = b.integer("cpu", Need::Optional, -1, 1023)) {
@@ -106,17 +119,22 @@ void read_bus(const MapReader& b, const BusTypeRegistry& registry, BusPlan& bus)
       b.source().warning(b.mark_of("cpu"), b.field("cpu"),
                          "this machine has " + std::to_string(cpus) + " CPUs (0.." + std::to_string(cpus - 1) + ")");
   }
-  if (type) read_options(b.map("options", Need::Optional), *type, bus);
+  if (!type) return;
+  const MapReader options = b.map("options", Need::Optional);
+  read_options(options, *type, bus);
+  if (type->name == "canopen") read_canopen_bus(b, options, bus);
 }
 
 struct Seen {
   std::string what;
-  std::map<std::string, std::string> first;  // key -> field path of the first occurrence
-  // Reports `key` when it was seen before; returns true when it is new.
-  bool check(const std::string& key, const MapReader& m, std::string_view field, const std::string& label) {
+  std::map<std::string, std::string> first;  // key -> field path of the first occurrence (and its owner)
+  // Reports `key` when it was seen before; returns true when it is new. `owner` names who uses it
+  // ("axis \"x\""), so the message can name both users.
+  bool check(const std::string& key, const MapReader& m, std::string_view field, const std::string& label,
+             const std::string& owner = {}) {
     if (key.empty()) return true;
-    const auto [it, added] = first.emplace(key, m.field(field));
-    if (!added) m.error(field, what + " " + label + " is already used by " + it->second);
+    const auto [it, added] = first.emplace(key, m.field(field) + (owner.empty() ? "" : " (" + owner + ")"));
+    if (!added) m.error(field, (owner.empty() ? "" : owner + ": ") + what + " " + label + " is already used by " + it->second);
     return added;
   }
 };
@@ -152,9 +170,10 @@ Plan compile(const std::string& text, const std::string& file, const LoadOptions
   std::vector<fs::path> dirs(plan.gateway.device_dirs.begin(), plan.gateway.device_dirs.end());
   dirs.insert(dirs.end(), options.device_dirs.begin(), options.device_dirs.end());
   DeviceCatalog devices{dirs};
-  AxisContext ctx{plan.buses, options.bus_types, devices};
+  AxisContext ctx{plan.buses, options.bus_types, devices, base_dir};
   Seen axis_names{"axis name", {}};
-  std::vector<Seen> addresses(plan.buses.size(), Seen{"address", {}});
+  std::vector<Seen> addresses;
+  for (const auto& bus : plan.buses) addresses.push_back(Seen{bus.type == "canopen" ? "node-ID" : "address", {}});
   std::vector<std::pair<std::size_t, AxisPlan>> axes;
   if (const auto list = root.list("axes", Need::Optional)) {
     for (std::size_t i = 0; i < list->size(); ++i) {
@@ -163,9 +182,14 @@ Plan compile(const std::string& text, const std::string& file, const LoadOptions
       ReadAxis axis = read_axis(a, ctx);
       axis_names.check(axis.plan.spec.name, a, "name", "\"" + axis.plan.spec.name + "\"");
       if (!axis.bus) continue;
-      if (axis.plan.address != 0)
+      if (axis.plan.address != 0) {
+        const BusPlan& bus = plan.buses[*axis.bus];
+        // Two drives on one CANopen node-ID answer each other's SDOs and PDOs: name both axes.
+        const bool canopen = bus.type == "canopen";
         addresses[*axis.bus].check(std::to_string(axis.plan.address), a, "address",
-                                   std::to_string(axis.plan.address) + " on bus \"" + plan.buses[*axis.bus].name + "\"");
+                                   std::to_string(axis.plan.address) + " on bus \"" + bus.name + "\"",
+                                   canopen ? "axis \"" + axis.plan.spec.name + "\"" : std::string{});
+      }
       axes.emplace_back(*axis.bus, std::move(axis.plan));
     }
   }

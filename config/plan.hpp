@@ -11,6 +11,7 @@
 #include "core/axis_spec.hpp"
 #include "core/axis_types.hpp"
 #include "core/clock.hpp"
+#include "config/eds.hpp"
 #include "core/units.hpp"
 #include "profiles/cia402/objects.hpp"
 
@@ -67,6 +68,12 @@ struct PdoSpec {
   int event_timer_ms = 0;             // TPDO only; 0 = none
   int dlc = 0;                        // RPDO frame length to send; 0 = the mapped length (NORD pads
                                       // RxPDO1 to 8 bytes: nord-sk500p-ds402.md §8.1)
+  [[nodiscard]] int mapped_bytes() const noexcept {
+    int bytes = 0;
+    for (const auto& e : entries) bytes += e.bits / 8;
+    return bytes;
+  }
+  [[nodiscard]] bool synchronous() const noexcept { return transmission_type <= 240; }
 };
 
 enum class PdoPolicy : std::uint8_t {
@@ -118,7 +125,11 @@ struct CanopenDeviceSpec {
   bool emcy_zero_needs_clear_register = true;  // EMCY 0000h means "no more errors" only with register 0
   std::optional<ParameterNaming> parameter_naming;
   int sdo_channels = 1;                 // SDO server channels (SD6: 4, channels 2..4 need node-ID <= 31)
-  std::string persona;                  // simulator persona for this drive (akd, nord-sk500p, stoeber-sd6, generic)
+  std::string persona = "generic";      // simulator persona for this drive (akd, nord-sk500p, stoeber-sd6, generic)
+  int fixed_mapping_count = 0;          // PDO mapping sub 0 reads this constant and at most this many
+                                        // entries fit (SD6: 6, stoeber-sd6-canopen.md quirks 4, 5); 0 = none
+  std::vector<core::Duration> sync_periods;  // SYNC periods the drive supports; empty = any (SD6 A150: 1, 2,
+                                             // 4, 8 ms, stoeber-sd6-canopen.md §7)
 };
 
 struct DeviceProfile {
@@ -156,6 +167,7 @@ struct CanopenAxisOptions {
   std::string eds;  // EDS file (made absolute); objects and mappings are checked against it
   int sdo_channel = 1;  // SDO server channel the gateway uses (1..device sdo_channels)
   std::vector<StartupWrite> startup_writes;  // after the device profile's
+  std::vector<EdsObject> eds_objects;  // the EDS' objects (empty without an EDS); see find_eds_object()
 };
 
 struct AxisPlan {

@@ -68,11 +68,11 @@ std::optional<double> read_number(const YAML::Node& n, const std::string& path, 
 }
 
 std::optional<std::int64_t> read_integer(const YAML::Node& n, const std::string& path, const Source& src,
-                                         std::int64_t lo, std::int64_t hi) {
+                                         std::int64_t lo, std::int64_t hi, std::string_view words) {
   const auto v = n.IsScalar() && !is_quoted(n) ? parse_integer(n.Scalar()) : std::nullopt;
   if (!v || *v < lo || *v > hi) {
     src.error(n.Mark(), path,
-              "must be an integer in " + std::to_string(lo) + ".." + std::to_string(hi) + got(n));
+              "must be " + std::string{words} + " in " + std::to_string(lo) + ".." + std::to_string(hi) + got(n));
     return std::nullopt;
   }
   return v;
@@ -225,11 +225,11 @@ std::optional<double> MapReader::number(std::string_view key, Need need, const N
   return read_number(n, field(key), src_, rule);
 }
 
-std::optional<std::int64_t> MapReader::integer(std::string_view key, Need need, std::int64_t lo,
-                                               std::int64_t hi) const {
+std::optional<std::int64_t> MapReader::integer(std::string_view key, Need need, std::int64_t lo, std::int64_t hi,
+                                               std::string_view words) const {
   const YAML::Node n = value(key, need);
   if (!n.IsDefined()) return std::nullopt;
-  return read_integer(n, field(key), src_, lo, hi);
+  return read_integer(n, field(key), src_, lo, hi, words);
 }
 
 std::optional<core::Duration> MapReader::duration(std::string_view key, Need need, core::Duration min,

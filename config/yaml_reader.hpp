@@ -47,8 +47,9 @@ std::string describe_value(const YAML::Node& node);
 // Readers for single values (also used for list elements). `path` names the value.
 std::optional<double> read_number(const YAML::Node& n, const std::string& path, const Source& src,
                                   const NumberRule& rule);
+// `words` names what the integer is in messages: "must be a CANopen node-ID in 1..127, got ...".
 std::optional<std::int64_t> read_integer(const YAML::Node& n, const std::string& path, const Source& src,
-                                         std::int64_t lo, std::int64_t hi);
+                                         std::int64_t lo, std::int64_t hi, std::string_view words = "an integer");
 std::optional<std::string> read_string(const YAML::Node& n, const std::string& path, const Source& src);
 
 // The whole content of a file; an unreadable file is reported (without position) and gives nullopt.
@@ -93,7 +94,8 @@ class MapReader {
   std::optional<std::string> name(std::string_view key, Need need, bool allow_punct = true) const;
   std::optional<std::string> choice(std::string_view key, Need need, std::span<const std::string> options) const;
   std::optional<double> number(std::string_view key, Need need, const NumberRule& rule) const;
-  std::optional<std::int64_t> integer(std::string_view key, Need need, std::int64_t lo, std::int64_t hi) const;
+  std::optional<std::int64_t> integer(std::string_view key, Need need, std::int64_t lo, std::int64_t hi,
+                                      std::string_view words = "an integer") const;
   // Durations in min..max; a zero `min` means strictly positive.
   std::optional<core::Duration> duration(std::string_view key, Need need, core::Duration min,
                                          core::Duration max) const;

@@ -127,7 +127,7 @@ axes:
   - { name: x, bus: sim0, address: 1, device: sim-servoo }
 )");
   EXPECT_REPORTED(e, "t.yaml:5:47: axes[0].device: unknown device profile \"sim-servoo\", did you mean \"sim-servo\"?");
-  EXPECT_REPORTED(e, "available: generic-cia402, pp-only, sim-servo;");
+  EXPECT_REPORTED(e, "available: generic-cia402, kollmorgen-akd, nord-sk500p, pp-only, sim-servo, stoeber-sd6;");
 }
 
 TEST(LoadErrors, NoDeviceProfileInTheSearchPath) {
@@ -250,17 +250,15 @@ TEST(LoadErrors, BusTypes) {
   const std::string e = errors_of(R"(gateway: { name: g }
 buses:
   - { name: a, type: simm, cycle_time: 1ms }
-  - { name: b, type: canopen, cycle_time: 1ms }
+  - { name: b, type: ethercat, cycle_time: 1ms }
   - { name: c, type: sim, cycle_time: 1ms, options: { latency: 2 } }
 )");
-  EXPECT_REPORTED(e, "t.yaml:3:22: buses[0].type: unknown bus type \"simm\", did you mean \"sim\"? (available: sim)");
-  EXPECT_REPORTED(e, "t.yaml:4:22: buses[1].type: bus type \"canopen\" has no adapter in this build (available: sim)");
+  EXPECT_REPORTED(e, "t.yaml:3:22: buses[0].type: unknown bus type \"simm\", did you mean \"sim\"? (available: sim, canopen)");
+  EXPECT_REPORTED(e, "t.yaml:4:22: buses[1].type: bus type \"ethercat\" has no adapter in this build (available: sim, canopen)");
   EXPECT_REPORTED(e, "t.yaml:5:55: buses[2].options.latency: unknown field (allowed: acyclic_latency_cycles)");
 }
 
 TEST(LoadErrors, SimSectionOnlyOnSimBuses) {
-  LoadOptions o = test_options();
-  o.bus_types.add({"canopen", true, 1, 127, {}, ""});  // as the CANopen adapter will
   const std::string e = errors_of(R"(gateway: { name: g }
 buses:
   - { name: can0, type: canopen, cycle_time: 1ms }
@@ -268,11 +266,11 @@ axes:
   - name: x
     bus: can0
     address: 5
-    device: pp-only
+    device: generic-cia402
+    mechanics: { encoder_counts_per_rev: 4096 }
     sim: { home_switch: 3 }
-)",
-                                  o);
-  EXPECT_REPORTED(e, "t.yaml:9:10: axes[0].sim: only allowed for axes on a sim bus; bus is of type canopen");
+)");
+  EXPECT_REPORTED(e, "t.yaml:10:10: axes[0].sim: only allowed for axes on a sim bus; bus is of type canopen");
 }
 
 TEST(LoadErrors, SimSectionRanges) {

@@ -1,0 +1,23 @@
+#pragma once
+// The `canopen:` section of a device profile (schema in profiles/devices/README.md) and the
+// start-up write lists that both profiles and axes carry.
+#include <optional>
+#include <string_view>
+#include <vector>
+
+#include "config/plan.hpp"
+#include "config/yaml_reader.hpp"
+
+namespace drivegate::config {
+
+// Reads the `canopen:` map of the profile `root` (if any) into `p.canopen`. Needs p.quirks already
+// read. When the section maps PDOs, p.cyclic_objects must list the same objects (if the profile
+// gave them: `cyclic_given`) or is derived from the maps.
+void read_canopen_device(const MapReader& root, DeviceProfile& p, bool cyclic_given);
+
+// A `startup_writes:` list under `parent` (absent: nothing). Objects are "0x6046:1" or, with
+// `naming`, manufacturer parameter names ("A83").
+void read_startup_writes(const MapReader& parent, std::string_view key, const std::optional<ParameterNaming>& naming,
+                         std::vector<StartupWrite>& out);
+
+}  // namespace drivegate::config

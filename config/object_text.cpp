@@ -1,0 +1,119 @@
+#include "config/object_text.hpp"
+
+#include <array>
+#include <cstdio>
+
+#include "config/scalars.hpp"
+
+namespace drivegate::config {
+
+std::optional<cia402::ObjectId> parse_object_id(std::string_view text) {
+  const auto colon = text.find(':');
+  const std::string_view index_text = text.substr(0, colon);
+  if (!index_text.starts_with("0x") && !index_text.starts_with("0X")) return std::nullopt;
+  const auto index = parse_integer(index_text);
+  if (!index || *index < 0 || *index > 0xFFFF) return std::nullopt;
+  std::int64_t sub = 0;
+  if (colon != std::string_view::npos) {
+    const auto s = parse_integer(text.substr(colon + 1));
+    if (!s || *s < 0 || *s > 0xFF) return std::nullopt;
+    sub = *s;
+  }
+  return cia402::ObjectId{static_cast<std::uint16_t>(*index), static_cast<std::uint8_t>(sub)};
+}
+
+namespace {
+constexpr std::array<std::pair<std::string_view, cia402::DataType>, 6> kTypes{{
+    {"i8", cia402::DataType::I8},
+    {"u8", cia402::DataType::U8},
+    {"i16", cia402::DataType::I16},
+    {"u16", cia402::DataType::U16},
+    {"i32", cia402::DataType::I32},
+    {"u32", cia402::DataType::U32},
+}};
+
+// Every object of profiles/cia402/objects.hpp: their types are the CiA 402 ones.
+constexpr std::array kKnown{
+    cia402::obj::kErrorRegister,           cia402::obj::kErrorCode,
+    cia402::obj::kControlword,             cia402::obj::kStatusword,
+    cia402::obj::kVlTargetVelocity,        cia402::obj::kVlVelocityDemand,
+    cia402::obj::kVlVelocityActual,        cia402::obj::kVlAccelerationDeltaSpeed,
+    cia402::obj::kVlAccelerationDeltaTime, cia402::obj::kVlDecelerationDeltaSpeed,
+    cia402::obj::kVlDecelerationDeltaTime, cia402::obj::kQuickStopOption,
+    cia402::obj::kShutdownOption,          cia402::obj::kDisableOperationOption,
+    cia402::obj::kHaltOption,              cia402::obj::kFaultReactionOption,
+    cia402::obj::kModesOfOperation,        cia402::obj::kModesOfOperationDisplay,
+    cia402::obj::kPositionDemand,          cia402::obj::kPositionActual,
+    cia402::obj::kFollowingErrorWindow,    cia402::obj::kFollowingErrorTimeout,
+    cia402::obj::kPositionWindow,          cia402::obj::kPositionWindowTime,
+    cia402::obj::kVelocityActual,          cia402::obj::kVelocityWindow,
+    cia402::obj::kVelocityWindowTime,      cia402::obj::kTargetTorque,
+    cia402::obj::kMaxTorque,               cia402::obj::kTorqueActual,
+    cia402::obj::kTargetPosition,          cia402::obj::kHomeOffset,
+    cia402::obj::kSoftwareLimitMin,        cia402::obj::kSoftwareLimitMax,
+    cia402::obj::kMaxProfileVelocity,      cia402::obj::kProfileVelocity,
+    cia402::obj::kProfileAcceleration,     cia402::obj::kProfileDeceleration,
+    cia402::obj::kQuickStopDeceleration,   cia402::obj::kTorqueSlope,
+    cia402::obj::kHomingMethod,            cia402::obj::kHomingSpeedSwitch,
+    cia402::obj::kHomingSpeedZero,         cia402::obj::kHomingAcceleration,
+    cia402::obj::kIpDataRecord,            cia402::obj::kIpTimePeriodUnits,
+    cia402::obj::kIpTimePeriodIndex,       cia402::obj::kVelocityOffset,
+    cia402::obj::kTorqueOffset,            cia402::obj::kDigitalInputs,
+    cia402::obj::kTargetVelocity,          cia402::obj::kSupportedDriveModes,
+};
+}  // namespace
+
+std::optional<cia402::DataType> parse_data_type(std::string_view text) {
+  for (const auto& [name, type] : kTypes)
+    if (name == text) return type;
+  return std::nullopt;
+}
+
+const std::vector<std::string>& data_type_names() {
+  static const std::vector<std::string> kNames{"i8", "u8", "i16", "u16", "i32", "u32"};
+  return kNames;
+}
+
+std::string_view to_string(cia402::DataType type) noexcept {
+  for (const auto& [name, t] : kTypes)
+    if (t == type) return name;
+  return "?";
+}
+
+std::string object_text(cia402::ObjectId id) {
+  char buf[16];
+  if (id.sub == 0)
+    std::snprintf(buf, sizeof buf, "%04Xh", id.index);
+  else
+    std::snprintf(buf, sizeof buf, "%04Xh:%u", id.index, static_cast<unsigned>(id.sub));
+  return buf;
+}
+
+std::optional<cia402::DataType> known_object_type(cia402::ObjectId id) noexcept {
+  for (const auto& def : kKnown)
+    if (def.id == id) return def.type;
+  return std::nullopt;
+}
+
+std::int64_t type_min(cia402::DataType type) noexcept {
+  switch (type) {
+    case cia402::DataType::I8: return -128;
+    case cia402::DataType::I16: return -32768;
+    case cia402::DataType::I32: return -2147483648LL;
+    default: return 0;
+  }
+}
+
+std::int64_t type_max(cia402::DataType type) noexcept {
+  switch (type) {
+    case cia402::DataType::I8: return 127;
+    case cia402::DataType::U8: return 255;
+    case cia402::DataType::I16: return 32767;
+    case cia402::DataType::U16: return 65535;
+    case cia402::DataType::I32: return 2147483647LL;
+    case cia402::DataType::U32: return 4294967295LL;
+  }
+  return 0;
+}
+
+}  // namespace drivegate::config
