@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "config/canopen_bus.hpp"
+#include "config/canopen_load.hpp"
 #include "config/object_text.hpp"
 #include "config/scalars.hpp"
 #include "config/text_util.hpp"
@@ -193,6 +194,7 @@ std::string describe_plan(const Plan& plan) {
       bp.row("CAN", link + ", " + std::to_string(c.bitrate / 1000) + " kbit/s, gateway node-ID " +
                         std::to_string(c.gateway_node_id));
       bp.row("SYNC", c.sync ? "every " + format_duration(b.cycle_time) : std::string{"off"});
+      if (!b.axes.empty()) bp.row("load", describe_canopen_load(b, canopen_cycle_load(b)));
     }
     bp.row("axes", std::to_string(b.axes.size()));
     for (const auto& a : b.axes) describe_axis(out, a, b);

@@ -7,6 +7,7 @@
 
 #include "config/axis_reader.hpp"
 #include "config/canopen_bus.hpp"
+#include "config/canopen_load.hpp"
 #include "config/text_util.hpp"
 #include "config/yaml_reader.hpp"
 
@@ -139,6 +140,23 @@ struct Seen {
   }
 };
 
+// What the bus sends per SYNC cycle must fit on the wire at its bit rate, with room to spare for
+// SDO, EMCY and retries (estimate: adapters/canopen/wire/bus_load.hpp, worst-case stuffing).
+void check_canopen_load(const BusPlan& bus, const Source& src, const YAML::Mark& mark, const std::string& path) {
+  if (bus.axes.empty()) return;
+  const canopen::CycleLoad load = canopen_cycle_load(bus);
+  const std::string what = "bus load " + describe_canopen_load(bus, load);
+  if (load.fraction > 1.0)
+    src.error(mark, path, what + ": it cannot fit; lengthen cycle_time, raise the bit rate or map fewer PDOs");
+  else if (load.fraction > kCanopenLoadWarning)
+    src.warning(mark, path, what + ": little room is left for SDO transfers, EMCYs and retries");
+  if (load.unbounded > 0)
+    src.warning(mark, path,
+                std::to_string(load.unbounded) +
+                    " event-driven TPDO(s) without an inhibit time: their rate is bounded only by how often the "
+                    "drive's data changes; give them an inhibit_time_100us");
+}
+
 Plan compile(const std::string& text, const std::string& file, const LoadOptions& options) {
   Problems problems;
   const Source src{file, &problems};
@@ -194,10 +212,12 @@ Plan compile(const std::string& text, const std::string& file, const LoadOptions
     }
   }
   for (auto& [bus, axis] : axes) plan.buses[bus].axes.push_back(std::move(axis));
-  for (std::size_t i = 0; i < plan.buses.size(); ++i)
+  for (std::size_t i = 0; i < plan.buses.size(); ++i) {
     if (plan.buses[i].axes.empty() && !plan.buses[i].name.empty())
       src.warning(bus_marks[i], indexed("buses", i),
                   "bus \"" + plan.buses[i].name + "\" has no axes; it will run its cycle with nothing on it");
+    if (plan.buses[i].type == "canopen") check_canopen_load(plan.buses[i], src, bus_marks[i], indexed("buses", i));
+  }
 
   problems.throw_if_errors();
   for (const auto& w : problems.warnings()) plan.warnings.push_back(w.to_string());

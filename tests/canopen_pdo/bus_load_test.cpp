@@ -2,7 +2,7 @@
 // stuffing (wire/bit_timing.hpp): DLC 0 = 55 bits, 1 = 65, 6 = 115, 7 = 125, 8 = 135; an RTR = 55.
 #include <gtest/gtest.h>
 
-#include "adapters/canopen/master/bus_load.hpp"
+#include "adapters/canopen/wire/bus_load.hpp"
 #include "adapters/canopen/master/pdo.hpp"  // CycleLoad reaches the engines' users through pdo.hpp too
 
 namespace drivegate::canopen {

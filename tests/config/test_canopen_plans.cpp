@@ -20,7 +20,7 @@ const std::string kValid = R"(gateway: { name: cell }
 buses:
   - name: can0
     type: canopen
-    cycle_time: 2ms
+    cycle_time: 4ms
     options:
       transport: udp-multicast
       interface: 127.0.0.1
@@ -69,7 +69,7 @@ TEST(CanopenPlans, BusOptionsAreTyped) {
   ASSERT_EQ(plan.buses.size(), 1U);
   const BusPlan& b = plan.buses[0];
   EXPECT_EQ(b.type, "canopen");
-  EXPECT_EQ(b.cycle_time, core::Duration{2ms});
+  EXPECT_EQ(b.cycle_time, core::Duration{4ms});
   const CanopenBusOptions& c = b.canopen;
   EXPECT_EQ(c.transport, CanTransportKind::UdpMulticast);
   EXPECT_EQ(c.interface, "127.0.0.1");
@@ -94,7 +94,7 @@ TEST(CanopenPlans, BusOptionsAreTyped) {
 
 TEST(CanopenPlans, DefaultsOfEveryOption) {
   const Plan plan = load_plan_from_string(R"(gateway: { name: g }
-buses: [{ name: can0, type: canopen, cycle_time: 1ms }]
+buses: [{ name: can0, type: canopen, cycle_time: 4ms }]
 axes: [{ name: x, bus: can0, address: 1, device: kollmorgen-akd }]
 )",
                                           "d.yaml", test_options());
@@ -119,7 +119,7 @@ axes: [{ name: x, bus: can0, address: 1, device: kollmorgen-akd }]
   // No encoder resolution needed: the AKD profile fixes 2^20 position units per motor rev.
   EXPECT_DOUBLE_EQ(x.spec.units.position_factor(), 1048576.0);
   const Plan udp = load_plan_from_string(R"(gateway: { name: g }
-buses: [{ name: can0, type: canopen, cycle_time: 1ms, options: { transport: udp-multicast } }]
+buses: [{ name: can0, type: canopen, cycle_time: 4ms, options: { transport: udp-multicast } }]
 )",
                                          "d.yaml", test_options());
   EXPECT_EQ(udp.buses[0].canopen.interface, "0.0.0.0");  // any local address
@@ -165,7 +165,10 @@ TEST(CanopenPlans, CheckConfigShowsTheCanopenPlan) {
   EXPECT_NE(text.find("transport=udp-multicast"), std::string::npos) << text;
   EXPECT_NE(text.find("CAN:             udp-multicast 239.1.2.3:40000 from 127.0.0.1, 1000 kbit/s, gateway node-ID 100"),
             std::string::npos) << text;
-  EXPECT_NE(text.find("SYNC:            every 2ms"), std::string::npos) << text;
+  EXPECT_NE(text.find("SYNC:            every 4ms"), std::string::npos) << text;
+  // 3 axes (AKD, NORD, SD6) at 1 Mbit/s: the estimate with worst-case stuffing.
+  EXPECT_NE(text.find("load:            21 frames, 2311 bits = 2.31 ms per 4 ms SYNC cycle at 1000 kbit/s (58 %)"),
+            std::string::npos) << text;
   EXPECT_NE(text.find("node-ID:               5"), std::string::npos) << text;
   EXPECT_NE(text.find("RPDO 1:                sync (type 1): 6040h u16, 6060h i8, 6071h i16 (5 bytes)"),
             std::string::npos) << text;
@@ -186,9 +189,25 @@ TEST(CanopenPlans, CheckConfigShowsTheCanopenPlan) {
   EXPECT_NE(text.find("akd-canopen.eds ("), std::string::npos) << text;
 }
 
+// A plan whose cyclic traffic does not fit in its SYNC cycle is refused; one that nearly fills it
+// gets a warning.
+TEST(CanopenPlanErrors, BusLoadMustFitTheCycle) {
+  std::string yaml = kValid;
+  yaml.replace(yaml.find("cycle_time: 4ms"), 15, "cycle_time: 2ms");
+  EXPECT_REPORTED(errors_of(yaml, test_options(), kLabel), "plan.yaml:3:5: buses[0]: bus load 19 frames, 2101 bits = 2.1 ms per 2 ms SYNC "
+                                        "cycle at 1000 kbit/s (105 %): it cannot fit; lengthen cycle_time, raise the "
+                                        "bit rate or map fewer PDOs");
+  yaml.replace(yaml.find("cycle_time: 2ms"), 15, "cycle_time: 4ms");
+  yaml.replace(yaml.find("bitrate: 1000000"), 16, "bitrate: 800000");  // 2311 bits = 2.89 ms: 72 %
+  const Plan plan = load_plan_from_string(yaml, kLabel, test_options());
+  bool warned = false;
+  for (const auto& w : plan.warnings) warned = warned || w.find("little room is left") != std::string::npos;
+  EXPECT_TRUE(warned);
+}
+
 TEST(CanopenPlans, SimTransportShowsThePersonas) {
   const Plan plan = load_plan_from_string(R"(gateway: { name: g }
-buses: [{ name: can0, type: canopen, cycle_time: 1ms, options: { transport: sim } }]
+buses: [{ name: can0, type: canopen, cycle_time: 4ms, options: { transport: sim } }]
 axes:
   - { name: x, bus: can0, address: 1, device: kollmorgen-akd }
   - { name: y, bus: can0, address: 2, device: generic-cia402, mechanics: { encoder_counts_per_rev: 4096 } }
@@ -202,14 +221,14 @@ axes:
 
 // A canopen bus (line 3) and one axis whose lines start at 5; tests append axis lines from line 9.
 std::string one_axis(const std::string& options, const std::string& device, int node, const std::string& extra = "") {
-  return "gateway: { name: g }\nbuses:\n  - { name: can0, type: canopen, cycle_time: 2ms, options: { " + options +
+  return "gateway: { name: g }\nbuses:\n  - { name: can0, type: canopen, cycle_time: 4ms, options: { " + options +
          " } }\naxes:\n  - name: x\n    bus: can0\n    address: " + std::to_string(node) + "\n    device: " + device +
          "\n" + extra;
 }
 
 TEST(CanopenPlanErrors, NodeIdRangeNamesCanopen) {
   const std::string e = errors_of(R"(gateway: { name: g }
-buses: [{ name: can0, type: canopen, cycle_time: 1ms }]
+buses: [{ name: can0, type: canopen, cycle_time: 4ms }]
 axes:
   - { name: x, bus: can0, address: 0, device: kollmorgen-akd }
   - { name: y, bus: can0, address: 128, device: kollmorgen-akd }
@@ -220,7 +239,7 @@ axes:
 
 TEST(CanopenPlanErrors, TwoAxesOnOneNodeId) {
   const std::string e = errors_of(R"(gateway: { name: g }
-buses: [{ name: can0, type: canopen, cycle_time: 1ms }]
+buses: [{ name: can0, type: canopen, cycle_time: 4ms }]
 axes:
   - { name: x, bus: can0, address: 5, device: kollmorgen-akd }
   - { name: y, bus: can0, address: 5, device: kollmorgen-akd }
@@ -240,10 +259,10 @@ TEST(CanopenPlanErrors, GatewayNodeIdCollision) {
 TEST(CanopenPlanErrors, TransportAndNetworkOptions) {
   const std::string e = errors_of(R"(gateway: { name: g }
 buses:
-  - { name: a, type: canopen, cycle_time: 1ms, options: { transport: socketcam, bitrate: 100000 } }
-  - { name: b, type: canopen, cycle_time: 1ms, options: { transport: udp-multicast, group: 10.0.0.1, interface: eth0 } }
-  - { name: c, type: canopen, cycle_time: 1ms, options: { interface: a-very-long-can-name, bitrate: 2000000 } }
-  - { name: d, type: canopen, cycle_time: 1ms, options: { transport: udp-multicast, group: 239.1.300.4 } }
+  - { name: a, type: canopen, cycle_time: 4ms, options: { transport: socketcam, bitrate: 100000 } }
+  - { name: b, type: canopen, cycle_time: 4ms, options: { transport: udp-multicast, group: 10.0.0.1, interface: eth0 } }
+  - { name: c, type: canopen, cycle_time: 4ms, options: { interface: a-very-long-can-name, bitrate: 2000000 } }
+  - { name: d, type: canopen, cycle_time: 4ms, options: { transport: udp-multicast, group: 239.1.300.4 } }
 )");
   EXPECT_REPORTED(e, "t.yaml:3:70: buses[0].options.transport: must be one of socketcan, udp-multicast, sim, got "
                      "\"socketcam\", did you mean \"socketcan\"?");
@@ -310,7 +329,7 @@ TEST(CanopenPlanErrors, SdoChannels) {
 
 TEST(CanopenPlanErrors, ModesAndHomingTheDeviceLacks) {
   const std::string e = errors_of(R"(gateway: { name: g }
-buses: [{ name: can0, type: canopen, cycle_time: 1ms }]
+buses: [{ name: can0, type: canopen, cycle_time: 4ms }]
 axes:
   - { name: x, bus: can0, address: 1, device: nord-sk500p, defaults: { mode: csp } }
   - { name: y, bus: can0, address: 2, device: kollmorgen-akd, defaults: { mode: vl } }
@@ -352,7 +371,7 @@ TEST(CanopenPlanErrors, SyncOffWithSynchronousPdos) {
 
 TEST(CanopenPlanErrors, SyncPeriodTheDeviceLacks) {
   std::string yaml = one_axis("", "stoeber-sd6", 1, "    mechanics: { encoder_counts_per_rev: 100 }\n");
-  yaml.replace(yaml.find("cycle_time: 2ms"), 15, "cycle_time: 3ms");
+  yaml.replace(yaml.find("cycle_time: 4ms"), 15, "cycle_time: 3ms");
   const std::string e = errors_of(yaml);
   EXPECT_REPORTED(e, "t.yaml:6:10: axes[0].bus: bus \"can0\" cycle_time 3ms is not a SYNC period device \"stoeber-sd6\" "
                      "supports (1ms, 2ms, 4ms, 8ms)");
@@ -410,7 +429,7 @@ TEST_F(CanopenEdsFiles, MissingAndBrokenEds) {
   write("bad.eds", "[6040]\nParameterName=Controlword\nDataType=0x0099\nAccessType=rw\n");
   const std::string label = (dir_ / "plan.yaml").string();
   const std::string e = errors_of(R"(gateway: { name: g }
-buses: [{ name: can0, type: canopen, cycle_time: 1ms }]
+buses: [{ name: can0, type: canopen, cycle_time: 4ms }]
 axes:
   - { name: x, bus: can0, address: 1, device: kollmorgen-akd, canopen: { eds: nowhere.eds } }
   - { name: y, bus: can0, address: 2, device: kollmorgen-akd, canopen: { eds: bad.eds } }

@@ -1,5 +1,5 @@
 // Bus-load estimate (bus_load.hpp).
-#include "adapters/canopen/master/bus_load.hpp"
+#include "adapters/canopen/wire/bus_load.hpp"
 
 #include <cmath>
 
