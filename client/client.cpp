@@ -257,6 +257,7 @@ class Client::Impl : public dds::DataReaderListener {
     out.write(req.write);
     out.index(req.index);
     out.subindex(req.subindex);
+    out.name(req.name);
     out.size(req.size);
     out.is_signed(req.is_signed);
     out.value(req.value);
@@ -459,7 +460,8 @@ class Client::Impl : public dds::DataReaderListener {
       std::lock_guard lock(mutex_);
       const auto it = param_replies_.find(in.id());
       if (it != param_replies_.end())
-        it->second = ParamResult{in.ok(), in.gateway(), in.value(), in.error_code(), in.error()};
+        it->second = ParamResult{in.ok(),         in.gateway(), in.value(), in.error_code(),
+                                 in.error(),      in.index(),   in.subindex()};
     });
   }
 

@@ -141,6 +141,7 @@ struct ParamRequest {
   std::uint8_t size = 4;
   bool is_signed = false;
   std::int64_t value = 0;
+  std::string name;  // the object by name (EDS ParameterName, SD6 "A83"); replaces index/subindex
 };
 
 struct ParamResult {
@@ -149,6 +150,8 @@ struct ParamResult {
   std::int64_t value = 0;
   std::uint32_t error_code = 0;
   std::string error;
+  std::uint16_t index = 0;  // the object the gateway accessed
+  std::uint8_t subindex = 0;
 };
 
 // Which gateway a request goes to, or why none.

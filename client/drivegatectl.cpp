@@ -1,5 +1,6 @@
 // drivegatectl: command-line client of drivegated (see --help).
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cstdio>
 #include <iostream>
@@ -48,8 +49,10 @@ constexpr CommandHelp kCommands[] = {
     {"events", "events [--follow] [AXIS]", "recent events (faults, warnings, state changes); --follow keeps printing",
      0, 1},
     {"param",
-     "param get AXIS INDEX[:SUB] [--size 1|2|4] [--signed]\n"
-     "  param set AXIS INDEX[:SUB] VALUE [--size 1|2|4] [--signed]",
+     "param get AXIS OBJECT [--size 1|2|4] [--signed]\n"
+     "  param set AXIS OBJECT VALUE [--size 1|2|4] [--signed]\n"
+     "  OBJECT is INDEX[:SUB] in hex (6060, 0x6099:1, 6060h) or a name: an EDS ParameterName or a\n"
+     "  vendor parameter such as A83 (a name gives size and sign when the axis has an EDS)",
      "read/write a drive object; INDEX is hex (0x optional), SUB decimal or 0x-hex", 3, 4},
     {"buses", "buses", "bus status: cycle timing, lateness, frame counters", 0, 0},
 };
@@ -368,6 +371,14 @@ ObjectAddress parse_address(std::string_view text) {
   return a;
 }
 
+// An object is an index (hex, "6060", "0x6060:1", "6060h") or a name ("A83", an EDS ParameterName).
+// A word that starts with a letter is a name unless it has the 0x prefix or the h suffix.
+bool is_object_name(std::string_view text) {
+  const std::string_view index = text.substr(0, text.find(':'));
+  if (index.empty() || !std::isalpha(static_cast<unsigned char>(index.front()))) return false;
+  return !(index.back() == 'h' || index.back() == 'H');
+}
+
 int cmd_param(Context& ctx) {
   const std::string& op = word(ctx, 0, "get|set");
   if (op != "get" && op != "set") throw UsageError("param: expected 'get' or 'set', got '" + op + "'");
@@ -376,9 +387,14 @@ int cmd_param(Context& ctx) {
   ParamRequest req;
   req.axis = word(ctx, 1, "AXIS");
   req.gateway = ctx.gateway;
-  const ObjectAddress addr = parse_address(word(ctx, 2, "INDEX[:SUB]"));
-  req.index = addr.index;
-  req.subindex = addr.sub;
+  const std::string& object = word(ctx, 2, "OBJECT");
+  if (is_object_name(object)) {
+    req.name = object;
+  } else {
+    const ObjectAddress addr = parse_address(object);
+    req.index = addr.index;
+    req.subindex = addr.sub;
+  }
   req.write = write;
   req.is_signed = ctx.args.flag("signed");
   req.size = static_cast<std::uint8_t>(parse_integer("--size", ctx.args.option_or("size", "4"), 1, 4));
@@ -390,8 +406,13 @@ int cmd_param(Context& ctx) {
     req.value = parse_integer("VALUE", word(ctx, 3, "VALUE"), min, max);
   }
   const ParamResult r = ctx.client.param(req, ctx.timeout);
-  char where[32];
-  std::snprintf(where, sizeof where, "%04X:%u", req.index, static_cast<unsigned>(req.subindex));
+  char where[96];
+  if (req.name.empty())
+    std::snprintf(where, sizeof where, "%04X:%u", req.index, static_cast<unsigned>(req.subindex));
+  else if (r.ok)
+    std::snprintf(where, sizeof where, "%.60s (%04X:%u)", req.name.c_str(), r.index, static_cast<unsigned>(r.subindex));
+  else
+    std::snprintf(where, sizeof where, "%.60s", req.name.c_str());
   if (ctx.json) {
     JsonWriter w;
     w.begin_object()

@@ -70,6 +70,8 @@ struct Pending {
   std::string client;
   std::uint64_t client_id = 0;
   std::string axis;
+  std::uint16_t index = 0;  // parameter requests: the object accessed
+  std::uint8_t sub = 0;
 };
 
 template <typename T>
@@ -342,12 +344,12 @@ void DdsBridge::Impl::handle_param(const msg::ParamRequest& in) {
     out.id(in.id());
     out.ok(false);
     out.error(error);
+    out.index(in.index());
+    out.subindex(in.subindex());
     param_w_->write(&out);
   };
   const auto axis = find_axis(in.axis());
   if (!axis) return fail("unknown axis '" + in.axis() + "' on gateway '" + gateway_ + "'; axes here: " + axis_list());
-  if (in.size() != 1 && in.size() != 2 && in.size() != 4)
-    return fail("parameter size must be 1, 2 or 4 bytes, got " + std::to_string(in.size()));
   core::ParamRequest req;
   req.id = next_id_++;
   req.write = in.write();
@@ -356,9 +358,21 @@ void DdsBridge::Impl::handle_param(const msg::ParamRequest& in) {
   req.size = in.size();
   req.is_signed = in.is_signed();
   req.value = in.value();
+  if (!in.name().empty()) {
+    const ParameterLookup p = rt_.lookup_parameter(*axis, in.name());
+    if (!p.ok) return fail(p.error);
+    req.index = p.index;
+    req.sub = p.sub;
+    if (p.size != 0) {
+      req.size = p.size;
+      req.is_signed = p.is_signed;
+    }
+  }
+  if (req.size != 1 && req.size != 2 && req.size != 4)
+    return fail("parameter size must be 1, 2 or 4 bytes, got " + std::to_string(req.size));
   if (!rt_.submit_parameter(*axis, req))
     return fail("gateway busy: the parameter queue of axis '" + in.axis() + "' is full");
-  remember(pending_params_, req.id, Pending{in.client(), in.id(), in.axis()});
+  remember(pending_params_, req.id, Pending{in.client(), in.id(), in.axis(), req.index, req.sub});
   spdlog::info("dds: parameter {} {:04X}:{} for axis '{}' from '{}' id {} -> request {}", in.write() ? "write" : "read",
                in.index(), in.subindex(), in.axis(), in.client(), in.id(), req.id);
   count([](Stats& s) { ++s.params_routed; });
@@ -441,6 +455,8 @@ void DdsBridge::Impl::publish_outbox() {
     out.value(p.reply.value);
     out.error_code(p.reply.error_code);
     out.error(p.reply.error.str());
+    out.index(it->second.index);
+    out.subindex(it->second.sub);
     param_w_->write(&out);
     spdlog::info("dds: parameter request {} ('{}' id {}): {}", p.reply.id, out.client(), out.id(),
                  out.ok() ? "ok" : "error: " + out.error());

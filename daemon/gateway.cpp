@@ -6,6 +6,8 @@
 #include <sstream>
 #include <thread>
 
+#include "config/eds.hpp"
+#include "config/parameter_names.hpp"
 #include "daemon/bus_factory.hpp"
 
 namespace drivegate::daemon {
@@ -299,6 +301,55 @@ std::vector<std::string> Gateway::scheduling_notes() const {
     if (b.thread && !b.thread->scheduling_note().empty())
       notes.push_back("bus " + b.plan->name + ": " + b.thread->scheduling_note());
   return notes;
+}
+
+}  // namespace drivegate::daemon
+
+namespace drivegate::daemon {
+
+// EDS names first (they carry size and signedness), then the device's parameter naming (SD6
+// "A83"), so an EDS can also name vendor parameters.
+ParameterLookup Gateway::lookup_parameter(std::size_t axis_id, std::string_view name) const {
+  ParameterLookup out;
+  if (axis_id >= refs_.size()) {
+    out.error = "unknown axis";
+    return out;
+  }
+  const AxisRef ref = refs_[axis_id];
+  const config::AxisPlan& axis = buses_[ref.bus].plan->axes[ref.axis];
+  if (const config::EdsObject* o = config::find_eds_object(axis.canopen.eds_objects, name)) {
+    out.ok = true;
+    out.index = o->id.index;
+    out.sub = o->id.sub;
+    switch (o->data_type) {  // CiA 301 basic types of 1, 2 and 4 bytes
+      case 0x0001: out.size = 1; break;  // BOOLEAN
+      case 0x0002: out.size = 1; out.is_signed = true; break;
+      case 0x0003: out.size = 2; out.is_signed = true; break;
+      case 0x0004: out.size = 4; out.is_signed = true; break;
+      case 0x0005: out.size = 1; break;
+      case 0x0006: out.size = 2; break;
+      case 0x0007: out.size = 4; break;
+      default:
+        out.ok = false;
+        out.error = "object '" + o->name + "' is of type " + config::eds_type_name(o->data_type) +
+                    "; parameters of 1, 2 or 4 bytes only";
+    }
+    return out;
+  }
+  if (const auto& naming = axis.device.canopen.parameter_naming) {
+    const auto r = config::resolve_parameter_name(name, *naming);
+    if (r.id) {
+      out.ok = true;
+      out.index = r.id->index;
+      out.sub = r.id->sub;
+      return out;
+    }
+    out.error = "'" + std::string(name) + "' is not a parameter of device " + axis.device.name + ": " + r.error;
+    return out;
+  }
+  out.error = "axis '" + axis.spec.name + "' has no object named '" + std::string(name) + "'" +
+              (axis.canopen.eds.empty() ? " (give the axis an EDS file to use names, or use INDEX:SUB)" : " in its EDS");
+  return out;
 }
 
 }  // namespace drivegate::daemon

@@ -65,6 +65,17 @@ struct Outbox {
   }
 };
 
+// An object named by a client (EDS ParameterName or a vendor parameter name), resolved for one
+// axis. size 0: the name does not say, the request's size applies.
+struct ParameterLookup {
+  bool ok = false;
+  std::uint16_t index = 0;
+  std::uint8_t sub = 0;
+  std::uint8_t size = 0;
+  bool is_signed = false;
+  std::string error;  // why not ok, in words
+};
+
 class Runtime {
  public:
   virtual ~Runtime() = default;
@@ -76,6 +87,8 @@ class Runtime {
   virtual bool submit_command(std::size_t axis_id, const core::Command& cmd) = 0;
   virtual bool submit_setpoint(std::size_t axis_id, const core::Setpoint& sp) = 0;
   virtual bool submit_parameter(std::size_t axis_id, const core::ParamRequest& req) = 0;
+  // The object `name` stands for on this axis (control plane only; may allocate).
+  [[nodiscard]] virtual ParameterLookup lookup_parameter(std::size_t axis_id, std::string_view name) const = 0;
 
   [[nodiscard]] virtual core::AxisSnapshot snapshot(std::size_t axis_id) const = 0;
   [[nodiscard]] virtual std::size_t bus_count() const noexcept = 0;

@@ -376,6 +376,35 @@ TEST(DdsBridge, ParameterGetAndSetRoundTrip) {
   EXPECT_NE(r.error.find("does not exist"), std::string::npos);
 }
 
+// Objects by name (EDS ParameterName or a vendor name): the gateway resolves index, sub-index
+// and, when the name says, size and signedness; the reply names the object accessed.
+TEST(DdsBridge, ParametersByName) {
+  FakeRuntime rt("gw1", {"x"});
+  daemon::ParameterLookup a83;
+  a83.index = 0x2053;
+  a83.size = 1;
+  rt.add_name("A83", a83);
+  rt.set_object(0, 0x2053, 0, 7);
+  daemon::DdsBridge bridge(rt, bridge_options());
+  bridge.start();
+  Client c(client_options());
+
+  client::ParamRequest get;
+  get.axis = "x";
+  get.name = "A83";
+  get.size = 3;  // ignored: the name gives the size
+  auto r = c.param(get, kTimeout);
+  ASSERT_TRUE(r.ok) << r.error << seen(c);
+  EXPECT_EQ(r.value, 7);
+  EXPECT_EQ(r.index, 0x2053);
+  EXPECT_EQ(r.subindex, 0);
+
+  get.name = "A840";
+  r = c.param(get, kTimeout);
+  EXPECT_FALSE(r.ok);
+  EXPECT_EQ(r.error, "no object named 'A840'");
+}
+
 TEST(DdsBridge, SetpointsAndEventsFlow) {
   FakeRuntime rt("gw1", {"x", "spindle"});
   daemon::DdsBridge bridge(rt, bridge_options());

@@ -89,6 +89,25 @@ TEST_F(Drivegatectl, ListStatusAndParam) {
   EXPECT_EQ(rt_.object(0, 0x6081, 0), 70000);
 }
 
+TEST_F(Drivegatectl, ParamByName) {
+  daemon::ParameterLookup a83;
+  a83.index = 0x2053;
+  a83.size = 1;
+  rt_.add_name("A83", a83);
+  rt_.set_object(0, 0x2053, 0, 9);
+  CtlRun r = ctl("param get x A83");
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("x A83 (2053:0) = 9"), std::string::npos) << r.output;
+  r = ctl("param get x A999");
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_NE(r.output.find("param get x A999: no object named 'A999'"), std::string::npos) << r.output;
+  // With the h suffix a word that starts with a letter is an index.
+  rt_.set_object(0, 0xA83, 0, 5);
+  r = ctl("param get x A83h");
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("0A83:0 = 5"), std::string::npos) << r.output;
+}
+
 TEST_F(Drivegatectl, VelocityStreamsKeepAliveThenStops) {
   const CtlRun r = ctl("velocity y -4.5 --for 0.4");
   EXPECT_EQ(r.status, 0) << r.output;

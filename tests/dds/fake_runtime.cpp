@@ -41,6 +41,20 @@ bool FakeRuntime::submit_setpoint(std::size_t axis_id, const core::Setpoint& sp)
   return true;
 }
 
+void FakeRuntime::add_name(std::string name, daemon::ParameterLookup object) {
+  std::lock_guard lock(mutex_);
+  object.ok = true;
+  names_[std::move(name)] = object;
+}
+
+daemon::ParameterLookup FakeRuntime::lookup_parameter(std::size_t, std::string_view name) const {
+  std::lock_guard lock(mutex_);
+  if (const auto it = names_.find(std::string(name)); it != names_.end()) return it->second;
+  daemon::ParameterLookup none;
+  none.error = "no object named '" + std::string(name) + "'";
+  return none;
+}
+
 bool FakeRuntime::submit_parameter(std::size_t axis_id, const core::ParamRequest& req) {
   std::lock_guard lock(mutex_);
   if (busy_) return false;

@@ -21,6 +21,7 @@ class FakeRuntime final : public daemon::Runtime {
   bool submit_command(std::size_t axis_id, const core::Command& cmd) override;
   bool submit_setpoint(std::size_t axis_id, const core::Setpoint& sp) override;
   bool submit_parameter(std::size_t axis_id, const core::ParamRequest& req) override;
+  [[nodiscard]] daemon::ParameterLookup lookup_parameter(std::size_t axis_id, std::string_view name) const override;
   [[nodiscard]] core::AxisSnapshot snapshot(std::size_t axis_id) const override;
   [[nodiscard]] std::size_t bus_count() const noexcept override { return 1; }
   [[nodiscard]] daemon::BusStatus bus_status(std::size_t bus) const override;
@@ -30,6 +31,8 @@ class FakeRuntime final : public daemon::Runtime {
   void set_busy(bool busy);
   void set_complete_commands(bool complete);  // false: reply Accepted only
   void set_object(std::size_t axis_id, std::uint16_t index, std::uint8_t sub, std::int64_t value);
+  // Parameter names lookup_parameter() knows (for every axis).
+  void add_name(std::string name, daemon::ParameterLookup object);
   void push_event(std::size_t axis_id, core::EventKind kind, std::string_view text);
   struct Received {
     std::size_t axis_id;
@@ -43,6 +46,7 @@ class FakeRuntime final : public daemon::Runtime {
   std::string gateway_;
   std::vector<daemon::AxisInfo> axes_;
   mutable std::mutex mutex_;
+  std::map<std::string, daemon::ParameterLookup> names_;
   bool busy_ = false;
   bool complete_ = true;
   std::vector<Received> commands_;
