@@ -11,7 +11,7 @@ namespace {
 
 using Phase = CanopenBus::Phase;
 
-// How long to wait for a boot-up after NMT reset communication before probing by SDO.
+// How long to wait for a drive's boot-up before probing it by SDO.
 constexpr core::Duration kBootUpWait = std::chrono::milliseconds(500);
 
 std::vector<SdoChannelConfig> sdo_channels_for(const config::BusPlan& plan) {
@@ -264,13 +264,13 @@ void CanopenBus::advance(Node& n, core::TimePoint now) noexcept {
   if (controller_ == ControllerState::BusOff) return;
   switch (n.phase) {
     case Phase::Start:
-      // Reset communication: the node sends a boot-up and is pre-operational with default
-      // communication parameters, whatever state it was left in.
-      nmt_.command(NmtCommand::ResetCommunication, n.id, tx_);
       enter(n, Phase::WaitBootUp, now);
       break;
     case Phase::WaitBootUp:
-      if (now - n.since >= kBootUpWait) enter(n, Phase::Probe, now);  // boot-up not repeated (SD6 quirk 9)
+      // A drive powering up announces itself; one that was already running (or does not repeat
+      // its boot-up: SD6 quirk 9) is probed by SDO, put into pre-operational and configured
+      // completely, whatever state an earlier master left it in.
+      if (now - n.since >= kBootUpWait) enter(n, Phase::Probe, now);
       break;
     case Phase::Probe:
       if (n.probe == kNoSdoRequest) {

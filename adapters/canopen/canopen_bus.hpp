@@ -3,8 +3,8 @@
 // client, SYNC, EMCY, PDOs) and a CiA 402 profile per axis over NodeAccess. Each axis is one node.
 //
 // Per node the bus runs the life cycle the issue asks for:
-//   start:        NMT reset communication, wait for the boot-up (or probe 1000h by SDO when the
-//                 drive does not repeat its boot-up: SD6 quirk 9), NMT pre-operational
+//   start:        wait for the boot-up, or probe 1000h by SDO (a drive already running, or one
+//                 that does not repeat its boot-up: SD6 quirk 9) and send NMT pre-operational
 //   configuring:  NodeBoot (identity, start-up writes, PDOs, error control), then NMT start
 //   operational:  PDOs after each SYNC, heartbeat or guarding supervision, EMCY
 //   lost / failed: link Lost or Offline with the reason; probed again with back-off, and on its
