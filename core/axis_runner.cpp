@@ -35,7 +35,11 @@ void AxisRunner::command(const Command& cmd, TimePoint now, RunnerOutput& out) n
   }
 
   const double relative_base = move_in_flight_ != 0 ? move_target_ : snapshot_.position;
-  const Conversion conv = validate_and_convert(spec_, cmd, relative_base);
+  Command c = cmd;
+  // A velocity command without a mode keeps the axis in vl when it is there (a vl drive such as
+  // the NORD SK 500P stays in its mode instead of switching to pv).
+  if (c.kind == CommandKind::Velocity && c.mode == Mode::None && snapshot_.mode == Mode::Velocity) c.mode = Mode::Velocity;
+  const Conversion conv = validate_and_convert(spec_, c, relative_base);
   if (!conv.ok) {
     send_reply(cmd.id, ReplyStatus::Rejected, conv.reason.view());
     return;

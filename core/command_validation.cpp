@@ -65,6 +65,9 @@ Mode mode_for(CommandKind kind, const ModeSet& modes, Mode requested) noexcept {
   switch (kind) {
     case CommandKind::Move: return Mode::ProfilePosition;
     case CommandKind::Velocity:
+      // A drive with both (NORD SK 500P) jogs in the one asked for; pv otherwise.
+      if ((requested == Mode::Velocity || requested == Mode::ProfileVelocity) && modes.contains(requested))
+        return requested;
       if (modes.contains(Mode::ProfileVelocity)) return Mode::ProfileVelocity;
       if (modes.contains(Mode::Velocity)) return Mode::Velocity;
       return Mode::ProfileVelocity;

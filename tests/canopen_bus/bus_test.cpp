@@ -143,3 +143,114 @@ TEST(CanopenBus, CyclesAllocateNothingWhileAxesMove) {
 
 }  // namespace
 }  // namespace drivegate::canopen::test
+
+namespace drivegate::canopen::test {
+namespace {
+
+using core::AxisState;
+using core::CommandKind;
+using core::Mode;
+using core::ReplyStatus;
+
+core::CommandId set_mode(BusHarness& h, const std::string& axis, Mode m) {
+  core::Command c;
+  c.id = h.next_id++;
+  c.axis = h.axis(axis);
+  c.kind = CommandKind::SetMode;
+  c.mode = m;
+  EXPECT_TRUE(h.runner->push_command(c));
+  return c.id;
+}
+
+void expect_completed(BusHarness& h, core::CommandId id, core::Duration budget, const std::string& what) {
+  ASSERT_EQ(h.wait_final(id, budget), ReplyStatus::Completed) << what << ": " << h.reason(id) << h.events_text();
+}
+
+// Every mode each persona offers, over PDOs and SDOs on the emulated wire.
+TEST(CanopenBusModes, AkdVelocityTorqueHomingAndCyclicPosition) {
+  BusHarness h;
+  ASSERT_TRUE(h.run_until([&] { return h.all_up(); }, 5s)) << h.events_text();
+  expect_completed(h, h.push("akd", CommandKind::Enable), 3s, "enable");
+
+  expect_completed(h, h.push("akd", CommandKind::Velocity, 0, 20.0), 5s, "pv velocity");
+  ASSERT_TRUE(h.run_until([&] { return std::fabs(h.snap("akd").velocity - 20.0) < 0.5; }, 3s)) << h.snap("akd").velocity;
+  EXPECT_EQ(h.snap("akd").mode, Mode::ProfileVelocity);
+  expect_completed(h, h.push("akd", CommandKind::Stop), 5s, "stop");
+  ASSERT_TRUE(h.run_until([&] { return std::fabs(h.snap("akd").velocity) < 0.01; }, 3s));
+
+  core::Command tq;
+  tq.id = h.next_id++;
+  tq.axis = h.axis("akd");
+  tq.kind = CommandKind::Torque;
+  tq.torque = 5.0;
+  ASSERT_TRUE(h.runner->push_command(tq));
+  expect_completed(h, tq.id, 5s, "torque");
+  EXPECT_EQ(h.snap("akd").mode, Mode::ProfileTorque);
+  // Without torque the unloaded simulated motor coasts on: take the power off and start again.
+  expect_completed(h, h.push("akd", CommandKind::Disable), 3s, "disable after torque");
+  ASSERT_TRUE(h.run_until([&] { return std::fabs(h.snap("akd").velocity) < 0.001; }, 20s)) << h.snap("akd").velocity;
+  expect_completed(h, h.push("akd", CommandKind::Enable), 3s, "enable again");
+
+  expect_completed(h, h.push("akd", CommandKind::Home), 10s, "homing");
+  EXPECT_TRUE(h.snap("akd").homed);
+
+  // csp: set-points streamed every cycle, the position follows.
+  expect_completed(h, set_mode(h, "akd", Mode::CyclicPosition), 3s, "csp");
+  double target = h.snap("akd").position;
+  for (int i = 0; i < 250; ++i) {
+    target += 0.02;  // 5 mm/s at 4 ms
+    core::Setpoint sp;
+    sp.axis = h.axis("akd");
+    sp.position = target;
+    ASSERT_TRUE(h.runner->push_setpoint(sp));
+    h.cycle();
+  }
+  EXPECT_NEAR(h.snap("akd").position, target, 0.2);
+
+  ASSERT_TRUE(h.run_until([&] { return std::fabs(h.snap("akd").velocity) < 0.001; }, 2s));
+
+  // ip: the same through 60C1h:1 with interpolation enabled (controlword bit 4).
+  expect_completed(h, set_mode(h, "akd", Mode::InterpolatedPosition), 3s, "ip");
+  for (int i = 0; i < 250; ++i) {
+    target -= 0.02;
+    core::Setpoint sp;
+    sp.axis = h.axis("akd");
+    sp.position = target;
+    ASSERT_TRUE(h.runner->push_setpoint(sp));
+    h.cycle();
+  }
+  EXPECT_NEAR(h.snap("akd").position, target, 0.2);
+  expect_completed(h, h.push("akd", CommandKind::Disable), 3s, "disable");
+}
+
+TEST(CanopenBusModes, NordVelocityModeNeedsTheVlBitsAndRuns) {
+  BusHarness h;
+  ASSERT_TRUE(h.run_until([&] { return h.all_up(); }, 5s)) << h.events_text();
+  expect_completed(h, h.push("nord", CommandKind::Enable), 3s, "enable");
+  expect_completed(h, set_mode(h, "nord", Mode::Velocity), 3s, "vl");
+  expect_completed(h, h.push("nord", CommandKind::Velocity, 0, 5.0), 5s, "vl velocity");
+  ASSERT_TRUE(h.run_until([&] { return std::fabs(h.snap("nord").velocity - 5.0) < 0.2; }, 5s))
+      << h.snap("nord").velocity << h.events_text();
+  EXPECT_EQ(h.snap("nord").mode, Mode::Velocity);
+  // The drive only runs with controlword bits 4..6 set (NORD §13 step 8: 0x007F).
+  EXPECT_EQ(h.drive("nord").drive().read_object({0x6040, 0}).value & 0x7F, 0x7F);
+  expect_completed(h, h.push("nord", CommandKind::Stop), 5s, "stop");
+  // Quick stop ends in Switch on disabled on this drive (NORD quirk 13).
+  expect_completed(h, h.push("nord", CommandKind::QuickStop), 5s, "quick stop");
+  EXPECT_EQ(h.snap("nord").state, AxisState::SwitchOnDisabled);
+}
+
+TEST(CanopenBusModes, Sd6ProfileVelocityAndHoming) {
+  BusHarness h;
+  ASSERT_TRUE(h.run_until([&] { return h.all_up(); }, 5s)) << h.events_text();
+  expect_completed(h, h.push("sd6", CommandKind::Enable), 3s, "enable");
+  expect_completed(h, h.push("sd6", CommandKind::Velocity, 0, 3.0), 5s, "pv");
+  ASSERT_TRUE(h.run_until([&] { return std::fabs(h.snap("sd6").velocity - 3.0) < 0.1; }, 5s)) << h.snap("sd6").velocity;
+  expect_completed(h, h.push("sd6", CommandKind::Stop), 5s, "stop");
+  ASSERT_TRUE(h.run_until([&] { return std::fabs(h.snap("sd6").velocity) < 0.01; }, 3s));
+  expect_completed(h, h.push("sd6", CommandKind::Home), 10s, "homing");
+  EXPECT_TRUE(h.snap("sd6").homed);
+}
+
+}  // namespace
+}  // namespace drivegate::canopen::test

@@ -94,6 +94,20 @@ TEST(CommandValidation, VelocityFallsBackToVlWhenTheDeviceHasNoPv) {
   EXPECT_EQ(r.drive.mode, Mode::Velocity);
 }
 
+TEST(CommandValidation, VelocityRunsInTheRequestedOfPvAndVl) {
+  auto spec = drivegate::test::linear_axis_spec();
+  spec.modes.add(Mode::ProfileVelocity);
+  spec.modes.add(Mode::Velocity);
+  Command v;
+  v.kind = CommandKind::Velocity;
+  v.velocity = 10;
+  EXPECT_EQ(validate_and_convert(spec, v, 0).drive.mode, Mode::ProfileVelocity);
+  v.mode = Mode::Velocity;
+  EXPECT_EQ(validate_and_convert(spec, v, 0).drive.mode, Mode::Velocity);
+  v.mode = Mode::Homing;  // not a velocity mode: ignored
+  EXPECT_EQ(validate_and_convert(spec, v, 0).drive.mode, Mode::ProfileVelocity);
+}
+
 TEST(CommandValidation, HomingMethodMustBeSupported) {
   const auto spec = drivegate::test::linear_axis_spec();
   Command h;
