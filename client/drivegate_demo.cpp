@@ -29,9 +29,10 @@ constexpr const char* kUsage =
     "usage: drivegate-demo [--domain N] [--namespace NS] [--gateway G] [--timeout S]\n"
     "                      [--x AXIS] [--y AXIS] [--spindle AXIS] [--turntable AXIS]\n"
     "                      [--spindle-speed V] [--jog-seconds S] [--plain]\n"
-    "Enables the demo axes, homes the turntable, moves x and y, jogs the spindle, then stops and\n"
-    "disables everything. Axis names default to those of demo.yaml (x, y, spindle, turntable);\n"
-    "axes that no gateway offers are skipped. --plain prints step lines without the live table.\n";
+    "Enables the demo axes, homes the turntable, moves x and y, moves the CANopen drives akd, nord\n"
+    "and sd6 out and back, jogs the spindle, then stops and disables everything. Axis names default\n"
+    "to those of demo.yaml (x, y, spindle, turntable); axes that no gateway offers are skipped.\n"
+    "--plain prints step lines without the live table.\n";
 
 // Keep-alive rate for the spindle jog: several times what a typical command timeout needs.
 constexpr auto kKeepAlivePeriod = std::chrono::milliseconds(50);
@@ -215,6 +216,10 @@ int run(int argc, char** argv) {
       std::cerr << "drivegate-demo: skipping axis '" << a << "': " << client.route(a, gateway).error << "\n";
     }
   }
+  // The CANopen drives of the demo config, each moved out and back (in its own unit).
+  const std::vector<std::pair<std::string, double>> canopen_moves{{"akd", 20}, {"nord", 3}, {"sd6", 2}};
+  for (const auto& [a, distance] : canopen_moves)
+    if (offered(a)) axes.push_back(a);
   if (axes.empty()) {
     std::cerr << "drivegate-demo: none of the demo axes is available\n";
     return 1;
@@ -235,6 +240,12 @@ int run(int argc, char** argv) {
     if (has(x)) moves.push_back(move(x, px));
     if (has(y)) moves.push_back(move(y, py));
     if (!moves.empty()) ok = demo.together("move", moves);
+  }
+  for (const double scale : {1.0, 0.0}) {
+    std::vector<CommandRequest> moves;
+    for (const auto& [a, distance] : canopen_moves)
+      if (has(a)) moves.push_back(move(a, scale * distance));
+    if (ok && !moves.empty()) ok = demo.together("move", moves);
   }
   if (ok && has(spindle)) ok = demo.jog(spindle, speed, jog_seconds);
   if (interrupted()) demo.log("interrupted: disabling all axes");
