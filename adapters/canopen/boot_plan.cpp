@@ -23,6 +23,9 @@ struct Steps {
   void write(std::string stage, ObjectDef def, std::int64_t value, bool optional = false, std::string why = {}) {
     list.push_back({BootStep::Kind::Write, def, value, 0xFFFFFFFF, optional, std::move(stage), std::move(why)});
   }
+  void seed(ObjectDef def) {
+    list.push_back({BootStep::Kind::Seed, def, 0, 0xFFFFFFFF, true, "process image", {}});
+  }
   void expect(std::string stage, ObjectDef def, std::int64_t value, std::uint32_t mask = 0xFFFFFFFF,
               std::string why = {}) {
     list.push_back({BootStep::Kind::Expect, def, value, mask, false, std::move(stage), std::move(why)});
@@ -113,6 +116,12 @@ std::vector<BootStep> build_boot_steps(const config::AxisPlan& axis, const confi
     s.write("interpolation period", u8(0x60C2, 1), cycle_ms, true);
     s.write("interpolation period", i8(0x60C2, 2), -3, true);
   }
+
+  // The drive's present values of what the gateway sends it cyclically (except the controlword,
+  // which the profile owns from the first cycle).
+  for (const auto& p : dev.rpdos)
+    for (const auto& e : p.entries)
+      if (e.object != cia402::obj::kControlword.id) s.seed({e.object, e.type});
 
   // Error control (AKD part 1 §16 step 10; SD6 gateway step B6: exactly one of the two).
   if (dev.error_control == config::ErrorControl::Heartbeat) {

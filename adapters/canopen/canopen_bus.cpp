@@ -4,6 +4,7 @@
 
 #include "adapters/canopen/boot_plan.hpp"
 #include "profiles/cia402/master_settings.hpp"
+#include "profiles/cia402/op_modes.hpp"
 #include "profiles/cia402/sdo_abort.hpp"
 
 namespace drivegate::canopen {
@@ -37,6 +38,17 @@ std::vector<NmtNodeConfig> nmt_nodes_for(const config::BusPlan& plan) {
     out.push_back(c);
   }
   return out;
+}
+
+// A drive that needs a valid mode in 6060h in every RPDO (quirk mode_object_always_valid: NORD
+// §13 step 6, quirk 18) gets one from the first RPDO on, before the profile has seen a status and
+// mirrors the drive's mode: the axis' default mode, else the first mode the device offers.
+void seed_mode_object(const config::AxisPlan& a, ProcessImage& image) {
+  if (!a.device.quirk("mode_object_always_valid") || !image.contains(cia402::obj::kModesOfOperation.id)) return;
+  core::Mode mode = a.spec.default_mode;
+  for (std::size_t i = 1; mode == core::Mode::None && i < core::kModeCount; ++i)
+    if (a.device.modes.contains(static_cast<core::Mode>(i))) mode = static_cast<core::Mode>(i);
+  if (const auto op = cia402::to_op_mode(mode)) image.set(cia402::obj::kModesOfOperation.id, *op);
 }
 
 }  // namespace
@@ -80,6 +92,7 @@ CanopenBus::CanopenBus(const config::BusPlan& plan, std::unique_ptr<Transport> t
     const NodePdoConfig pdo = build_pdo_config(a);
     if (!n->pdos.configure(pdo.rpdos, pdo.tpdos))
       throw core::BusError("bus '" + name_ + "' axis '" + a.spec.name + "': PDO maps exceed the process image");
+    seed_mode_object(a, n->pdos.image());
     n->io = std::make_unique<NodeAccess>(n->id, n->channel, n->pdos, sdo_, emcy_);
     n->master = std::make_unique<cia402::Cia402Master>(*n->io, cia402::settings_from(a.spec));
     n->master->set_fault_table(tables_[i].faults);
@@ -300,7 +313,7 @@ void CanopenBus::advance(Node& n, core::TimePoint now) noexcept {
       }
       break;
     case Phase::Configuring:
-      switch (n.boot.step(sdo_)) {
+      switch (n.boot.step(sdo_, n.pdos.image())) {
         case NodeBoot::Status::Done:
           nmt_.command(NmtCommand::Start, n.id, tx_);
           nmt_.watch(n.id, now);

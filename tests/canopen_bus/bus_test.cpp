@@ -33,6 +33,15 @@ TEST(CanopenBus, EveryNodeComesUpByItselfDisabled) {
   EXPECT_EQ(h.bus->unexpected_frames(), 0U);
 }
 
+// NORD: 6060h in RxPDO1 is never 0, not even before the first status (quirk mode_object_always_valid).
+TEST(CanopenBus, NordModeByteIsValidFromTheFirstRpdo) {
+  BusHarness h;
+  const auto nord = h.axis("nord");
+  EXPECT_EQ(h.bus->pdos(nord).image().get(cia402::obj::kModesOfOperation.id), 1);  // pp: the first mode it offers
+  ASSERT_TRUE(h.run_until([&] { return h.all_up(); }, 5s)) << h.events_text();
+  EXPECT_EQ(h.drive("nord").counters().refused_pdo_values, 0U);
+}
+
 TEST(CanopenBus, EnableAndMoveEveryPersonaInProfilePosition) {
   BusHarness h;
   ASSERT_TRUE(h.run_until([&] { return h.all_up(); }, 5s)) << h.events_text();

@@ -50,7 +50,7 @@ void NodeBoot::fail_abort(const BootStep& s, std::uint32_t code) noexcept {
                     s.def.id.sub, cia402::sdo_abort_text(code).data(), code);
 }
 
-NodeBoot::Status NodeBoot::step(SdoClient& sdo) noexcept {
+NodeBoot::Status NodeBoot::step(SdoClient& sdo, ProcessImage& image) noexcept {
   if (status_ != Status::Running) return status_;
   if (next_ >= steps_.size()) return status_ = Status::Done;
   const BootStep& s = steps_[next_];
@@ -69,13 +69,15 @@ NodeBoot::Status NodeBoot::step(SdoClient& sdo) noexcept {
     return status_;
   }
   if (r.status == SdoStatus::Failed) {
-    if (s.optional && missing_object(r.abort_code)) {
+    // A seed the drive cannot answer leaves the image value as it is (0 at first).
+    if (s.kind == BootStep::Kind::Seed || (s.optional && missing_object(r.abort_code))) {
       ++next_;
       return status_ = next_ >= steps_.size() ? Status::Done : Status::Running;
     }
     fail_abort(s, r.abort_code);
     return status_;
   }
+  if (s.kind == BootStep::Kind::Seed) image.set(s.def.id, sign_extend(r.value, s.def.type));
   if (s.kind == BootStep::Kind::Expect) {
     const auto got = static_cast<std::uint32_t>(sign_extend(r.value, s.def.type) & 0xFFFFFFFF);
     const auto want = static_cast<std::uint32_t>(s.value & 0xFFFFFFFF);

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "adapters/canopen/master/pdo.hpp"
 #include "adapters/canopen/master/sdo_client.hpp"
 #include "core/clock.hpp"
 #include "core/fixed_string.hpp"
@@ -23,6 +24,8 @@ struct BootStep {
   enum class Kind : std::uint8_t {
     Write,   // write `value`
     Expect,  // read and compare (value & mask) == (expected & mask)
+    Seed,    // read an RPDO-mapped object into the process image, so the first RPDOs carry the
+             // drive's own values rather than zeros it may refuse (e.g. a 0 profile acceleration)
   };
   Kind kind = Kind::Write;
   cia402::ObjectDef def{};
@@ -41,8 +44,9 @@ class NodeBoot {
 
   // Start (or restart) from the first step.
   void start() noexcept;
-  // Drive the sequence: submit the next transfer, check the finished one. Returns the status.
-  Status step(SdoClient& sdo) noexcept;
+  // Drive the sequence: submit the next transfer, check the finished one (Seed steps store into
+  // `image`). Returns the status.
+  Status step(SdoClient& sdo, ProcessImage& image) noexcept;
   // Stop without a verdict (node lost mid-way): the transfer in flight is cancelled.
   void abandon(SdoClient& sdo) noexcept;
 
