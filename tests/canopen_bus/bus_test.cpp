@@ -263,3 +263,42 @@ TEST(CanopenBusModes, Sd6ProfileVelocityAndHoming) {
 
 }  // namespace
 }  // namespace drivegate::canopen::test
+
+namespace drivegate::canopen::test {
+namespace {
+
+// Malformed and unexpected frames from a third device on the wire are counted and dropped; no node
+// changes state because of them.
+TEST(CanopenBusBadInput, StrayFramesAreCountedAndChangeNothing) {
+  BusHarness h;
+  ASSERT_TRUE(h.run_until([&] { return h.all_up(); }, 5s)) << h.events_text();
+  auto rogue = h.peer->bus().connect();
+  rogue->open();
+  const std::vector<CanFrame> junk{
+      make_frame(0x581, {0x43, 0x00, 0x10}),                                   // SDO response, wrong DLC
+      make_frame(0x581, {0xE0, 0, 0, 0, 0, 0, 0, 0}),                          // unknown specifier
+      make_frame(0x582, {0x60, 0x17, 0x10, 0, 0, 0, 0, 0}),                    // a response nobody asked for
+      make_frame(0x5A5, {0x43, 0x00, 0x10, 0x00, 0x92, 0x01, 0x02, 0x00}),     // from an unconfigured node
+      make_frame(0x185, {0x37, 0x02}),                                         // TPDO of an unconfigured node
+      make_frame(0x181, {0x37}),                                               // TPDO1 of node 1, too short
+      make_frame(0x701, {0x05, 0x00}),                                         // heartbeat, wrong DLC
+      make_frame(0x701, {0x42}),                                               // heartbeat, no such state
+      make_frame(0x081, {0x10}),                                               // EMCY too short
+      make_frame(0x77F, {0x05}),                                               // heartbeat of an unknown node
+  };
+  const auto dropped_before = h.bus->counters().frames_dropped;
+  for (int round = 0; round < 20; ++round) {
+    for (const auto& f : junk) ASSERT_EQ(rogue->send(f, h.now), SendResult::Sent);
+    h.cycle();
+  }
+  h.run_until([] { return false; }, 200ms);
+  EXPECT_TRUE(h.all_operational()) << h.events_text();
+  for (std::size_t i = 0; i < h.specs.size(); ++i) EXPECT_EQ(h.bus->boots(i), 1U) << h.specs[i].name;
+  EXPECT_GE(h.bus->counters().frames_dropped - dropped_before, 20U * 8U);
+  // And the axes still work.
+  const auto en = h.push("akd", CommandKind::Enable);
+  EXPECT_EQ(h.wait_final(en, 3s), ReplyStatus::Completed) << h.reason(en);
+}
+
+}  // namespace
+}  // namespace drivegate::canopen::test
