@@ -302,3 +302,48 @@ TEST(CanopenBusBadInput, StrayFramesAreCountedAndChangeNothing) {
 
 }  // namespace
 }  // namespace drivegate::canopen::test
+
+namespace drivegate::canopen::test {
+namespace {
+
+// Parameter requests go over the node's SDO channel between the cyclic PDOs; an abort comes back
+// with its code and text.
+TEST(CanopenBusParameters, ReadsWritesAndAbortsOverSdo) {
+  BusHarness h;
+  ASSERT_TRUE(h.run_until([&] { return h.all_up(); }, 5s)) << h.events_text();
+  std::vector<core::ParamReply> got;
+  auto ask = [&](const std::string& axis, bool write, std::uint16_t index, std::uint8_t sub, std::uint8_t size,
+                 std::int64_t value = 0) {
+    core::ParamRequest r;
+    r.id = h.next_id++;
+    r.axis = h.axis(axis);
+    r.write = write;
+    r.index = index;
+    r.sub = sub;
+    r.size = size;
+    r.value = value;
+    EXPECT_TRUE(h.runner->push_parameter(r));
+    core::ParamReply reply;
+    h.run_until([&] { return h.runner->pop_parameter_reply(reply); }, 2s);
+    return reply;
+  };
+  auto r = ask("akd", false, 0x1018, 1, 4);
+  ASSERT_TRUE(r.ok) << r.error.view();
+  EXPECT_EQ(r.value, 0x6A);  // Kollmorgen (AKD part 1 §14 vector 11)
+  r = ask("sd6", false, 0x1018, 1, 4);
+  ASSERT_TRUE(r.ok) << r.error.view();
+  EXPECT_EQ(r.value, 0xB9);  // STÖBER, answered with 42h (SD6 D-2)
+  r = ask("sd6", false, 0x2053, 0, 1);  // A83: the node-ID
+  ASSERT_TRUE(r.ok) << r.error.view();
+  EXPECT_EQ(r.value, 3);
+  r = ask("nord", false, 0x603F, 0, 2);  // NORD has no 603Fh (NORD §9)
+  EXPECT_FALSE(r.ok);
+  EXPECT_EQ(r.error_code, 0x06020000U);
+  EXPECT_NE(std::string(r.error.view()).find("does not exist"), std::string::npos) << r.error.view();
+  r = ask("akd", true, 0x6081, 0, 4, 12345);
+  ASSERT_TRUE(r.ok) << r.error.view();
+  EXPECT_EQ(h.drive("akd").drive().read_object({0x6081, 0}).value, 12345);
+}
+
+}  // namespace
+}  // namespace drivegate::canopen::test
