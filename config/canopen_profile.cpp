@@ -312,9 +312,13 @@ void read_startup_writes(const MapReader& parent, std::string_view key, const st
     else
       id = read_object(object_node, w.field("object"), src, naming);
     const auto type_name = w.choice("type", Need::Required, data_type_names());
-    const auto type = type_name ? parse_data_type(*type_name) : std::nullopt;
+    // A plain value and a flag rather than optional<DataType>: GCC 12 -O2 reports a false
+    // "maybe uninitialized" for the optional.
+    const auto parsed = type_name ? parse_data_type(*type_name) : std::nullopt;
+    const bool has_type = parsed.has_value();
+    const cia402::DataType type = parsed.value_or(cia402::DataType::U8);
     std::optional<std::int64_t> value;
-    if (type) value = w.integer("value", Need::Required, type_min(*type), type_max(*type));
+    if (has_type) value = w.integer("value", Need::Required, type_min(type), type_max(type));
     else if (!w.has("value")) w.error("value", "missing required field");
     const auto why = w.string("why", Need::Required);
     if (why && why->empty()) w.error("why", "must say why the drive needs this write (it is shown when the write fails)");
@@ -323,14 +327,14 @@ void read_startup_writes(const MapReader& parent, std::string_view key, const st
       w.error("object", hex_text(*id) + " " + *reason);
       continue;
     }
-    if (type) check_known_type(object_node, w.field("object"), src, *id, *type);
+    if (has_type) check_known_type(object_node, w.field("object"), src, *id, type);
     const auto dup = std::find_if(written.begin(), written.end(), [&](const Mapped& x) { return x.id == *id; });
     if (dup != written.end()) {
       w.error("object", hex_text(*id) + " is already written by " + dup->path);
       continue;
     }
     written.push_back({*id, w.path(), object_node.Mark()});
-    if (type && value && why) out.push_back({{*id, *type}, *value, *why});
+    if (has_type && value && why) out.push_back({{*id, type}, *value, *why});
   }
 }
 

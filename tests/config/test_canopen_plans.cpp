@@ -167,12 +167,12 @@ TEST(CanopenPlans, CheckConfigShowsTheCanopenPlan) {
             std::string::npos) << text;
   EXPECT_NE(text.find("SYNC:            every 4ms"), std::string::npos) << text;
   // 3 axes (AKD, NORD, SD6) at 1 Mbit/s: the estimate with worst-case stuffing.
-  EXPECT_NE(text.find("load:            21 frames, 2311 bits = 2.31 ms per 4 ms SYNC cycle at 1000 kbit/s (58 %)"),
+  EXPECT_NE(text.find("load:            18 frames, 1969 bits = 1.97 ms per 4 ms SYNC cycle at 1000 kbit/s (49 %)"),
             std::string::npos) << text;
   EXPECT_NE(text.find("node-ID:               5"), std::string::npos) << text;
   EXPECT_NE(text.find("RPDO 1:                sync (type 1): 6040h u16, 6060h i8, 6071h i16 (5 bytes)"),
             std::string::npos) << text;
-  EXPECT_NE(text.find("TPDO 3:                event (type 255, inhibit 1ms, timer 100ms): 1002h u32 (4 bytes)"),
+  EXPECT_NE(text.find("TPDO 3:                event (type 255, inhibit 10ms, timer 100ms): 1002h u32 (4 bytes)"),
             std::string::npos) << text;
   EXPECT_NE(text.find("RPDO 1:                event (type 255): 6040h u16, 6042h i16, 6060h i8 (5 bytes, sent as 8)"),
             std::string::npos) << text;
@@ -193,12 +193,12 @@ TEST(CanopenPlans, CheckConfigShowsTheCanopenPlan) {
 // gets a warning.
 TEST(CanopenPlanErrors, BusLoadMustFitTheCycle) {
   std::string yaml = kValid;
-  yaml.replace(yaml.find("cycle_time: 4ms"), 15, "cycle_time: 2ms");
-  EXPECT_REPORTED(errors_of(yaml, test_options(), kLabel), "plan.yaml:3:5: buses[0]: bus load 19 frames, 2101 bits = 2.1 ms per 2 ms SYNC "
-                                        "cycle at 1000 kbit/s (105 %): it cannot fit; lengthen cycle_time, raise the "
+  yaml.replace(yaml.find("cycle_time: 4ms"), 15, "cycle_time: 1ms");
+  EXPECT_REPORTED(errors_of(yaml, test_options(), kLabel), "plan.yaml:3:5: buses[0]: bus load 17 frames, 1910 bits = 1.91 ms per 1 ms SYNC "
+                                        "cycle at 1000 kbit/s (191 %): it cannot fit; lengthen cycle_time, raise the "
                                         "bit rate or map fewer PDOs");
-  yaml.replace(yaml.find("cycle_time: 2ms"), 15, "cycle_time: 4ms");
-  yaml.replace(yaml.find("bitrate: 1000000"), 16, "bitrate: 800000");  // 2311 bits = 2.89 ms: 72 %
+  yaml.replace(yaml.find("cycle_time: 1ms"), 15, "cycle_time: 4ms");
+  yaml.replace(yaml.find("bitrate: 1000000"), 16, "bitrate: 500000");  // 1969 bits = 3.94 ms: 98 %
   const Plan plan = load_plan_from_string(yaml, kLabel, test_options());
   bool warned = false;
   for (const auto& w : plan.warnings) warned = warned || w.find("little room is left") != std::string::npos;

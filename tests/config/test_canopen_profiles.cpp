@@ -80,7 +80,7 @@ TEST(CanopenProfiles, KollmorgenAkd) {
     EXPECT_TRUE(lists(p, id)) << object_text(id);
   ASSERT_EQ(co.tpdos.size(), 3U);
   EXPECT_EQ(co.tpdos[2].transmission_type, 255);
-  EXPECT_EQ(co.tpdos[2].inhibit_time_100us, 10);
+  EXPECT_EQ(co.tpdos[2].inhibit_time_100us, 100);
   EXPECT_EQ(co.tpdos[2].event_timer_ms, 100);
   EXPECT_TRUE(p.quirk("homing_objects_not_pdo_mappable"));
   EXPECT_TRUE(p.quirk("no_sync_producer"));

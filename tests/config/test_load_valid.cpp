@@ -144,7 +144,7 @@ TEST(LoadValid, FixedDeviceUnitsAndDefaults) {
 TEST(LoadValid, DemoConfigLoads) {
   const Plan plan = load_plan(DRIVEGATE_DEMO_CONFIG);
   EXPECT_TRUE(plan.warnings.empty());
-  ASSERT_EQ(plan.buses.size(), 1U);
+  ASSERT_EQ(plan.buses.size(), 2U);
   const BusPlan& bus = plan.buses[0];
   EXPECT_EQ(bus.type, "sim");
   EXPECT_EQ(bus.cycle_time, core::Duration{1ms});
@@ -168,6 +168,15 @@ TEST(LoadValid, DemoConfigLoads) {
   EXPECT_NE(std::find(sim_methods.begin(), sim_methods.end(), table.spec.homing.method), sim_methods.end());
   EXPECT_TRUE(table.sim.negative_limit_switch_position.has_value());
   EXPECT_TRUE(table.sim.home_switch_position.has_value());
+
+  // The CANopen bus: one simulated drive of each reference type.
+  const BusPlan& can = plan.buses[1];
+  EXPECT_EQ(can.type, "canopen");
+  EXPECT_EQ(can.canopen.transport, CanTransportKind::Simulated);
+  ASSERT_EQ(can.axes.size(), 3U);
+  EXPECT_EQ(can.axes[0].device.name, "kollmorgen-akd");
+  EXPECT_EQ(can.axes[1].device.name, "nord-sk500p");
+  EXPECT_EQ(can.axes[2].device.name, "stoeber-sd6");
 }
 
 TEST(LoadValid, DescribePlanShowsTheImportantNumbers) {
