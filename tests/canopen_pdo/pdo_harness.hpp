@@ -79,8 +79,8 @@ class FakeObjects final : public sim::PdoObjects {
   }
 
   void add(ObjectDef def, bool rx, bool tx) { objects_[size_++] = {def, rx, tx, 0}; }
-  void set(cia402::ObjectId id, std::int64_t v) noexcept { find(id)->value = v; }
-  [[nodiscard]] std::int64_t get(cia402::ObjectId id) const noexcept { return find(id)->value; }
+  void set(cia402::ObjectId id, std::int64_t v) noexcept { at(id).value = v; }
+  [[nodiscard]] std::int64_t get(cia402::ObjectId id) const noexcept { return at(id).value; }
   [[nodiscard]] std::size_t writes() const noexcept { return writes_; }
 
   [[nodiscard]] std::optional<DataType> mappable(cia402::ObjectId id, bool receive) const noexcept override {
@@ -88,9 +88,9 @@ class FakeObjects final : public sim::PdoObjects {
     if (o == nullptr || !(receive ? o->rx : o->tx)) return std::nullopt;
     return o->def.type;
   }
-  [[nodiscard]] std::int64_t read(cia402::ObjectId id) const noexcept override { return find(id)->value; }
+  [[nodiscard]] std::int64_t read(cia402::ObjectId id) const noexcept override { return at(id).value; }
   void write(cia402::ObjectId id, std::int64_t value) noexcept override {
-    find(id)->value = value;
+    at(id).value = value;
     ++writes_;
   }
 
@@ -110,8 +110,19 @@ class FakeObjects final : public sim::PdoObjects {
   Object* find(cia402::ObjectId id) noexcept {
     return const_cast<Object*>(static_cast<const FakeObjects*>(this)->find(id));
   }
+  // The object, or a scratch entry for ids the fake does not hold (the slave only asks for
+  // objects mappable() accepted, so tests never see the scratch value).
+  Object& at(cia402::ObjectId id) noexcept {
+    Object* o = find(id);
+    return o != nullptr ? *o : scratch_;
+  }
+  const Object& at(cia402::ObjectId id) const noexcept {
+    const Object* o = find(id);
+    return o != nullptr ? *o : scratch_;
+  }
 
   std::array<Object, 32> objects_{};
+  Object scratch_{};
   std::size_t size_ = 0;
   std::size_t writes_ = 0;
 };

@@ -30,10 +30,17 @@ bool lists(const DeviceProfile& p, ObjectId id) {
   return std::find(p.cyclic_objects.begin(), p.cyclic_objects.end(), id) != p.cyclic_objects.end();
 }
 
-const StartupWrite* write_of(const DeviceProfile& p, ObjectId id) {
+bool has_write(const DeviceProfile& p, ObjectId id) {
   for (const auto& w : p.canopen.startup_writes)
-    if (w.def.id == id) return &w;
-  return nullptr;
+    if (w.def.id == id) return true;
+  return false;
+}
+// The profile's start-up write of `id` (an empty one when there is none: has_write() says).
+const StartupWrite& write_of(const DeviceProfile& p, ObjectId id) {
+  static const StartupWrite kNone{};
+  for (const auto& w : p.canopen.startup_writes)
+    if (w.def.id == id) return w;
+  return kNone;
 }
 
 TEST(CanopenProfiles, KollmorgenAkd) {
@@ -58,11 +65,13 @@ TEST(CanopenProfiles, KollmorgenAkd) {
   EXPECT_DOUBLE_EQ(n.position_per_rev, 1048576.0);
   EXPECT_DOUBLE_EQ(n.velocity_per_rps, 60000.0);
   EXPECT_DOUBLE_EQ(n.acceleration_per_rps2, 1048576.0);
-  ASSERT_NE(write_of(p, {0x36E9, 0}), nullptr);
-  EXPECT_EQ(write_of(p, {0x36E9, 0})->value & 0x11, 0x11);  // fault reset via CW only, CiA 402 scaling
-  EXPECT_EQ(write_of(p, {0x6092, 1})->value, 1048576);
-  EXPECT_EQ(write_of(p, {0x608F, 1})->value, 1048576);
-  EXPECT_EQ(write_of(p, {0x605A, 0})->def.type, cia402::DataType::I16);
+  ASSERT_TRUE(has_write(p, {0x36E9, 0}));
+  EXPECT_EQ(write_of(p, {0x36E9, 0}).value & 0x11, 0x11);  // fault reset via CW only, CiA 402 scaling
+  for (const cia402::ObjectId id : {cia402::ObjectId{0x6092, 1}, {0x608F, 1}, {0x605A, 0}})
+    ASSERT_TRUE(has_write(p, id)) << std::hex << id.index;
+  EXPECT_EQ(write_of(p, {0x6092, 1}).value, 1048576);
+  EXPECT_EQ(write_of(p, {0x608F, 1}).value, 1048576);
+  EXPECT_EQ(write_of(p, {0x605A, 0}).def.type, cia402::DataType::I16);
   // The complete EMCY table (part 1 §9.4) with the fault numbers.
   EXPECT_EQ(p.fault_texts.size(), 209U);
   EXPECT_EQ(p.fault_texts.at(0x8130), "F129: Life guard (node guarding) error or heartbeat error");
@@ -113,10 +122,12 @@ TEST(CanopenProfiles, NordSk500p) {
   ASSERT_EQ(p.cyclic_objects.size(), 15U);
   EXPECT_EQ(p.cyclic_objects.front(), (ObjectId{0x6040, 0}));
   EXPECT_EQ(p.cyclic_objects.back(), (ObjectId{0x606C, 0}));
-  ASSERT_NE(write_of(p, {0x605D, 0}), nullptr);
-  EXPECT_EQ(write_of(p, {0x605D, 0})->value, 1);
-  EXPECT_EQ(write_of(p, {0x6046, 1})->value, 0);
-  EXPECT_EQ(write_of(p, {0x608A, 0})->def.type, cia402::DataType::U8);
+  ASSERT_TRUE(has_write(p, {0x605D, 0}));
+  EXPECT_EQ(write_of(p, {0x605D, 0}).value, 1);
+  ASSERT_TRUE(has_write(p, {0x6046, 1}));
+  EXPECT_EQ(write_of(p, {0x6046, 1}).value, 0);
+  ASSERT_TRUE(has_write(p, {0x608A, 0}));
+  EXPECT_EQ(write_of(p, {0x608A, 0}).def.type, cia402::DataType::U8);
   EXPECT_NE(p.fault_texts.at(0x2310).find("unverified"), std::string::npos);
 }
 
