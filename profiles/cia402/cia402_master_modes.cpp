@@ -34,6 +34,12 @@ void Cia402Master::start_motion(const core::DriveCommand& cmd, Mode mode, core::
     mode_switching_ = true;
     mode_since_ = now;
     motion_.phase = Phase::SwitchMode;
+    // The drive follows a cyclic target from the SYNC that carries the new mode, before 6061h
+    // confirms it and hold_cyclic() takes over: the image must already hold where the axis
+    // stands, not a target an earlier mode left there (a pp target from before a homing run that
+    // moved the coordinates makes the drive jump into a following error) [AKD digest part 2 §14
+    // step 17: csp takes 607Ah at every SYNC].
+    if (core::mode_is_cyclic(mode)) write_safe_holds();
   } else {
     mode_switching_ = false;
     enter_stage(now);
