@@ -383,9 +383,10 @@ void CanopenBus::publish_counters() noexcept {
     missed += n->pdos.counters().missed;
     bad += n->pdos.counters().short_frames;
   }
-  lost_.store(missed, std::memory_order_relaxed);
-  dropped_.store(bad, std::memory_order_relaxed);
+  // What the transport could not decode (a garbage datagram on udp-multicast) is dropped input too.
   const auto t = transport_->counters();
+  lost_.store(missed, std::memory_order_relaxed);
+  dropped_.store(bad + t.rx_malformed, std::memory_order_relaxed);
   errors_.store(t.error_frames + t.bus_off, std::memory_order_relaxed);
 }
 
