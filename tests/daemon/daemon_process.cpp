@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
+#include <sys/prctl.h>
 #include <sys/socket.h>
 #include <sys/un.h>
 #include <sys/wait.h>
@@ -39,6 +40,14 @@ std::string write_demo_config(const std::string& gateway, const DdsIsolation& dd
   const std::string path = temp_path(gateway + ".yaml");
   std::ofstream out(path);
   out << root << "\n";
+  return path;
+}
+
+std::string write_config_text(const std::string& stem, const std::string& yaml) {
+  const std::string path = temp_path(stem + ".yaml");
+  std::ofstream out(path);
+  out << yaml;
+  if (!out) throw std::runtime_error("cannot write " + path);
   return path;
 }
 
@@ -90,9 +99,14 @@ bool NotifySocket::wait_for(const std::string& what, std::chrono::milliseconds t
 
 DaemonProcess::DaemonProcess(const std::string& config, const std::string& notify_socket)
     : log_path_(config + ".log") {
+  const pid_t parent = getpid();
   pid_ = fork();
   if (pid_ < 0) throw std::runtime_error("fork failed");
   if (pid_ == 0) {
+    // Killed with the thread that started it (the test's), even when the test crashes; the check
+    // covers a parent that died before prctl() took effect.
+    prctl(PR_SET_PDEATHSIG, SIGKILL);
+    if (getppid() != parent) _exit(127);
     const int fd = open(log_path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     dup2(fd, STDOUT_FILENO);
     dup2(fd, STDERR_FILENO);
@@ -124,6 +138,13 @@ std::optional<int> DaemonProcess::terminate(int signal, std::chrono::millisecond
     std::this_thread::sleep_for(std::chrono::milliseconds(10));  // polling waitpid for a child's exit
   }
   return std::nullopt;
+}
+
+bool DaemonProcess::running() {
+  if (pid_ <= 0) return false;
+  if (waitpid(pid_, nullptr, WNOHANG) == 0) return true;
+  pid_ = -1;
+  return false;
 }
 
 std::string DaemonProcess::log() const {

@@ -1,7 +1,8 @@
 #pragma once
 // Runs the real drivegated binary for an integration test: a config made from config/demo.yaml
 // with the test's own gateway name, DDS domain and topic namespace, a NOTIFY_SOCKET the test
-// listens on, and the daemon's log in a file. The process is killed when the object goes.
+// listens on, and the daemon's log in a file. The process is killed when the object goes, and
+// when the test process dies first (PR_SET_PDEATHSIG), so a crashed test leaves no daemon behind.
 #include <sys/types.h>
 
 #include <chrono>
@@ -23,6 +24,9 @@ DdsIsolation unique_dds(const std::string& tag);
 
 // The demo configuration with gateway name, domain and namespace replaced; returns the file path.
 std::string write_demo_config(const std::string& gateway, const DdsIsolation& dds);
+
+// A configuration given as text, in a file of this test process; returns the file path.
+std::string write_config_text(const std::string& stem, const std::string& yaml);
 
 // A NOTIFY_SOCKET like systemd's: it reads continuously (a unix datagram socket queues only a
 // few messages; a sender whose queue is full blocks, as drivegated would in sd_notify).
@@ -52,6 +56,8 @@ class DaemonProcess {
   [[nodiscard]] pid_t pid() const { return pid_; }
   // Sends a signal and waits for the exit; returns the exit status (or nullopt on timeout).
   std::optional<int> terminate(int signal, std::chrono::milliseconds timeout);
+  // Whether the daemon is still running (a daemon that ended is reaped here).
+  bool running();
   [[nodiscard]] std::string log() const;
   // Resident set size in KiB from /proc, 0 if unknown.
   [[nodiscard]] long rss_kib() const;

@@ -1,0 +1,262 @@
+#include "tests/canopen_e2e/e2e_fixture.hpp"
+
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+namespace drivegate::test {
+
+namespace {
+
+// The last `lines` lines of `text`.
+std::string tail(const std::string& text, std::size_t lines) {
+  std::size_t at = text.size();
+  for (std::size_t n = 0; n <= lines; ++n) {  // one more: the text ends with a newline
+    if (at == 0) return text;
+    at = text.rfind('\n', at - 1);
+    if (at == std::string::npos) return text;
+  }
+  return text.substr(at + 1);
+}
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// drivegated --check-config on the file; its exit status, the output in `out`.
+int check_config(const std::string& file, std::string& out) {
+  const std::string cmd = std::string(DRIVEGATED_PATH) + " --check-config " + file + " 2>&1";
+  FILE* p = ::popen(cmd.c_str(), "r");
+  if (p == nullptr) return -1;
+  char buf[512];
+  while (std::fgets(buf, sizeof buf, p) != nullptr) out += buf;
+  const int status = ::pclose(p);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+}  // namespace
+
+BusAddress unique_bus_address(unsigned slot) {
+  // RTPS puts a DDS domain's ports at 7400 + 250 x domain + 0..~60 (participants of parallel tests
+  // on domains 20..99: unique_dds()), bound without SO_REUSEADDR. The bus ports sit in the gaps
+  // between those bands, at +120..+239, in 16270..19889: clear of the simulator process tests'
+  // block (12000..15999) and the UDP transport tests' (20000..31999). Two tests may share a port:
+  // the group differs per process (the transport turns IP_MULTICAST_ALL off).
+  constexpr unsigned kFirstBand = 35;  // 7400 + 250 x 35 = 16150
+  constexpr unsigned kBands = 15;
+  constexpr unsigned kGap = 120;
+  const auto pid = static_cast<unsigned>(::getpid());
+  const unsigned index = (pid * 16 + slot) % (kBands * kGap);
+  BusAddress a;
+  a.port = static_cast<std::uint16_t>(7400 + 250 * (kFirstBand + index / kGap) + 120 + index % kGap);
+  a.group = "239.201." + std::to_string((pid >> 8) & 0xFF) + "." + std::to_string(pid & 0xFF);
+  return a;
+}
+
+std::string three_drives_config(const std::string& gateway, const DdsIsolation& dds, const BusAddress& bus) {
+  std::ostringstream y;
+  y << "gateway: { name: " << gateway << ", dds: { domain: " << dds.domain << ", namespace: " << dds.ns
+    << " }, status_rate_hz: 50 }\n"
+    << "buses:\n"
+    << "  - name: can0\n"
+    << "    type: canopen\n"
+    << "    cycle_time: 4ms\n"
+    << "    options: { transport: udp-multicast, interface: 127.0.0.1, group: " << bus.group << ", port: " << bus.port
+    << ", bitrate: 1000000 }\n"
+    << "axes:\n"
+    // 2^20 counts per motor rev on a 5 mm screw. Homing 34: the next index pulse in the positive
+    // direction, an AKD method (akd-canopen-part2-ds402.md §9.2) that moves the motor.
+    << "  - { name: akd, bus: can0, address: 1, device: kollmorgen-akd, unit: mm, mechanics: { feed: 5 },\n"
+    << "      defaults: { velocity: 50, acceleration: 500, deceleration: 500 },\n"
+    << "      homing: { method: 34, search_velocity: 10, zero_velocity: 5, acceleration: 200 } }\n"
+    // Positions in revolutions; 35 (the current position is home) is in the profile's list (§6).
+    << "  - { name: nord, bus: can0, address: 2, device: nord-sk500p,\n"
+    << "      defaults: { velocity: 10, acceleration: 100, deceleration: 100 }, homing: { method: 35 } }\n"
+    // 10000 counts per revolution as commissioned in DS6; 35 is the one method the profile lists.
+    << "  - { name: sd6, bus: can0, address: 3, device: stoeber-sd6, mechanics: { encoder_counts_per_rev: 10000 },\n"
+    << "      defaults: { velocity: 10, acceleration: 100, deceleration: 100 }, homing: { method: 35 } }\n";
+  return y.str();
+}
+
+void CanopenE2e::SetUp() {
+  static unsigned slot = 0;
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  dds_ = unique_dds(info->name());
+  bus_ = unique_bus_address(slot++);
+  yaml_ = three_drives_config("e2e", dds_, bus_);
+  config_ = write_config_text(std::string("canopen-e2e-") + info->name(), yaml_);
+  configs_.push_back(config_);
+  std::string plan;
+  ASSERT_EQ(check_config(config_, plan), 0) << plan;
+  ASSERT_NE(plan.find("load:"), std::string::npos) << plan;
+
+  sim_ = std::make_unique<SimProcess>(config_);
+  const auto ready = sim_->wait_ready(10s);
+  ASSERT_TRUE(ready) << sim_->log();
+  ASSERT_EQ(*ready, "drivegate-sim: 3 nodes on udp-multicast " + bus_.group + ":" + std::to_string(bus_.port));
+
+  start_gateway();
+  if (HasFatalFailure()) return;
+  connect_client();
+}
+
+void CanopenE2e::connect_client() {
+  client_.reset();
+  events_.clear();
+  event_cursor_ = 0;
+  client_ = std::make_unique<client::Client>(client::ClientOptions{dds_.domain, dds_.ns, "e2e-client"});
+}
+
+void CanopenE2e::TearDown() {
+  // The client first, so that nothing it waits for outlives the processes; then the gateway
+  // before its drives, as a real cell is switched off.
+  client_.reset();
+  daemon_.reset();
+  notify_.reset();
+  sim_.reset();
+  // A sanitizer's report from drivegated or drivegate-sim lands in their logs, not in this test.
+  for (const auto& c : configs_) {
+    for (const char* suffix : {".log", ".sim.log"}) {
+      const std::string log = read_file(c + suffix);
+      EXPECT_EQ(log.find("Sanitizer"), std::string::npos) << c + suffix << ":\n" << log;
+      EXPECT_EQ(log.find("runtime error:"), std::string::npos) << c + suffix << ":\n" << log;
+    }
+  }
+  // The files stay for a failed test, whose messages name them.
+  if (HasFailure()) return;
+  for (const auto& c : configs_) {
+    for (const char* suffix : {"", ".log", ".sim.log"}) std::filesystem::remove(c + suffix);
+  }
+}
+
+void CanopenE2e::start_gateway() {
+  // A restarted daemon gets a copy of the config, so that its log does not overwrite the first's.
+  const std::string file = daemon_ ? write_config_text("canopen-e2e-restart", yaml_) : config_;
+  if (file != config_) configs_.push_back(file);
+  daemon_.reset();
+  notify_ = std::make_unique<NotifySocket>();
+  daemon_ = std::make_unique<DaemonProcess>(file, notify_->path());
+  ASSERT_TRUE(notify_->wait_for("READY=1", kStartUp)) << daemon_->log();
+}
+
+void CanopenE2e::kill_gateway() {
+  const auto rc = daemon_->terminate(SIGKILL, 5s);
+  ASSERT_TRUE(rc.has_value());
+  EXPECT_EQ(*rc, 128 + SIGKILL);
+}
+
+client::CommandRequest CanopenE2e::request(const std::string& axis, const std::string& kind) const {
+  client::CommandRequest r;
+  r.axis = axis;
+  r.kind = kind;
+  return r;
+}
+
+client::CommandResult CanopenE2e::send(const client::CommandRequest& r, std::chrono::milliseconds timeout) {
+  return client_->send(r, true, timeout);
+}
+
+client::CommandResult CanopenE2e::send(const std::string& axis, const std::string& kind,
+                                       std::chrono::milliseconds timeout) {
+  return send(request(axis, kind), timeout);
+}
+
+client::AxisState CanopenE2e::state(const std::string& axis) const {
+  return client_->state(axis).value_or(client::AxisState{});
+}
+
+bool CanopenE2e::wait_axis(const std::string& axis, const std::function<bool(const client::AxisState&)>& done,
+                           std::chrono::milliseconds timeout) {
+  return client_->wait_until([&] {
+    const auto s = client_->state(axis);
+    return s && done(*s);
+  }, timeout);
+}
+
+bool CanopenE2e::wait_all(const std::string& drive_state, std::chrono::milliseconds timeout) {
+  return client_->wait_until([&] {
+    for (const char* axis : {"akd", "nord", "sd6"}) {
+      const auto s = client_->state(axis);
+      if (!s || s->link != "operational" || s->state != drive_state) return false;
+    }
+    return true;
+  }, timeout);
+}
+
+bool CanopenE2e::keep_alive_until(const std::string& axis, double position, double velocity, double torque,
+                                  const std::function<bool(const client::AxisState&)>& done,
+                                  std::chrono::milliseconds timeout) {
+  const auto end = std::chrono::steady_clock::now() + timeout;
+  while (std::chrono::steady_clock::now() < end) {
+    const std::string error = client_->stream_setpoint(axis, {}, position, velocity, torque);
+    EXPECT_TRUE(error.empty()) << error;
+    if (wait_axis(axis, done, 20ms)) return true;
+  }
+  return false;
+}
+
+double CanopenE2e::stream_ramp(const std::string& axis, double speed, std::chrono::milliseconds duration) {
+  constexpr auto kPeriod = 10ms;
+  const double start = state(axis).position;
+  double target = start;
+  auto next = std::chrono::steady_clock::now();
+  for (auto left = duration; left > 0ms; left -= kPeriod) {
+    target += speed * std::chrono::duration<double>(kPeriod).count();
+    const std::string error = client_->stream_setpoint(axis, {}, target, 0, 0);
+    EXPECT_TRUE(error.empty()) << error;
+    // The set-point generator's period (a controller's own clock), not a wait for the gateway.
+    next += kPeriod;
+    std::this_thread::sleep_until(next);
+  }
+  return target;
+}
+
+const std::vector<client::AxisEvent>& CanopenE2e::events() {
+  for (auto& e : client_->events_since(event_cursor_)) events_.push_back(std::move(e));
+  return events_;
+}
+
+bool CanopenE2e::wait_event(const std::string& axis, const std::string& kind, const std::string& what,
+                            std::chrono::milliseconds timeout) {
+  return client_->wait_until([&] {
+    for (const auto& e : events()) {
+      if (e.axis == axis && e.kind == kind &&
+          (e.text.find(what) != std::string::npos || e.state.find(what) != std::string::npos))
+        return true;
+    }
+    return false;
+  }, timeout);
+}
+
+std::optional<client::BusStatus> CanopenE2e::bus_status() const {
+  for (const auto& b : client_->buses())
+    if (b.bus == "can0") return b;
+  return std::nullopt;
+}
+
+std::string CanopenE2e::diagnostics() {
+  std::ostringstream d;
+  d << "\n--- axes:";
+  if (client_) {
+    for (const auto& s : client_->states())
+      d << "\n  " << s.axis << ": link " << s.link << ", " << s.state << ", mode " << s.mode << ", pos " << s.position
+        << ", vel " << s.velocity << ", fault 0x" << std::hex << s.fault_code << std::dec << " " << s.fault_text;
+  }
+  if (sim_) d << "\n--- simulator: " << sim_->command("status") << "\n" << tail(sim_->log(), 20);
+  if (daemon_) d << "\n--- drivegated (end of log):\n" << tail(daemon_->log(), 60);
+  d << "\n--- files:";
+  for (const auto& c : configs_) d << " " << c << "{,.log,.sim.log}";
+  return d.str();
+}
+
+}  // namespace drivegate::test

@@ -1,0 +1,62 @@
+// Parameters over the DDS parameter topic, answered by the simulated SD6 over SDO: a read by the
+// drive's own parameter name, and SDO aborts surfacing as replies with their text.
+#include "tests/canopen_e2e/e2e_fixture.hpp"
+
+namespace drivegate::test {
+namespace {
+
+class CanopenE2eParameters : public CanopenE2eUp {
+ protected:
+  client::ParamResult param(client::ParamRequest r) {
+    r.axis = "sd6";
+    return client_->param(r, 5s);
+  }
+};
+
+TEST_F(CanopenE2eParameters, Sd6ParameterByNameAndSdoAborts) {
+  // A83 is the SD6's bus address: 2000h + group A (0) x 200h + line 83 = 2053h:00
+  // (stoeber-sd6-canopen.md §2.2), the node-ID 3.
+  client::ParamRequest a83;
+  a83.name = "A83";
+  auto r = param(a83);
+  ASSERT_TRUE(r.ok) << r.error << diagnostics();
+  EXPECT_EQ(r.value, 3);
+  EXPECT_EQ(r.index, 0x2053);
+  EXPECT_EQ(r.subindex, 0);
+  EXPECT_EQ(r.gateway, "e2e");
+
+  // E200 resolves (TV-6: 28C8h:00) but this drive has no such object: the SDO abort comes back as
+  // the reply, with its code and text.
+  client::ParamRequest e200;
+  e200.name = "E200";
+  r = param(e200);
+  EXPECT_FALSE(r.ok);
+  EXPECT_EQ(r.index, 0x28C8);
+  EXPECT_EQ(r.error_code, 0x06020000U) << r.error;
+  EXPECT_NE(r.error.find("object does not exist in the object dictionary"), std::string::npos) << r.error;
+
+  // Writing the read-only bus address is refused by the drive in the same way.
+  client::ParamRequest write_a83 = a83;
+  write_a83.write = true;
+  write_a83.value = 5;
+  r = param(write_a83);
+  EXPECT_FALSE(r.ok);
+  EXPECT_EQ(r.error_code, 0x06010002U) << r.error;
+  EXPECT_NE(r.error.find("attempt to write a read-only object"), std::string::npos) << r.error;
+
+  // A name beyond the SD6's naming scheme never reaches the bus.
+  client::ParamRequest too_far;
+  too_far.name = "A600";
+  r = param(too_far);
+  EXPECT_FALSE(r.ok);
+  EXPECT_EQ(r.error_code, 0U) << r.error;
+  EXPECT_FALSE(r.error.empty());
+
+  // The drive itself is untouched and the axis stays up.
+  r = param(a83);
+  EXPECT_TRUE(r.ok && r.value == 3) << r.error;
+  EXPECT_EQ(state("sd6").link, "operational");
+}
+
+}  // namespace
+}  // namespace drivegate::test

@@ -1,0 +1,118 @@
+#include "tests/canopen_e2e/sim_process.hpp"
+
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+namespace drivegate::test {
+
+using Clock = std::chrono::steady_clock;
+
+SimProcess::SimProcess(const std::string& config) : log_path_(config + ".sim.log") {
+  // A simulator that ended must fail the test through its missing answers, not kill the test
+  // process with SIGPIPE when a command is written to it.
+  ::signal(SIGPIPE, SIG_IGN);
+  int in[2];
+  int out[2];
+  if (::pipe2(in, O_CLOEXEC) != 0) throw std::runtime_error(std::string("pipe2: ") + std::strerror(errno));
+  if (::pipe2(out, O_CLOEXEC) != 0) {
+    ::close(in[0]);
+    ::close(in[1]);
+    throw std::runtime_error(std::string("pipe2: ") + std::strerror(errno));
+  }
+  const pid_t parent = ::getpid();
+  pid_ = ::fork();
+  if (pid_ < 0) {
+    for (int fd : {in[0], in[1], out[0], out[1]}) ::close(fd);
+    throw std::runtime_error("fork failed");
+  }
+  if (pid_ == 0) {
+    // See DaemonProcess: the simulator goes with the test that started it.
+    ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+    if (::getppid() != parent) ::_exit(127);
+    const int log = ::open(log_path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    ::dup2(in[0], STDIN_FILENO);
+    ::dup2(out[1], STDOUT_FILENO);
+    ::dup2(log, STDERR_FILENO);
+    ::execl(DRIVEGATE_SIM_PATH, DRIVEGATE_SIM_PATH, config.c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  ::close(in[0]);
+  ::close(out[1]);
+  stdin_ = in[1];
+  stdout_ = out[0];
+}
+
+SimProcess::~SimProcess() {
+  if (pid_ > 0) {
+    ::kill(pid_, SIGKILL);
+    ::waitpid(pid_, nullptr, 0);
+  }
+  ::close(stdin_);
+  ::close(stdout_);
+}
+
+std::optional<std::string> SimProcess::next_line(std::chrono::milliseconds timeout) {
+  const auto end = Clock::now() + timeout;
+  for (;;) {
+    if (const auto nl = buffer_.find('\n'); nl != std::string::npos) {
+      std::string line = buffer_.substr(0, nl);
+      buffer_.erase(0, nl + 1);
+      return line;
+    }
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(end - Clock::now()).count();
+    if (left <= 0) return std::nullopt;
+    pollfd p{stdout_, POLLIN, 0};
+    if (::poll(&p, 1, static_cast<int>(left)) <= 0) continue;
+    char chunk[512];
+    const ssize_t n = ::read(stdout_, chunk, sizeof chunk);
+    if (n <= 0) return std::nullopt;  // the simulator ended
+    buffer_.append(chunk, static_cast<std::size_t>(n));
+  }
+}
+
+std::optional<std::string> SimProcess::wait_ready(std::chrono::milliseconds timeout) {
+  return next_line(timeout);
+}
+
+std::string SimProcess::command(const std::string& line, std::chrono::milliseconds timeout) {
+  const std::string l = line + "\n";
+  if (::write(stdin_, l.data(), l.size()) != static_cast<ssize_t>(l.size())) return {};
+  return next_line(timeout).value_or("");
+}
+
+bool SimProcess::wait_status(const std::function<bool(const std::string&)>& done, std::chrono::milliseconds timeout,
+                             std::string& last) {
+  for (const auto end = Clock::now() + timeout;;) {
+    last = command("status");
+    if (done(last)) return true;
+    if (Clock::now() >= end) return false;
+    ::poll(nullptr, 0, 20);  // the pace of the status requests; each answer is the condition
+  }
+}
+
+std::string SimProcess::log() const {
+  std::ifstream in(log_path_);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::string node_status(const std::string& status, const std::string& bus, int node) {
+  const std::string key = " " + bus + ":" + std::to_string(node) + " ";
+  const auto at = status.find(key);
+  if (at == std::string::npos) return {};
+  const auto end = status.find(';', at);
+  return status.substr(at + 1, end == std::string::npos ? std::string::npos : end - at - 1);
+}
+
+}  // namespace drivegate::test
