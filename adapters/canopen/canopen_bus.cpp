@@ -1,6 +1,7 @@
 #include "adapters/canopen/canopen_bus.hpp"
 
 #include <algorithm>
+#include <thread>
 
 #include "adapters/canopen/boot_plan.hpp"
 #include "profiles/cia402/master_settings.hpp"
@@ -89,6 +90,10 @@ CanopenBus::CanopenBus(const config::BusPlan& plan, std::unique_ptr<Transport> t
     auto n = std::make_unique<Node>(static_cast<int>(i), build_boot_steps(a, plan));
     n->id = static_cast<NodeId>(a.address);
     n->channel = static_cast<int>(i);
+    if (a.device.canopen.error_control == config::ErrorControl::Guarding)
+      n->watchdog = {0x100C, 0};
+    else if (a.device.canopen.consumer_heartbeat)
+      n->watchdog = {0x1016, 1};
     const NodePdoConfig pdo = build_pdo_config(a);
     if (!n->pdos.configure(pdo.rpdos, pdo.tpdos))
       throw core::BusError("bus '" + name_ + "' axis '" + a.spec.name + "': PDO maps exceed the process image");
@@ -117,6 +122,7 @@ void CanopenBus::open(core::TimePoint now) {
 
 void CanopenBus::close() noexcept {
   if (!open_) return;
+  release_watchdogs();
   // Leave the drives pre-operational (SD6 gateway step B15: before guarding and SYNC stop, so a
   // life-guarding fault is not raised), then release the transport.
   for (auto& n : nodes_) nmt_.command(NmtCommand::EnterPreOperational, n->id, tx_);
@@ -125,6 +131,43 @@ void CanopenBus::close() noexcept {
   transport_->close();
   open_ = false;
   for (auto& n : nodes_) n->link.store(core::LinkState::Offline, std::memory_order_relaxed);
+}
+
+// An orderly stop is not a lost gateway: the drives stop watching it (consumer heartbeat 1016h:01
+// or guard time 100Ch := 0) before its heartbeat and guarding RTRs end, so they do not fault
+// (AKD F129, SD6 event 52). Not cyclic: the cycle thread has stopped, so this may wait, briefly.
+void CanopenBus::release_watchdogs() noexcept {
+  std::array<SdoRequestId, 128> requests{};
+  std::size_t pending = 0;
+  for (std::size_t i = 0; i < nodes_.size(); ++i) {
+    Node& n = *nodes_[i];
+    if (n.phase != Phase::Operational || n.watchdog.index == 0) continue;
+    requests[i] = sdo_.write(n.channel, n.watchdog, 0, n.watchdog.index == 0x1016 ? 4 : 2);
+    if (requests[i] != kNoSdoRequest) ++pending;
+  }
+  // Time goes on from the last cycle's time line (the daemon's is the monotonic clock; a test's
+  // is virtual) by the real time that passes here.
+  const core::SteadyClock clock;
+  const auto start = clock.now();
+  const auto budget = options_.sdo_timeout * (options_.sdo_retries + 1);
+  while (pending > 0 && clock.now() - start < budget) {
+    const auto now = last_now_ + (clock.now() - start);
+    if (peer_) peer_->step(now);
+    const std::size_t got = transport_->receive(rx_buffer_, now);
+    for (std::size_t i = 0; i < got; ++i)
+      if (split_cob_id(rx_buffer_[i].id).function == Function::SdoTx) sdo_.on_frame(rx_buffer_[i], now);
+    sdo_.poll(now, tx_);
+    flush(now);
+    for (std::size_t i = 0; i < nodes_.size(); ++i) {
+      if (requests[i] == kNoSdoRequest) continue;
+      const auto status = sdo_.result(requests[i]).status;
+      if (status == SdoStatus::Queued || status == SdoStatus::InFlight) continue;
+      sdo_.take(requests[i]);
+      requests[i] = kNoSdoRequest;
+      --pending;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
 }
 
 core::LinkState CanopenBus::link_state(std::size_t axis) const noexcept {
@@ -172,6 +215,7 @@ void CanopenBus::fail_node(Node& n, core::TimePoint now) noexcept {
 
 void CanopenBus::receive(core::TimePoint now) noexcept {
   if (!open_) return;
+  last_now_ = now;
   if (peer_) peer_->step(now);
   for (;;) {
     const std::size_t got = transport_->receive(rx_buffer_, now);
@@ -240,8 +284,7 @@ void CanopenBus::handle_nmt_events(core::TimePoint now) noexcept {
       case NmtEventKind::BootUp:
         // The node (re)started: its configuration is gone. Reconfigure it from scratch.
         if (n->phase == Phase::Operational) n->had_link = true;
-        if (n->phase == Phase::Operational || n->phase == Phase::Configuring)
-          n->detail.format("node %u rebooted: configuring it again", unsigned{n->id});
+        n->detail.format("node %u booted: configuring it", unsigned{n->id});
         drop_node(*n, Phase::Configuring, now);
         ++n->boots;
         n->boot.start();

@@ -89,6 +89,7 @@ class CanopenBus final : public core::Bus {
     core::Duration backoff{};
     SdoRequestId probe = kNoSdoRequest;
     bool had_link = false;  // was operational before: a loss shows as Lost, not Offline
+    cia402::ObjectId watchdog{};  // how the drive watches the gateway (1016h:01 or 100Ch); index 0: not
     std::uint64_t boots = 0;
     core::FixedString<200> detail;
     std::atomic<core::LinkState> link{core::LinkState::Offline};
@@ -104,6 +105,7 @@ class CanopenBus final : public core::Bus {
   void fail_node(Node& n, core::TimePoint now) noexcept;
   Node* node_by_id(NodeId id) noexcept { return id <= kMaxNodeId ? by_id_[id] : nullptr; }
   void flush(core::TimePoint now) noexcept;
+  void release_watchdogs() noexcept;
   void publish_counters() noexcept;
 
   std::string name_;
@@ -130,6 +132,7 @@ class CanopenBus final : public core::Bus {
   TxQueue tx_;
   std::array<CanFrame, 64> rx_buffer_{};
   bool open_ = false;
+  core::TimePoint last_now_{};  // the last cycle's time
   ControllerState controller_ = ControllerState::Active;
   std::uint64_t unexpected_ = 0;
   std::uint64_t tx_dropped_ = 0;

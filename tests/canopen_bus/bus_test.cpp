@@ -347,3 +347,26 @@ TEST(CanopenBusParameters, ReadsWritesAndAbortsOverSdo) {
 
 }  // namespace
 }  // namespace drivegate::canopen::test
+
+namespace drivegate::canopen::test {
+namespace {
+
+// An orderly stop of the gateway is not a lost gateway: the drives are told to stop watching it
+// before its heartbeat ends, and none of them faults afterwards.
+TEST(CanopenBusShutdown, OrderlyCloseReleasesTheDrivesWatchdogs) {
+  BusHarness h;
+  ASSERT_TRUE(h.run_until([&] { return h.all_up(); }, 5s)) << h.events_text();
+  h.bus->close();  // takes up to a few hundred ms of real time past the last cycle
+  auto t = h.now + 1s;
+  for (int i = 0; i < 500; ++i) {  // 2 s more, far beyond every heartbeat and life time
+    t += 4ms;
+    h.peer->step(t);
+  }
+  for (const char* name : {"akd", "nord", "sd6"}) {
+    EXPECT_EQ(h.drive(name).counters().comm_losses, 0U) << name;
+    EXPECT_EQ(h.drive(name).fault_code(), 0U) << name;
+  }
+}
+
+}  // namespace
+}  // namespace drivegate::canopen::test
