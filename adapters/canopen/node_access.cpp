@@ -1,21 +1,6 @@
 #include "adapters/canopen/node_access.hpp"
 
 namespace drivegate::canopen {
-namespace {
-
-std::int64_t sign_extend(std::uint32_t raw, cia402::DataType t) noexcept {
-  switch (t) {
-    case cia402::DataType::I8: return static_cast<std::int8_t>(raw & 0xFF);
-    case cia402::DataType::I16: return static_cast<std::int16_t>(raw & 0xFFFF);
-    case cia402::DataType::I32: return static_cast<std::int32_t>(raw);
-    case cia402::DataType::U8: return raw & 0xFF;
-    case cia402::DataType::U16: return raw & 0xFFFF;
-    case cia402::DataType::U32: return raw;
-  }
-  return raw;
-}
-
-}  // namespace
 
 NodeAccess::Pending* NodeAccess::slot_for(SdoRequestId id) noexcept {
   for (auto& p : pending_)
@@ -56,7 +41,7 @@ cia402::RequestResult NodeAccess::poll(cia402::RequestId id) noexcept {
       const auto type = p->type;
       sdo_.take(id);
       *p = {};
-      return {cia402::RequestState::Done, sign_extend(r.value, type), 0};
+      return {cia402::RequestState::Done, cia402::normalise(type, r.value), 0};
     }
     case SdoStatus::Failed:
       sdo_.take(id);

@@ -22,6 +22,17 @@ constexpr std::uint8_t size_of(DataType t) noexcept {
 constexpr bool is_signed(DataType t) noexcept {
   return t == DataType::I8 || t == DataType::I16 || t == DataType::I32;
 }
+// A value as the type holds it: truncated to the type's width and sign-extended when signed (what
+// the little-endian bytes of a PDO or SDO transfer of that type mean).
+constexpr std::int64_t normalise(DataType t, std::int64_t value) noexcept {
+  const unsigned bits = 8U * size_of(t);
+  const auto mask = (std::uint64_t{1} << bits) - 1U;
+  const auto raw = static_cast<std::uint64_t>(value) & mask;
+  if (is_signed(t) && (raw >> (bits - 1U)) != 0U) return static_cast<std::int64_t>(raw | ~mask);
+  return static_cast<std::int64_t>(raw);
+}
+static_assert(normalise(DataType::I16, 0xFEF6) == -266);  // AKD part 1 §14 vector 2
+static_assert(normalise(DataType::U8, 0x1FF) == 0xFF);
 
 struct ObjectId {
   std::uint16_t index = 0;

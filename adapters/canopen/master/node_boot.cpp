@@ -9,18 +9,6 @@ bool missing_object(std::uint32_t code) noexcept {
   return code == sdo_abort_code::kNoObject || code == sdo_abort_code::kNoSubIndex;
 }
 
-std::int64_t sign_extend(std::uint32_t raw, cia402::DataType t) noexcept {
-  switch (t) {
-    case cia402::DataType::I8: return static_cast<std::int8_t>(raw & 0xFF);
-    case cia402::DataType::I16: return static_cast<std::int16_t>(raw & 0xFFFF);
-    case cia402::DataType::I32: return static_cast<std::int32_t>(raw);
-    case cia402::DataType::U8: return raw & 0xFF;
-    case cia402::DataType::U16: return raw & 0xFFFF;
-    case cia402::DataType::U32: return raw;
-  }
-  return raw;
-}
-
 }  // namespace
 
 NodeBoot::NodeBoot(int sdo_channel, std::vector<BootStep> steps) : channel_(sdo_channel), steps_(std::move(steps)) {}
@@ -77,9 +65,9 @@ NodeBoot::Status NodeBoot::step(SdoClient& sdo, ProcessImage& image) noexcept {
     fail_abort(s, r.abort_code);
     return status_;
   }
-  if (s.kind == BootStep::Kind::Seed) image.set(s.def.id, sign_extend(r.value, s.def.type));
+  if (s.kind == BootStep::Kind::Seed) image.set(s.def.id, cia402::normalise(s.def.type, r.value));
   if (s.kind == BootStep::Kind::Expect) {
-    const auto got = static_cast<std::uint32_t>(sign_extend(r.value, s.def.type) & 0xFFFFFFFF);
+    const auto got = static_cast<std::uint32_t>(cia402::normalise(s.def.type, r.value) & 0xFFFFFFFF);
     const auto want = static_cast<std::uint32_t>(s.value & 0xFFFFFFFF);
     if ((got & s.mask) != (want & s.mask)) {
       status_ = Status::Failed;

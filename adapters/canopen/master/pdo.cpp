@@ -6,15 +6,6 @@
 namespace drivegate::canopen {
 namespace {
 
-// A value as the type holds it: truncated to its width, sign-extended when signed.
-std::int64_t normalise(cia402::DataType type, std::int64_t value) noexcept {
-  const unsigned bits = 8U * cia402::size_of(type);
-  const auto mask = (std::uint64_t{1} << bits) - 1U;
-  const auto raw = static_cast<std::uint64_t>(value) & mask;
-  if (cia402::is_signed(type) && (raw >> (bits - 1U)) != 0U) return static_cast<std::int64_t>(raw | ~mask);
-  return static_cast<std::int64_t>(raw);
-}
-
 constexpr bool synchronous(std::uint8_t transmission_type) noexcept { return transmission_type <= 240; }
 constexpr bool rtr_only(std::uint8_t transmission_type) noexcept {
   return transmission_type > 240 && transmission_type < 254;
@@ -71,7 +62,7 @@ std::int64_t ProcessImage::get(cia402::ObjectId id) const noexcept {
 void ProcessImage::set(cia402::ObjectId id, std::int64_t value) noexcept {
   for (std::size_t i = 0; i < size_; ++i) {
     if (entries_[i].def.id == id) {
-      entries_[i].value = normalise(entries_[i].def.type, value);
+      entries_[i].value = cia402::normalise(entries_[i].def.type, value);
       return;
     }
   }

@@ -22,18 +22,6 @@ constexpr std::uint32_t kSaveSignature = 0x65766173;
 // COB-ID bits 30..11: generate/dynamic, 29-bit frame, extended id bits. None is used here.
 constexpr std::uint32_t kCobUnsupported = 0x7FFFF800U;
 
-std::int64_t normalise(DataType type, std::uint32_t raw) noexcept {
-  switch (type) {
-    case DataType::I8: return static_cast<std::int8_t>(raw);
-    case DataType::U8: return static_cast<std::uint8_t>(raw);
-    case DataType::I16: return static_cast<std::int16_t>(raw);
-    case DataType::U16: return static_cast<std::uint16_t>(raw);
-    case DataType::I32: return static_cast<std::int32_t>(raw);
-    case DataType::U32: return raw;
-  }
-  return raw;
-}
-
 std::uint32_t to_raw(std::int64_t value, std::uint8_t size) noexcept {
   const auto bits = static_cast<std::uint32_t>(value);  // two's complement, as on the wire
   return size >= 4 ? bits : bits & ((1U << (8U * size)) - 1U);
@@ -478,7 +466,7 @@ std::uint32_t SlaveNode::write_value(ObjectId id, std::uint32_t raw, std::size_t
   if (const VendorObject* v = vendor_object(id)) {
     if (v->access == Access::ReadOnly) return abort::kReadOnly;
     if (size != cia402::size_of(v->def.type)) return abort::kTypeMismatch;
-    return vendor_.set(id, normalise(v->def.type, raw));
+    return vendor_.set(id, cia402::normalise(v->def.type, raw));
   }
   if (hidden(id)) return abort::kNoObject;
   const auto& od = model_.dictionary();
@@ -490,7 +478,7 @@ std::uint32_t SlaveNode::write_value(ObjectId id, std::uint32_t raw, std::size_t
   }
   if (od.access_of(id) == Access::ReadOnly) return abort::kReadOnly;
   if (size != cia402::size_of(*type)) return abort::kTypeMismatch;
-  const auto value = normalise(*type, raw);
+  const auto value = cia402::normalise(*type, raw);
   if (p.mode_zero_refused && id == cia402::obj::kModesOfOperation.id && value == 0) return abort::kValueRange;
   return model_.write_object(id, value);
 }

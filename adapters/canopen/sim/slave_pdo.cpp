@@ -27,19 +27,6 @@ int slot_of(std::uint16_t index, bool& mapping) noexcept {
   }
 }
 
-// A value as the type holds it: truncated to its width, sign-extended when signed.
-std::int64_t normalise(cia402::DataType type, std::uint32_t raw) noexcept {
-  switch (type) {
-    case cia402::DataType::I8: return static_cast<std::int8_t>(raw);
-    case cia402::DataType::U8: return static_cast<std::uint8_t>(raw);
-    case cia402::DataType::I16: return static_cast<std::int16_t>(raw);
-    case cia402::DataType::U16: return static_cast<std::uint16_t>(raw);
-    case cia402::DataType::I32: return static_cast<std::int32_t>(raw);
-    case cia402::DataType::U32: return raw;
-  }
-  return raw;
-}
-
 std::uint8_t comm_size(std::uint8_t sub) noexcept {
   switch (sub) {
     case 1: return 4;
@@ -235,7 +222,7 @@ void SlavePdos::set_operational(bool on) noexcept {
 void SlavePdos::apply(Pdo& pdo, std::span<const std::uint8_t> data) noexcept {
   for (std::size_t i = 0; i < pdo.layout.count; ++i) {
     const auto& f = pdo.layout.fields[i];
-    objects_.write(f.id, normalise(f.type, get_le(data, f.offset, cia402::size_of(f.type))));
+    objects_.write(f.id, cia402::normalise(f.type, get_le(data, f.offset, cia402::size_of(f.type))));
   }
   ++counters_.rpdos_applied;
 }

@@ -12,6 +12,8 @@
 #include <system_error>
 #include <utility>
 
+#include "adapters/canopen/transport/fd_guard.hpp"
+
 namespace drivegate::canopen {
 namespace {
 
@@ -32,21 +34,6 @@ std::string hex(std::uint32_t v) {
 }
 
 std::int64_t ns_of(const timespec& t) noexcept { return std::int64_t{t.tv_sec} * kNsPerSecond + t.tv_nsec; }
-
-class FdGuard {
- public:
-  explicit FdGuard(int fd) noexcept : fd_(fd) {}
-  ~FdGuard() {
-    if (fd_ >= 0) ::close(fd_);
-  }
-  FdGuard(const FdGuard&) = delete;
-  FdGuard& operator=(const FdGuard&) = delete;
-  [[nodiscard]] int get() const noexcept { return fd_; }
-  int release() noexcept { return std::exchange(fd_, -1); }
-
- private:
-  int fd_;
-};
 
 template <typename T>
 void set_option(int fd, int level, int name, const T& value, const char* name_text) {

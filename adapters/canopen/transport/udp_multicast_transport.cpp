@@ -8,6 +8,8 @@
 #include <system_error>
 #include <utility>
 
+#include "adapters/canopen/transport/fd_guard.hpp"
+
 namespace drivegate::canopen {
 namespace {
 
@@ -18,22 +20,6 @@ constexpr std::size_t kDiscardBudget = 64;
 std::string errno_text(int e) { return std::system_category().message(e); }
 
 [[noreturn]] void fail(const std::string& what) { throw TransportError("udp-multicast: " + what); }
-
-// Closes the socket unless released, so that a failing open() leaves nothing behind.
-class FdGuard {
- public:
-  explicit FdGuard(int fd) noexcept : fd_(fd) {}
-  ~FdGuard() {
-    if (fd_ >= 0) ::close(fd_);
-  }
-  FdGuard(const FdGuard&) = delete;
-  FdGuard& operator=(const FdGuard&) = delete;
-  [[nodiscard]] int get() const noexcept { return fd_; }
-  int release() noexcept { return std::exchange(fd_, -1); }
-
- private:
-  int fd_;
-};
 
 int udp_socket() {
   const int fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
