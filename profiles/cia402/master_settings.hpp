@@ -21,7 +21,8 @@ struct MasterSettings {
   // |velocity actual| (606Ch, 6044h in vl) at or below this counts as standstill for mode changes
   // [AKD digest §3.6], in drive units. Real drives jitter a few counts at rest, so 0 would refuse
   // every mode change on a servo holding position; 10 is a few encoder counts/s (0.01 rpm on the
-  // AKD's 1/1000 rpm). settings_from() widens it to 0.2% of the axis' velocity limit.
+  // AKD's 1/1000 rpm). settings_from() widens it to 0.2% of the axis' velocity limit (or 0.01 user
+  // units per second for an axis without one).
   std::int32_t standstill_velocity = 10;
   // Status words received within this many cycles after a new target was handed over may still
   // carry the previous target's "reached" bit; completion ignores them.
@@ -39,8 +40,10 @@ inline MasterSettings settings_from(const core::AxisSpec& spec) {
   s.enable_step_timeout = spec.enable_step_timeout;
   s.homing_timeout = spec.homing.timeout;
   // 0.2% of the velocity limit (6 rpm on a 3000 rpm axis): well below any commanded motion, well
-  // above encoder jitter.
-  const double window = std::fabs(spec.limits.max_velocity * spec.units.velocity_factor()) * 0.002;
+  // above encoder jitter. Without a limit, 0.01 user units per second (0.01 mm/s, 0.6 rpm on a
+  // rev axis): a drive settling after a move in 1/1000 rpm units is not held up by the 10.
+  const double factor = std::fabs(spec.units.velocity_factor());
+  const double window = spec.limits.max_velocity > 0 ? std::fabs(spec.limits.max_velocity) * factor * 0.002 : 0.01 * factor;
   if (window > s.standstill_velocity && window < 1e9) s.standstill_velocity = static_cast<std::int32_t>(window);
   return s;
 }

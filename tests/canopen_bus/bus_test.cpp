@@ -370,3 +370,21 @@ TEST(CanopenBusShutdown, OrderlyCloseReleasesTheDrivesWatchdogs) {
 
 }  // namespace
 }  // namespace drivegate::canopen::test
+
+namespace drivegate::canopen::test {
+namespace {
+
+// A completed move is a standstill a client can act on: the next command in another mode is
+// accepted at once, also on an axis without a velocity limit (standstill window 0.01 unit/s).
+TEST(CanopenBusModes, ModeChangeRightAfterACompletedMove) {
+  BusHarness h;
+  ASSERT_TRUE(h.run_until([&] { return h.all_up(); }, 5s)) << h.events_text();
+  ASSERT_EQ(h.wait_final(h.push("akd", CommandKind::Enable), 3s), ReplyStatus::Completed);
+  const auto mv = h.push("akd", CommandKind::Move, 3.0);
+  ASSERT_EQ(h.wait_final(mv, 20s), ReplyStatus::Completed) << h.reason(mv);
+  const auto jog = h.push("akd", CommandKind::Velocity, 0, 5.0);
+  EXPECT_EQ(h.wait_final(jog, 5s), ReplyStatus::Completed) << h.reason(jog);
+}
+
+}  // namespace
+}  // namespace drivegate::canopen::test
