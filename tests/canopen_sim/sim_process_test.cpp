@@ -222,6 +222,20 @@ TEST_F(SimProcessTest, AnswersSdoOnTheUdpBusAndTakesCommands) {
   EXPECT_EQ(sim_.command("silent 5 off"), "ok silent node 5 off");
   EXPECT_TRUE(read_device_type());
 
+  // An injected SDO abort answers the next request for the object; then it reads normally again.
+  EXPECT_EQ(sim_.command("abort 5 0x1000 0x08000022"), "ok abort node 5");
+  reply = read_device_type();
+  ASSERT_TRUE(reply);
+  EXPECT_TRUE(is_frame(*reply, 0x585, {0x80, 0x00, 0x10, 0x00, 0x22, 0x00, 0x00, 0x08}));
+  EXPECT_TRUE(read_device_type());
+  // A corrupted answer arrives with the wrong length.
+  EXPECT_EQ(sim_.command("corrupt 5 1 dlc"), "ok corrupt node 5");
+  reply = read_device_type();
+  ASSERT_TRUE(reply);
+  EXPECT_EQ(reply->dlc, 7);
+  EXPECT_EQ(sim_.command("abort 5 0x1000").value_or("").rfind("error: abort takes", 0), 0U);
+  EXPECT_EQ(sim_.command("corrupt 5 0").value_or("").rfind("error: corrupt takes", 0), 0U);
+
   EXPECT_EQ(sim_.command("launch 5").value_or("").rfind("error: unknown command \"launch\"", 0), 0U);
   EXPECT_EQ(sim_.command("power-off 9"), "error: no simulated node 9");
   EXPECT_EQ(sim_.command("silent 5 maybe").value_or("").rfind("error:", 0), 0U);

@@ -34,6 +34,7 @@
 namespace {
 
 using namespace drivegate;
+using canopen::sim::FrameDamage;
 using canopen::sim::SimNetwork;
 using canopen::sim::SlaveNode;
 
@@ -74,11 +75,14 @@ std::string hex4(unsigned v) {
 }
 
 constexpr std::string_view kCommands =
-    "power-off NODE, power-on NODE, fault NODE CODE [CAUSE], clear NODE, silent NODE on|off, status";
+    "power-off NODE, power-on NODE, fault NODE CODE [CAUSE], clear NODE, silent NODE on|off, "
+    "abort NODE INDEX[:SUB] CODE, corrupt NODE COUNT [dlc|garbage], status";
 
 std::string usage_of(const std::string& verb) {
   if (verb == "fault") return "NODE CODE [CAUSE]";
   if (verb == "silent") return "NODE on|off";
+  if (verb == "abort") return "NODE INDEX[:SUB] CODE (hex index, e.g. abort 3 0x6081 0x06090031)";
+  if (verb == "corrupt") return "NODE COUNT [dlc|garbage]";
   return "NODE";
 }
 
@@ -98,7 +102,8 @@ class Simulator {
     in >> verb;
     if (verb.empty()) return "error: empty command";
     if (verb == "status") return status();
-    if (verb != "power-off" && verb != "power-on" && verb != "fault" && verb != "clear" && verb != "silent") {
+    if (verb != "power-off" && verb != "power-on" && verb != "fault" && verb != "clear" && verb != "silent" &&
+        verb != "abort" && verb != "corrupt") {
       return "error: unknown command \"" + verb + "\" (" + std::string(kCommands) + ")";
     }
     in >> node_text;
@@ -122,6 +127,32 @@ class Simulator {
     if (verb == "silent" && (arg == "on" || arg == "off")) {
       node->set_silent(arg == "on");
       return "ok silent " + id + " " + arg;
+    }
+    if (verb == "abort" && !arg.empty()) {
+      // The next SDO request for the object is answered with this abort code.
+      std::string code_text;
+      in >> code_text;
+      const auto colon = arg.find(':');
+      const auto index = parse_number(arg.substr(0, colon));
+      const auto sub = colon == std::string::npos ? std::optional<unsigned long>{0} : parse_number(arg.substr(colon + 1));
+      const auto code = parse_number(code_text);
+      if (!index || *index > 0xFFFF || !sub || *sub > 0xFF || !code || *code == 0 || *code > 0xFFFFFFFF) {
+        return "error: abort takes " + usage_of(verb);
+      }
+      node->inject_sdo_abort({static_cast<std::uint16_t>(*index), static_cast<std::uint8_t>(*sub)},
+                             static_cast<std::uint32_t>(*code));
+      return "ok abort " + id;
+    }
+    if (verb == "corrupt" && !arg.empty()) {
+      // The next COUNT frames the node sends get a wrong length or garbage data.
+      std::string how;
+      in >> how;
+      const auto count = parse_number(arg);
+      if (!count || *count == 0 || *count > 1000 || !(how.empty() || how == "dlc" || how == "garbage")) {
+        return "error: corrupt takes " + usage_of(verb) + " with COUNT 1..1000";
+      }
+      node->damage_next(static_cast<std::uint32_t>(*count), how == "garbage" ? FrameDamage::Garbage : FrameDamage::WrongDlc);
+      return "ok corrupt " + id;
     }
     if (verb == "fault") {
       std::string cause_text;
