@@ -3,6 +3,7 @@
 
 #include <vector>
 
+#include "adapters/canopen/wire/can_frame.hpp"
 #include "adapters/canopen/wire/sdo_codec.hpp"
 
 namespace drivegate::canopen {
@@ -98,6 +99,31 @@ TEST(SdoCodec, BadFramesAreReported) {
   EXPECT_EQ(decode_sdo_response(Bytes{0xE0, 0, 0, 0, 0, 0, 0, 0}).error, SdoDecodeError::UnknownCommand);
   EXPECT_EQ(decode_sdo_request(Bytes{0xE0, 0, 0, 0, 0, 0, 0, 0}).error, SdoDecodeError::UnknownCommand);
   EXPECT_EQ(decode_sdo_request(Bytes{0xC0, 0, 0, 0, 0, 0, 0, 0}).message.command, SdoCommand::Block);
+}
+
+}  // namespace
+}  // namespace drivegate::canopen
+
+namespace drivegate::canopen {
+namespace {
+
+// The byte helpers never read or write past the span or beyond 4 bytes, and a frame's payload is
+// never longer than 8 bytes whatever its dlc says.
+TEST(CanFrame, HelpersStayInBounds) {
+  const std::uint8_t bytes[6] = {1, 2, 3, 4, 5, 6};
+  EXPECT_EQ(get_le(bytes, 0, 7), 0x04030201U);
+  EXPECT_EQ(get_le(bytes, 4, 4), 0x0605U);
+  std::uint8_t out[3] = {};
+  put_le(out, 1, 4, 0xAABBCCDD);
+  EXPECT_EQ(out[0], 0);
+  EXPECT_EQ(out[1], 0xDD);
+  EXPECT_EQ(out[2], 0xCC);
+  CanFrame f;
+  f.dlc = 15;
+  EXPECT_FALSE(f.valid());
+  EXPECT_EQ(f.payload().size(), 8U);
+  f.remote = true;
+  EXPECT_TRUE(f.payload().empty());
 }
 
 }  // namespace

@@ -21,7 +21,10 @@ struct CanFrame {
   std::array<std::uint8_t, 8> data{};
   core::TimePoint timestamp{};  // reception time (set by the transport); unused when sending
 
-  [[nodiscard]] std::span<const std::uint8_t> payload() const noexcept { return {data.data(), remote ? 0U : dlc}; }
+  // The data bytes (none for a remote frame; never more than 8, whatever dlc says).
+  [[nodiscard]] std::span<const std::uint8_t> payload() const noexcept {
+    return {data.data(), remote ? 0U : (dlc > kMaxDlc ? kMaxDlc : dlc)};
+  }
   // A frame that can exist on a classic CAN bus.
   [[nodiscard]] constexpr bool valid() const noexcept {
     return dlc <= kMaxDlc && id <= (extended ? kMaxExtendedId : kMaxStandardId);
@@ -41,14 +44,15 @@ inline CanFrame make_frame(std::uint32_t id, std::initializer_list<std::uint8_t>
   return make_frame(id, std::span<const std::uint8_t>(bytes.begin(), bytes.size()));
 }
 
-// Little-endian helpers for CANopen payloads [CiA 301 §7.1: all numbers little-endian].
+// Little-endian helpers for CANopen payloads [CiA 301 §7.1: all numbers little-endian]: n bytes
+// (at most 4) from / to offset `at`, never past the end of the span.
 inline constexpr std::uint32_t get_le(std::span<const std::uint8_t> b, std::size_t at, std::size_t n) noexcept {
   std::uint32_t v = 0;
-  for (std::size_t i = 0; i < n && at + i < b.size(); ++i) v |= std::uint32_t{b[at + i]} << (8 * i);
+  for (std::size_t i = 0; i < n && i < 4 && at + i < b.size(); ++i) v |= std::uint32_t{b[at + i]} << (8 * i);
   return v;
 }
 inline constexpr void put_le(std::span<std::uint8_t> b, std::size_t at, std::size_t n, std::uint32_t v) noexcept {
-  for (std::size_t i = 0; i < n && at + i < b.size(); ++i) b[at + i] = static_cast<std::uint8_t>(v >> (8 * i));
+  for (std::size_t i = 0; i < n && i < 4 && at + i < b.size(); ++i) b[at + i] = static_cast<std::uint8_t>(v >> (8 * i));
 }
 
 }  // namespace drivegate::canopen
