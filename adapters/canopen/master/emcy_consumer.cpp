@@ -66,7 +66,7 @@ bool EmcyConsumer::on_frame(const CanFrame& frame, core::TimePoint now) noexcept
     ++counters_.unexpected;
     return true;
   }
-  const auto decoded = frame.remote ? std::nullopt : decode_emcy(frame.payload());
+  const auto decoded = frame.remote || !frame.valid() ? std::nullopt : decode_emcy(frame.payload());
   if (!decoded) {
     ++counters_.malformed;
     return true;
