@@ -86,7 +86,7 @@ TEST_F(TwoNodes, NodesHearEachOther) {
 // A `transport: sim` bus with one axis per persona.
 config::BusPlan sim_bus_plan() {
   const std::string yaml = R"(
-gateway: { name: t6 }
+gateway: { name: sim-test }
 buses:
   - name: can0
     type: canopen

@@ -40,7 +40,7 @@ std::filesystem::path write_config(const std::string& name, const std::string& y
 
 std::string udp_config(std::uint16_t port) {
   return R"(
-gateway: { name: t6 }
+gateway: { name: sim-test }
 buses:
   - name: can0
     type: canopen
@@ -246,7 +246,7 @@ TEST_F(SimProcessTest, AnswersSdoOnTheUdpBusAndTakesCommands) {
 
 TEST(SimProcess, RefusesConfigsItCannotRun) {
   const auto sim_only = write_config("simbus", R"(
-gateway: { name: t6 }
+gateway: { name: sim-test }
 buses:
   - { name: sim0, type: sim, cycle_time: 1ms }
 axes:
