@@ -299,7 +299,6 @@ void SlaveNode::open_channel(std::size_t channel) noexcept {
                                  .tx_cob = ch.tx & cob::kIdMask,
                                  .upload_without_size = config_.persona.upload_without_size},
                  static_cast<SdoBackend&>(*this));
-  if (silent_) server->set_silent(true);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -388,14 +387,6 @@ void SlaveNode::clear_fault_cause() noexcept {
   model_.clear_fault_cause();
 }
 
-void SlaveNode::set_silent(bool on) noexcept {
-  silent_ = on;
-  nmt_.set_silent(on);
-  for (auto& server : sdo_) {
-    if (server) server->set_silent(on);
-  }
-}
-
 void SlaveNode::inject_sdo_abort(ObjectId object, std::uint32_t code) noexcept {
   for (auto& server : sdo_) {
     if (server) server->inject_abort(object, code);
@@ -441,13 +432,8 @@ SlaveNode::ValueRead SlaveNode::read_value(ObjectId id) const noexcept {
     return {0, to_raw(vendor_value(*v), size), size};
   }
   if (hidden(id)) return {abort::kNoObject, 0, 0};
-  const auto& od = model_.dictionary();
-  const auto type = od.type_of(id);
-  if (!type) {
-    const bool index_known = std::any_of(p.vendor_objects.begin(), p.vendor_objects.end(),
-                                         [&](const VendorObject& v) { return v.def.id.index == id.index; });
-    return {index_known ? abort::kNoSubIndex : od.missing_code(id), 0, 0};
-  }
+  const auto type = model_.dictionary().type_of(id);
+  if (!type) return {missing_code(id), 0, 0};
   const auto r = model_.read_object(id);
   if (r.abort_code != 0) return {r.abort_code, 0, 0};
   const auto size = cia402::size_of(*type);
@@ -471,11 +457,7 @@ std::uint32_t SlaveNode::write_value(ObjectId id, std::uint32_t raw, std::size_t
   if (hidden(id)) return abort::kNoObject;
   const auto& od = model_.dictionary();
   const auto type = od.type_of(id);
-  if (!type) {
-    const bool index_known = std::any_of(p.vendor_objects.begin(), p.vendor_objects.end(),
-                                         [&](const VendorObject& v) { return v.def.id.index == id.index; });
-    return index_known ? abort::kNoSubIndex : od.missing_code(id);
-  }
+  if (!type) return missing_code(id);
   if (od.access_of(id) == Access::ReadOnly) return abort::kReadOnly;
   if (size != cia402::size_of(*type)) return abort::kTypeMismatch;
   const auto value = cia402::normalise(*type, raw);
@@ -632,6 +614,14 @@ const VendorObject* SlaveNode::vendor_object(ObjectId id) const noexcept {
     if (v.def.id == id) return &v;
   }
   return nullptr;
+}
+
+std::uint32_t SlaveNode::missing_code(ObjectId id) const noexcept {
+  // A sub-index the persona's manufacturer object does not have, else what the model says.
+  const auto& vo = config_.persona.vendor_objects;
+  const bool index_known =
+      std::any_of(vo.begin(), vo.end(), [&](const VendorObject& v) { return v.def.id.index == id.index; });
+  return index_known ? abort::kNoSubIndex : model_.dictionary().missing_code(id);
 }
 
 bool SlaveNode::hidden(ObjectId id) const noexcept {

@@ -92,9 +92,9 @@ class SlaveNode final : private SdoBackend, private PdoObjects {
   // manufacturer bytes, `cause` in byte 4 where the persona has one (SD6 E43).
   void inject_fault(std::uint16_t code, std::uint8_t cause = 0) noexcept;
   void clear_fault_cause() noexcept;
-  // A cut cable: nothing is received or sent; the node's own timers run on, so life guarding and
-  // the heartbeat consumer notice the silent master.
-  void set_silent(bool on) noexcept;
+  // A cut cable: nothing is received or sent (on_frame() and the outbox are the cable); the
+  // engines behind it run on, so life guarding and the heartbeat consumer notice the silent master.
+  void set_silent(bool on) noexcept { silent_ = on; }
   // The next SDO request for `object` (on any channel) is aborted with `code`.
   void inject_sdo_abort(ObjectId object, std::uint32_t code) noexcept;
   // The next `frames` frames this node sends are spoiled.
@@ -145,6 +145,8 @@ class SlaveNode final : private SdoBackend, private PdoObjects {
   std::uint32_t write_sdo_parameter(std::size_t channel, std::uint8_t sub, std::uint32_t raw, std::size_t size) noexcept;
   [[nodiscard]] const VendorObject* vendor_object(ObjectId id) const noexcept;
   [[nodiscard]] std::int64_t vendor_value(const VendorObject& v) const noexcept;
+  // The abort code for an object neither the persona nor the model has.
+  [[nodiscard]] std::uint32_t missing_code(ObjectId id) const noexcept;
   [[nodiscard]] bool hidden(ObjectId id) const noexcept;
   [[nodiscard]] const EmcyRule* rule_for(std::uint16_t code) const noexcept;
   [[nodiscard]] std::uint32_t emcy_cob_id() const noexcept;
