@@ -11,14 +11,6 @@
 namespace drivegate::canopen::sim {
 namespace {
 
-// The transmission type an unused PDO holds: one the persona accepts, so that it reads back as a
-// value the drive could have.
-std::uint8_t unused_type(const TransmissionTypes& types) noexcept {
-  if (types.type_255) return 255;
-  if (types.type_254) return 254;
-  return types.sync_min;
-}
-
 void from_table(std::span<const PdoDefault> table, bool receive, NodeId node, const Persona& persona,
                 std::array<SlavePdoConfig, 4>& out) {
   for (std::size_t n = 0; n < out.size(); ++n) {
@@ -27,7 +19,7 @@ void from_table(std::span<const PdoDefault> table, bool receive, NodeId node, co
     c.cob_id = receive ? cob::rpdo(pdo, node) : cob::tpdo(pdo, node);
     if (n >= table.size()) {
       c.cob_id |= cob::kInvalid;
-      c.transmission_type = unused_type(persona.pdo.transmission_types);
+      c.transmission_type = persona.pdo.transmission_types.unused();
       continue;
     }
     const auto& d = table[n];
@@ -43,7 +35,7 @@ void from_profile(std::span<const config::PdoSpec> specs, bool receive, NodeId n
   for (std::size_t n = 0; n < out.size(); ++n) {
     const int pdo = static_cast<int>(n);
     out[n].cob_id = (receive ? cob::rpdo(pdo, node) : cob::tpdo(pdo, node)) | cob::kInvalid;
-    out[n].transmission_type = unused_type(persona.pdo.transmission_types);
+    out[n].transmission_type = persona.pdo.transmission_types.unused();
   }
   for (const auto& spec : specs) {
     if (spec.number < 1 || spec.number > 4 || spec.entries.size() > 8 || spec.transmission_type < 0 ||

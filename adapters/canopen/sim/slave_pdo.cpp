@@ -36,13 +36,6 @@ std::uint8_t comm_size(std::uint8_t sub) noexcept {
   }
 }
 
-// The transmission type an absent PDO reads back: one the persona allows.
-std::uint8_t unused_type(const TransmissionTypes& types) noexcept {
-  if (types.type_255) return 255;
-  if (types.type_254) return 254;
-  return types.sync_min;
-}
-
 constexpr std::uint32_t kCobReserved = 0x3FFFF800U;  // bit 29 (29-bit ids) and bits 28..11
 constexpr core::Duration kInhibitUnit = std::chrono::microseconds(100);
 constexpr core::Duration kEventTimerUnit = std::chrono::milliseconds(1);
@@ -64,7 +57,7 @@ SlavePdos::SlavePdos(PdoObjects& objects, SlavePdoOptions options, std::span<con
     if (n < given.size()) {
       pdo.params = given[n];
     } else {
-      pdo.params.transmission_type = unused_type(options_.transmission_types);
+      pdo.params.transmission_type = options_.transmission_types.unused();
     }
     if (options_.fixed_count != 0) pdo.params.count = options_.fixed_count;
     const auto& p = pdo.params;

@@ -64,6 +64,12 @@ struct TransmissionTypes {
   [[nodiscard]] constexpr bool allows(std::uint8_t t) const noexcept {
     return (t >= sync_min && t <= sync_max && t <= 240) || (t == 254 && type_254) || (t == 255 && type_255);
   }
+  // The type an unused PDO holds: one allowed, so that it reads back as a value the drive could have.
+  [[nodiscard]] constexpr std::uint8_t unused() const noexcept {
+    if (type_255) return 255;
+    if (type_254) return 254;
+    return sync_min;
+  }
 };
 
 // Persona options (the device profile's quirks as data).
