@@ -292,10 +292,9 @@ const Persona* find_persona(std::string_view name) noexcept {
 
 const Persona& persona_for(std::string_view name) {
   if (const Persona* p = find_persona(name)) return *p;
-  throw std::invalid_argument("unknown simulator persona \"" + std::string(name) + "\" (known: " +
-                              std::string(persona_names()) + ")");
+  std::string known;
+  for (const Persona* p : kAll) known += (known.empty() ? "" : ", ") + std::string(p->name);
+  throw std::invalid_argument("unknown simulator persona \"" + std::string(name) + "\" (known: " + known + ")");
 }
-
-std::string_view persona_names() noexcept { return "akd, nord-sk500p, stoeber-sd6, generic"; }
 
 }  // namespace drivegate::canopen::sim

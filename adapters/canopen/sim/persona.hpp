@@ -111,7 +111,5 @@ struct Persona {
 const Persona* find_persona(std::string_view name) noexcept;
 // The same, throwing std::invalid_argument that lists the known names.
 const Persona& persona_for(std::string_view name);
-// "akd, nord-sk500p, stoeber-sd6, generic"
-std::string_view persona_names() noexcept;
 
 }  // namespace drivegate::canopen::sim
