@@ -59,12 +59,12 @@ struct InprocBus::Slot {
     core::TimePoint at;  // when send() queued it
   };
   bool open = false;
-  bool bus_off = false;
   std::size_t tx_limit = 0;
   Ring<Queued> tx;
   Ring<CanFrame> rx;
   CounterCells counters;
   ControllerTracker controller;
+  [[nodiscard]] bool bus_off() const noexcept { return controller.state() == ControllerState::BusOff; }
 };
 
 struct InprocBus::Hook {
@@ -116,12 +116,12 @@ void InprocBus::advance(core::TimePoint now) noexcept {
 
 bool InprocBus::start_next(core::TimePoint now) noexcept {
   // The medium is free from free_since_; the next transmission starts when it is free and a frame
-  // is waiting, among the frames waiting by then.
+  // is waiting, among the frames waiting by then. A bus-off controller has nothing queued.
   bool any = false;
   core::TimePoint first{};
   for (std::size_t i = 0; i < slot_count_; ++i) {
     const Slot& s = slots_[i];
-    if (s.bus_off || s.tx.empty()) continue;
+    if (s.tx.empty()) continue;
     if (!any || s.tx.front().at < first) first = s.tx.front().at;
     any = true;
   }
@@ -135,7 +135,7 @@ bool InprocBus::start_next(core::TimePoint now) noexcept {
   std::uint32_t best = 0;
   for (std::size_t i = 0; i < slot_count_; ++i) {
     const Slot& s = slots_[i];
-    if (s.bus_off || s.tx.empty() || s.tx.front().at > start) continue;
+    if (s.tx.empty() || s.tx.front().at > start) continue;
     const auto key = arbitration_key(s.tx.front().frame);
     if (winner == slot_count_ || key < best) {
       winner = i;
@@ -177,14 +177,14 @@ void InprocBus::finish() noexcept {
   }
   for (std::size_t i = 0; i < slot_count_; ++i) {
     Slot& s = slots_[i];
-    if (i == w.sender || !s.open || s.bus_off) continue;
+    if (i == w.sender || !s.open || s.bus_off()) continue;
     if (!s.rx.push(f)) ++stats_.rx_overruns;
   }
 }
 
 SendResult InprocBus::enqueue(std::size_t slot, const CanFrame& frame, core::TimePoint now) noexcept {
   Slot& s = slots_[slot];
-  if (!s.open || s.bus_off) return SendResult::Down;
+  if (!s.open || s.bus_off()) return SendResult::Down;
   if (!frame.valid()) return SendResult::Invalid;
   advance(now);  // frames that have left by now make room in the queue
   if (s.tx.size() >= s.tx_limit) {
@@ -215,8 +215,7 @@ void InprocBus::set_tx_queue_limit(const InprocEndpoint& endpoint, std::size_t l
 
 void InprocBus::set_bus_off(const InprocEndpoint& endpoint, bool bus_off) noexcept {
   Slot& s = slots_[endpoint.index()];
-  if (s.bus_off == bus_off) return;
-  s.bus_off = bus_off;
+  if (s.bus_off() == bus_off) return;
   if (bus_off) {
     // A controller that goes bus-off abandons its pending transmissions (the kernel flushes them).
     stats_.flushed += s.tx.size();
