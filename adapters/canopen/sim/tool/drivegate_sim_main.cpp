@@ -5,8 +5,9 @@
 //   drivegate-sim CONFIG [--bus NAME]
 //
 // Steps every 1 ms on an absolute CLOCK_MONOTONIC schedule until SIGINT or SIGTERM. Fault
-// injection comes on stdin, one command a line, each answered with one line on stdout:
-//   power-off NODE | power-on NODE | fault NODE CODE [CAUSE] | clear NODE | silent NODE on|off | status
+// injection comes on stdin, one command a line, each answered with one line on stdout (kCommands):
+//   power-off NODE | power-on NODE | fault NODE CODE [CAUSE] | clear NODE | silent NODE on|off |
+//   abort NODE INDEX[:SUB] CODE | corrupt NODE COUNT [dlc|garbage] | status
 // NODE is a node-ID, or BUS:NODE when several buses have it; numbers are decimal or 0x hex.
 #include <poll.h>
 #include <signal.h>
