@@ -1,5 +1,7 @@
 #include "adapters/canopen/wire/sdo_codec.hpp"
 
+#include <algorithm>
+
 #include "adapters/canopen/wire/can_frame.hpp"
 
 namespace drivegate::canopen {
@@ -8,20 +10,34 @@ namespace {
 SdoBytes with_object(std::uint8_t cs, ObjectId o) noexcept {
   SdoBytes b{};
   b[0] = cs;
-  b[1] = static_cast<std::uint8_t>(o.index & 0xFF);
-  b[2] = static_cast<std::uint8_t>(o.index >> 8);
+  put_le(b, 1, 2, o.index);
   b[3] = o.sub;
   return b;
 }
 
-ObjectId object_of(std::span<const std::uint8_t> p) noexcept {
-  return {static_cast<std::uint16_t>(p[1] | (p[2] << 8)), p[3]};
+// An initiate or abort frame whose bytes 4..7 carry `size` bytes of `value`: a 4-byte count or
+// code, or the data of an expedited transfer.
+SdoBytes with_value(std::uint8_t cs, ObjectId o, std::uint32_t value, std::size_t size = 4) noexcept {
+  auto b = with_object(cs, o);
+  put_le(b, 4, size, value);
+  return b;
 }
 
-SdoBytes segment(std::uint8_t cs_bits, bool toggle, std::span<const std::uint8_t> bytes, bool last) noexcept {
+// Expedited with size indicated: cs | n (bytes of 4..7 without data) in bits 3..2.
+SdoBytes expedited(std::uint8_t cs, ObjectId o, std::uint32_t value, std::uint8_t size) noexcept {
+  size = std::clamp<std::uint8_t>(size, 1, 4);
+  return with_value(static_cast<std::uint8_t>(cs | ((4 - size) << 2)), o, value, size);
+}
+
+ObjectId object_of(std::span<const std::uint8_t> p) noexcept {
+  return {static_cast<std::uint16_t>(get_le(p, 1, 2)), p[3]};
+}
+
+// Download and upload segments share one layout: toggle, n (bytes of 1..7 without data), c.
+SdoBytes segment(bool toggle, std::span<const std::uint8_t> bytes, bool last) noexcept {
   SdoBytes b{};
   const auto n = bytes.size() > 7 ? std::size_t{7} : bytes.size();
-  b[0] = static_cast<std::uint8_t>(cs_bits | (toggle ? 0x10 : 0) | ((7 - n) << 1) | (last ? 1 : 0));
+  b[0] = static_cast<std::uint8_t>((toggle ? 0x10 : 0) | ((7 - n) << 1) | (last ? 1 : 0));
   for (std::size_t i = 0; i < n; ++i) b[1 + i] = bytes[i];
   return b;
 }
@@ -63,7 +79,6 @@ const char* to_string(SdoDecodeError e) noexcept {
     case SdoDecodeError::None: return "none";
     case SdoDecodeError::WrongLength: return "SDO frame is not 8 bytes long";
     case SdoDecodeError::UnknownCommand: return "unknown SDO command specifier";
-    case SdoDecodeError::Malformed: return "malformed SDO frame";
   }
   return "?";
 }
@@ -143,21 +158,13 @@ SdoDecoded decode_sdo_response(std::span<const std::uint8_t> p) noexcept {
 SdoBytes sdo_upload_request(ObjectId o) noexcept { return with_object(0x40, o); }
 
 SdoBytes sdo_download_expedited(ObjectId o, std::uint32_t value, std::uint8_t size) noexcept {
-  if (size < 1) size = 1;
-  if (size > 4) size = 4;
-  auto b = with_object(static_cast<std::uint8_t>(0x23 | ((4 - size) << 2)), o);
-  put_le(b, 4, size, value);
-  return b;
+  return expedited(0x23, o, value, size);
 }
 
-SdoBytes sdo_download_initiate(ObjectId o, std::uint32_t total_size) noexcept {
-  auto b = with_object(0x21, o);
-  put_le(b, 4, 4, total_size);
-  return b;
-}
+SdoBytes sdo_download_initiate(ObjectId o, std::uint32_t total_size) noexcept { return with_value(0x21, o, total_size); }
 
 SdoBytes sdo_download_segment(bool toggle, std::span<const std::uint8_t> bytes, bool last) noexcept {
-  return segment(0x00, toggle, bytes, last);
+  return segment(toggle, bytes, last);
 }
 
 SdoBytes sdo_upload_segment_request(bool toggle) noexcept {
@@ -175,27 +182,17 @@ SdoBytes sdo_download_segment_response(bool toggle) noexcept {
 }
 
 SdoBytes sdo_upload_expedited_response(ObjectId o, std::uint32_t value, std::uint8_t size) noexcept {
-  if (size < 1) size = 1;
-  if (size > 4) size = 4;
-  auto b = with_object(static_cast<std::uint8_t>(0x43 | ((4 - size) << 2)), o);
-  put_le(b, 4, size, value);
-  return b;
+  return expedited(0x43, o, value, size);
 }
 
 SdoBytes sdo_upload_initiate_response(ObjectId o, std::uint32_t total_size) noexcept {
-  auto b = with_object(0x41, o);
-  put_le(b, 4, 4, total_size);
-  return b;
+  return with_value(0x41, o, total_size);
 }
 
 SdoBytes sdo_upload_segment(bool toggle, std::span<const std::uint8_t> bytes, bool last) noexcept {
-  return segment(0x00, toggle, bytes, last);
+  return segment(toggle, bytes, last);
 }
 
-SdoBytes sdo_abort(ObjectId o, std::uint32_t code) noexcept {
-  auto b = with_object(0x80, o);
-  put_le(b, 4, 4, code);
-  return b;
-}
+SdoBytes sdo_abort(ObjectId o, std::uint32_t code) noexcept { return with_value(0x80, o, code); }
 
 }  // namespace drivegate::canopen

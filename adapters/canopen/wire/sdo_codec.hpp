@@ -50,7 +50,6 @@ enum class SdoDecodeError : std::uint8_t {
   None,
   WrongLength,      // DLC != 8
   UnknownCommand,   // specifier 7, or a specifier the direction does not use
-  Malformed,        // field combination CiA 301 does not allow (e.g. segment n > 7 ... )
 };
 const char* to_string(SdoDecodeError e) noexcept;
 
