@@ -189,13 +189,15 @@ void NmtMaster::on_guard_reply(Node& n, ErrorControlFrame reply, core::TimePoint
   heard(n, reply.state, now);
 }
 
+void NmtMaster::lose(Node& n) noexcept {
+  if (n.lost) return;
+  n.lost = true;
+  ++counters_.losses;
+  push_event(NmtEventKind::Lost, n);
+}
+
 void NmtMaster::miss(Node& n) noexcept {
-  ++n.misses;
-  if (!n.lost && n.misses >= n.config.life_time_factor) {
-    n.lost = true;
-    ++counters_.losses;
-    push_event(NmtEventKind::Lost, n);
-  }
+  if (++n.misses >= n.config.life_time_factor) lose(n);
 }
 
 void NmtMaster::poll_guarding(Node& n, core::TimePoint now, TxQueue& tx) noexcept {
@@ -214,25 +216,18 @@ void NmtMaster::poll_guarding(Node& n, core::TimePoint now, TxQueue& tx) noexcep
 }
 
 void NmtMaster::poll(core::TimePoint now, TxQueue& tx) noexcept {
-  if (config_.heartbeat_period > core::Duration::zero()) {
-    if (!own_heartbeat_started_ || now >= next_own_heartbeat_) {
-      // The master reports Operational: consumers (AKD 1016h) only care that it is alive.
-      const std::uint8_t state = encode_error_control(NmtState::Operational);
-      if (!tx.push(make_frame(cob::error_control(config_.own_node), {state}))) ++counters_.tx_full;
-      next_own_heartbeat_ = own_heartbeat_started_ ? next_own_heartbeat_ + config_.heartbeat_period
-                                                   : now + config_.heartbeat_period;
-      if (next_own_heartbeat_ <= now) next_own_heartbeat_ = now + config_.heartbeat_period;
-      own_heartbeat_started_ = true;
-    }
+  if (config_.heartbeat_period > core::Duration::zero() && now >= next_own_heartbeat_) {
+    // The master reports Operational: consumers (AKD 1016h) only care that it is alive.
+    const std::uint8_t state = encode_error_control(NmtState::Operational);
+    if (!tx.push(make_frame(cob::error_control(config_.own_node), {state}))) ++counters_.tx_full;
+    // Steady schedule; the first one and one after a stall set it to one period from now.
+    next_own_heartbeat_ += config_.heartbeat_period;
+    if (next_own_heartbeat_ <= now) next_own_heartbeat_ = now + config_.heartbeat_period;
   }
   for (auto& n : nodes_) {
     if (!n.watching) continue;
     if (n.config.watch == Watch::Heartbeat) {
-      if (!n.lost && now >= n.heartbeat_deadline) {
-        n.lost = true;
-        ++counters_.losses;
-        push_event(NmtEventKind::Lost, n);
-      }
+      if (now >= n.heartbeat_deadline) lose(n);
     } else {
       poll_guarding(n, now, tx);
     }
@@ -241,10 +236,7 @@ void NmtMaster::poll(core::TimePoint now, TxQueue& tx) noexcept {
 
 core::TimePoint NmtMaster::next_deadline() const noexcept {
   auto next = core::TimePoint::max();
-  if (config_.heartbeat_period > core::Duration::zero()) {
-    // Before the first poll the own heartbeat is due at once.
-    next = own_heartbeat_started_ ? next_own_heartbeat_ : core::TimePoint::min();
-  }
+  if (config_.heartbeat_period > core::Duration::zero()) next = next_own_heartbeat_;
   for (const auto& n : nodes_) {
     if (!n.watching) continue;
     if (n.config.watch == Watch::Heartbeat) {

@@ -126,6 +126,7 @@ class NmtMaster {
   void on_guard_reply(Node& n, ErrorControlFrame reply, core::TimePoint now) noexcept;
   void heard(Node& n, NmtState state, core::TimePoint now) noexcept;
   void miss(Node& n) noexcept;
+  void lose(Node& n) noexcept;
   void poll_guarding(Node& n, core::TimePoint now, TxQueue& tx) noexcept;
 
   NmtMasterConfig config_;
@@ -135,8 +136,7 @@ class NmtMaster {
   std::array<NmtEvent, kEventCapacity> events_{};
   std::size_t event_head_ = 0;
   std::size_t event_count_ = 0;
-  bool own_heartbeat_started_ = false;
-  core::TimePoint next_own_heartbeat_{};
+  core::TimePoint next_own_heartbeat_ = core::TimePoint::min();  // min: due at the first poll
 };
 
 // SYNC producer (CiA 301 §7.2.5): COB-ID 080h, DLC 0 (the reference drives use no SYNC counter:
