@@ -28,19 +28,18 @@ void NodeBoot::abandon(SdoClient& sdo) noexcept {
 
 void NodeBoot::fail_abort(const BootStep& s, std::uint32_t code) noexcept {
   status_ = Status::Failed;
-  const char* verb = s.kind == BootStep::Kind::Write ? "write" : "read";
   if (s.kind == BootStep::Kind::Write)
-    failure_.format("%s: %s %04Xh:%02X := 0x%llX failed: %s (abort 0x%08X)%s%s", s.stage.c_str(), verb,
-                    s.def.id.index, s.def.id.sub, static_cast<unsigned long long>(s.value) & 0xFFFFFFFFULL,
+    failure_.format("%s: write %04Xh:%02X := 0x%llX failed: %s (abort 0x%08X)%s%s", s.stage.c_str(), s.def.id.index,
+                    s.def.id.sub, static_cast<unsigned long long>(s.value) & 0xFFFFFFFFULL,
                     cia402::sdo_abort_text(code).data(), code, s.why.empty() ? "" : "; ", s.why.c_str());
   else
-    failure_.format("%s: %s %04Xh:%02X failed: %s (abort 0x%08X)", s.stage.c_str(), verb, s.def.id.index,
-                    s.def.id.sub, cia402::sdo_abort_text(code).data(), code);
+    failure_.format("%s: read %04Xh:%02X failed: %s (abort 0x%08X)", s.stage.c_str(), s.def.id.index, s.def.id.sub,
+                    cia402::sdo_abort_text(code).data(), code);
 }
 
 NodeBoot::Status NodeBoot::step(SdoClient& sdo, ProcessImage& image) noexcept {
+  // Running means next_ < steps_.size(): start() and the end of every step see to it.
   if (status_ != Status::Running) return status_;
-  if (next_ >= steps_.size()) return status_ = Status::Done;
   const BootStep& s = steps_[next_];
   const auto size = cia402::size_of(s.def.type);
   if (request_ == kNoSdoRequest) {
@@ -58,15 +57,13 @@ NodeBoot::Status NodeBoot::step(SdoClient& sdo, ProcessImage& image) noexcept {
   }
   if (r.status == SdoStatus::Failed) {
     // A seed the drive cannot answer leaves the image value as it is (0 at first).
-    if (s.kind == BootStep::Kind::Seed || (s.optional && missing_object(r.abort_code))) {
-      ++next_;
-      return status_ = next_ >= steps_.size() ? Status::Done : Status::Running;
+    if (s.kind != BootStep::Kind::Seed && !(s.optional && missing_object(r.abort_code))) {
+      fail_abort(s, r.abort_code);
+      return status_;
     }
-    fail_abort(s, r.abort_code);
-    return status_;
-  }
-  if (s.kind == BootStep::Kind::Seed) image.set(s.def.id, cia402::normalise(s.def.type, r.value));
-  if (s.kind == BootStep::Kind::Expect) {
+  } else if (s.kind == BootStep::Kind::Seed) {
+    image.set(s.def.id, r.value);  // set() takes it to the object's type
+  } else if (s.kind == BootStep::Kind::Expect) {
     const auto got = static_cast<std::uint32_t>(cia402::normalise(s.def.type, r.value) & 0xFFFFFFFF);
     const auto want = static_cast<std::uint32_t>(s.value & 0xFFFFFFFF);
     if ((got & s.mask) != (want & s.mask)) {
