@@ -146,10 +146,7 @@ NodePdoConfig build_pdo_config(const config::AxisPlan& axis) {
   const auto& dev = axis.device.canopen;
   auto layout_of = [](const config::PdoSpec& p) {
     PdoLayout l;
-    for (const auto& e : p.entries) {
-      const auto bytes = static_cast<std::uint8_t>(e.bits / 8);
-      (void)l.add({e.object, e.type}, static_cast<std::uint8_t>(bytes * 8));
-    }
+    for (const auto& e : p.entries) (void)l.add({e.object, e.type}, e.bits);
     return l;
   };
   for (const auto& p : dev.rpdos) {

@@ -71,19 +71,18 @@ CanopenBus::CanopenBus(const config::BusPlan& plan, std::unique_ptr<Transport> t
         }
         return t;
       }()),
-      sdo_channels_(sdo_channels_for(plan)),
       nmt_nodes_(nmt_nodes_for(plan)),
-      emcy_nodes_([&] {
+      // The engines copy their node configurations; only nmt_nodes_ is looked at again.
+      sdo_(sdo_channels_for(plan), SdoTiming{plan.canopen.sdo_timeout, plan.canopen.sdo_retries}),
+      nmt_(NmtMasterConfig{static_cast<NodeId>(plan.canopen.gateway_node_id), plan.canopen.heartbeat_period},
+           nmt_nodes_),
+      emcy_([&] {
         std::vector<EmcyNodeConfig> e;
         for (std::size_t i = 0; i < plan.axes.size(); ++i)
           e.push_back({static_cast<NodeId>(plan.axes[i].address), tables_[i].faults, tables_[i].fields,
                        plan.axes[i].device.canopen.emcy_zero_needs_clear_register});
         return e;
       }()),
-      sdo_(sdo_channels_, SdoTiming{plan.canopen.sdo_timeout, plan.canopen.sdo_retries}),
-      nmt_(NmtMasterConfig{static_cast<NodeId>(plan.canopen.gateway_node_id), plan.canopen.heartbeat_period},
-           nmt_nodes_),
-      emcy_(emcy_nodes_),
       sync_(cob::kSync, plan.cycle_time) {
   for (std::size_t i = 0; i < plan.axes.size(); ++i) {
     const auto& a = plan.axes[i];
@@ -154,8 +153,7 @@ void CanopenBus::release_watchdogs() noexcept {
     const auto now = last_now_ + (clock.now() - start);
     if (peer_) peer_->step(now);
     const std::size_t got = transport_->receive(rx_buffer_, now);
-    for (std::size_t i = 0; i < got; ++i)
-      if (split_cob_id(rx_buffer_[i].id).function == Function::SdoTx) sdo_.on_frame(rx_buffer_[i], now);
+    for (std::size_t i = 0; i < got; ++i) sdo_.on_frame(rx_buffer_[i], now);  // ignores other COB-IDs
     sdo_.poll(now, tx_);
     flush(now);
     for (std::size_t i = 0; i < nodes_.size(); ++i) {
@@ -243,7 +241,7 @@ void CanopenBus::dispatch(const CanFrame& f, core::TimePoint now) noexcept {
   bool used = false;
   switch (c.function) {
     case Function::SdoTx: used = sdo_.on_frame(f, now); break;
-    case Function::ErrorControl: used = !f.remote && nmt_.on_frame(f, now); break;
+    case Function::ErrorControl: used = nmt_.on_frame(f, now); break;  // counts an RTR there as unexpected
     case Function::Emcy: used = emcy_.on_frame(f, now); break;
     case Function::Tpdo:
       if (Node* n = node_by_id(c.node)) used = n->pdos.on_frame(f, now);

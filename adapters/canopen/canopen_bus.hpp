@@ -120,9 +120,7 @@ class CanopenBus final : public core::Bus {
     std::vector<EmcyField> fields;
   };
   std::vector<Tables> tables_;
-  std::vector<SdoChannelConfig> sdo_channels_;
-  std::vector<NmtNodeConfig> nmt_nodes_;
-  std::vector<EmcyNodeConfig> emcy_nodes_;
+  std::vector<NmtNodeConfig> nmt_nodes_;  // per axis; also tells how a lost node was watched
   SdoClient sdo_;
   NmtMaster nmt_;
   EmcyConsumer emcy_;
