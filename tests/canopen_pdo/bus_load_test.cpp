@@ -3,7 +3,6 @@
 #include <gtest/gtest.h>
 
 #include "adapters/canopen/wire/bus_load.hpp"
-#include "adapters/canopen/master/pdo.hpp"  // CycleLoad reaches the engines' users through pdo.hpp too
 
 namespace drivegate::canopen {
 namespace {

@@ -13,7 +13,6 @@
 #include <optional>
 #include <span>
 
-#include "adapters/canopen/wire/bus_load.hpp"
 #include "adapters/canopen/master/tx_queue.hpp"
 #include "adapters/canopen/wire/can_frame.hpp"
 #include "adapters/canopen/wire/cob_id.hpp"

@@ -199,8 +199,8 @@ std::size_t SdoClient::pending(int channel) const noexcept {
 bool SdoClient::on_frame(const CanFrame& frame, core::TimePoint /*now*/) noexcept {
   if (frame.extended || frame.id > kMaxStandardId || by_tx_cob_[frame.id] < 0) return false;
   auto& ch = channels_[static_cast<std::size_t>(by_tx_cob_[frame.id])];
-  // An RTR carries no SDO; a DLC above 8 cannot come off a real bus, and payload() would overrun.
-  if (frame.remote || frame.dlc > kMaxDlc) {
+  // An RTR carries no SDO; a DLC above 8 cannot come off a real bus (payload() would hide it).
+  if (frame.remote || !frame.valid()) {
     ++counters_.malformed;
     return true;
   }
