@@ -347,6 +347,19 @@ std::optional<std::uint8_t> eds_type_bits(std::uint16_t data_type) noexcept {
   return t->bits;
 }
 
+std::optional<cia402::DataType> eds_integer_type(std::uint16_t data_type) noexcept {
+  switch (data_type) {  // CiA 301 §7.4.7.1
+    case 0x0001: return cia402::DataType::U8;  // BOOLEAN
+    case 0x0002: return cia402::DataType::I8;
+    case 0x0003: return cia402::DataType::I16;
+    case 0x0004: return cia402::DataType::I32;
+    case 0x0005: return cia402::DataType::U8;
+    case 0x0006: return cia402::DataType::U16;
+    case 0x0007: return cia402::DataType::U32;
+    default: return std::nullopt;
+  }
+}
+
 std::string_view to_string(EdsAccess access) noexcept {
   switch (access) {
     case EdsAccess::ReadOnly: return "ro";

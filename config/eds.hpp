@@ -59,6 +59,9 @@ std::string eds_type_name(std::uint16_t data_type);
 // Size in bits of a fixed-size basic type (BOOLEAN counts as 8: it is mapped as a byte here);
 // nullopt for strings, domains and unknown types.
 std::optional<std::uint8_t> eds_type_bits(std::uint16_t data_type) noexcept;
+// The type an object of 1, 2 or 4 bytes is read and written as (BOOLEAN as u8); nullopt for
+// others (REAL32, strings, 24..64-bit integers), which a parameter request cannot carry.
+std::optional<cia402::DataType> eds_integer_type(std::uint16_t data_type) noexcept;
 // "ro", "rw", ... as written in an EDS.
 std::string_view to_string(EdsAccess access) noexcept;
 

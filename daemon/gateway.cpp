@@ -303,10 +303,6 @@ std::vector<std::string> Gateway::scheduling_notes() const {
   return notes;
 }
 
-}  // namespace drivegate::daemon
-
-namespace drivegate::daemon {
-
 // EDS names first (they carry size and signedness), then the device's parameter naming (SD6
 // "A83"), so an EDS can also name vendor parameters.
 ParameterLookup Gateway::lookup_parameter(std::size_t axis_id, std::string_view name) const {
@@ -318,22 +314,17 @@ ParameterLookup Gateway::lookup_parameter(std::size_t axis_id, std::string_view 
   const AxisRef ref = refs_[axis_id];
   const config::AxisPlan& axis = buses_[ref.bus].plan->axes[ref.axis];
   if (const config::EdsObject* o = config::find_eds_object(axis.canopen.eds_objects, name)) {
+    const auto type = config::eds_integer_type(o->data_type);
+    if (!type) {
+      out.error = "object '" + o->name + "' is of type " + config::eds_type_name(o->data_type) +
+                  "; parameters of 1, 2 or 4 bytes only";
+      return out;
+    }
     out.ok = true;
     out.index = o->id.index;
     out.sub = o->id.sub;
-    switch (o->data_type) {  // CiA 301 basic types of 1, 2 and 4 bytes
-      case 0x0001: out.size = 1; break;  // BOOLEAN
-      case 0x0002: out.size = 1; out.is_signed = true; break;
-      case 0x0003: out.size = 2; out.is_signed = true; break;
-      case 0x0004: out.size = 4; out.is_signed = true; break;
-      case 0x0005: out.size = 1; break;
-      case 0x0006: out.size = 2; break;
-      case 0x0007: out.size = 4; break;
-      default:
-        out.ok = false;
-        out.error = "object '" + o->name + "' is of type " + config::eds_type_name(o->data_type) +
-                    "; parameters of 1, 2 or 4 bytes only";
-    }
+    out.size = cia402::size_of(*type);
+    out.is_signed = cia402::is_signed(*type);
     return out;
   }
   if (const auto& naming = axis.device.canopen.parameter_naming) {

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "config/eds.hpp"
+#include "tests/config/test_support.hpp"
 
 namespace drivegate::config {
 namespace {
@@ -16,7 +17,18 @@ std::string errors_of(const std::string& text) {
   return out;
 }
 
-#define EXPECT_REPORTED(errors, text) EXPECT_NE((errors).find(text), std::string::npos) << (errors)
+TEST(Eds, IntegerTypesOfParameterRequests) {
+  EXPECT_EQ(eds_integer_type(0x0001), cia402::DataType::U8);  // BOOLEAN travels as a byte
+  EXPECT_EQ(eds_integer_type(0x0002), cia402::DataType::I8);
+  EXPECT_EQ(eds_integer_type(0x0003), cia402::DataType::I16);
+  EXPECT_EQ(eds_integer_type(0x0004), cia402::DataType::I32);
+  EXPECT_EQ(eds_integer_type(0x0005), cia402::DataType::U8);
+  EXPECT_EQ(eds_integer_type(0x0006), cia402::DataType::U16);
+  EXPECT_EQ(eds_integer_type(0x0007), cia402::DataType::U32);
+  EXPECT_FALSE(eds_integer_type(0x0008));  // REAL32: 4 bytes, but not an integer
+  EXPECT_FALSE(eds_integer_type(0x0010));  // INTEGER24
+  EXPECT_FALSE(eds_integer_type(0x0015));  // INTEGER64
+}
 
 TEST(Eds, TheTestFileParses) {
   Problems problems;
@@ -95,6 +107,7 @@ ObjectType=0x9
   ASSERT_NE(vendor, nullptr);
   EXPECT_EQ(vendor->name, "Vendor-ID");
   EXPECT_EQ(vendor->data_type, 0x0007);
+  EXPECT_EQ(eds_integer_type(vendor->data_type), cia402::DataType::U32);
   EXPECT_EQ(vendor->access, EdsAccess::ReadOnly);  // keys and access values are case-insensitive
   EXPECT_FALSE(vendor->pdo_mapping);               // PDOMapping left out: not mappable
   EXPECT_EQ(vendor->default_value, "0x6A");
@@ -103,6 +116,7 @@ ObjectType=0x9
   ASSERT_NE(name, nullptr);  // ObjectType left out: a VAR
   EXPECT_EQ(eds_type_name(name->data_type), "VISIBLE_STRING");
   EXPECT_FALSE(eds_type_bits(name->data_type));
+  EXPECT_FALSE(eds_integer_type(name->data_type));  // no parameter request carries a string
   EXPECT_FALSE(name->writable());
   const EdsObject* mode = find_eds_object(*objects, cia402::ObjectId{0x6060, 0});
   ASSERT_NE(mode, nullptr);
