@@ -374,7 +374,7 @@ void DdsBridge::Impl::handle_param(const msg::ParamRequest& in) {
     return fail("gateway busy: the parameter queue of axis '" + in.axis() + "' is full");
   remember(pending_params_, req.id, Pending{in.client(), in.id(), in.axis(), req.index, req.sub});
   spdlog::info("dds: parameter {} {:04X}:{} for axis '{}' from '{}' id {} -> request {}", in.write() ? "write" : "read",
-               in.index(), in.subindex(), in.axis(), in.client(), in.id(), req.id);
+               req.index, req.sub, in.axis(), in.client(), in.id(), req.id);
   count([](Stats& s) { ++s.params_routed; });
 }
 
