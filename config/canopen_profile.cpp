@@ -7,7 +7,6 @@
 
 #include "config/object_text.hpp"
 #include "config/parameter_names.hpp"
-#include "config/scalars.hpp"
 #include "config/text_util.hpp"
 
 namespace drivegate::config {
@@ -15,8 +14,6 @@ namespace drivegate::config {
 namespace {
 
 using namespace std::chrono_literals;
-
-std::string indexed(const std::string& list, std::size_t i) { return list + "[" + std::to_string(i) + "]"; }
 
 std::string hex_text(cia402::ObjectId id) {
   char buf[16];
@@ -253,16 +250,9 @@ void read_naming(const MapReader& n, CanopenDeviceSpec& co) {
 void read_sync_periods(const MapReader& c, CanopenDeviceSpec& co) {
   const auto list = c.list("sync_periods", Need::Optional);
   if (!list) return;
-  for (std::size_t i = 0; i < list->size(); ++i) {
-    const YAML::Node n = (*list)[i];
-    const auto d = n.IsScalar() && n.Tag() != "!" ? parse_duration(n.Scalar()) : std::nullopt;
-    if (!d || *d < 100us || *d > 1s) {
-      c.source().error(n.Mark(), indexed(c.field("sync_periods"), i),
-                       "must be a duration in 100us..1s such as 2ms, got " + describe_value(n));
-      continue;
-    }
-    co.sync_periods.push_back(*d);
-  }
+  for (std::size_t i = 0; i < list->size(); ++i)
+    if (const auto d = read_duration((*list)[i], indexed(c.field("sync_periods"), i), c.source(), 100us, 1s))
+      co.sync_periods.push_back(*d);
 }
 
 // The cyclic image is the set of mapped objects: a profile that lists cyclic_objects too must

@@ -18,8 +18,6 @@ namespace {
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
 
-std::string indexed(std::string_view list, std::size_t i) { return std::string{list} + "[" + std::to_string(i) + "]"; }
-
 void read_gateway(const MapReader& g, const fs::path& base_dir, GatewayPlan& out) {
   g.check_keys({"name", "dds", "log_level", "status_rate_hz", "device_dirs"});
   out.name = g.name("name", Need::Required).value_or("");

@@ -70,7 +70,11 @@ std::optional<cia402::DataType> parse_data_type(std::string_view text) {
 }
 
 const std::vector<std::string>& data_type_names() {
-  static const std::vector<std::string> kNames{"i8", "u8", "i16", "u16", "i32", "u32"};
+  static const std::vector<std::string> kNames = [] {
+    std::vector<std::string> names;
+    for (const auto& [name, type] : kTypes) names.emplace_back(name);
+    return names;
+  }();
   return kNames;
 }
 
@@ -96,24 +100,12 @@ std::optional<cia402::DataType> known_object_type(cia402::ObjectId id) noexcept 
 }
 
 std::int64_t type_min(cia402::DataType type) noexcept {
-  switch (type) {
-    case cia402::DataType::I8: return -128;
-    case cia402::DataType::I16: return -32768;
-    case cia402::DataType::I32: return -2147483648LL;
-    default: return 0;
-  }
+  return cia402::is_signed(type) ? -type_max(type) - 1 : 0;
 }
 
 std::int64_t type_max(cia402::DataType type) noexcept {
-  switch (type) {
-    case cia402::DataType::I8: return 127;
-    case cia402::DataType::U8: return 255;
-    case cia402::DataType::I16: return 32767;
-    case cia402::DataType::U16: return 65535;
-    case cia402::DataType::I32: return 2147483647LL;
-    case cia402::DataType::U32: return 4294967295LL;
-  }
-  return 0;
+  const unsigned bits = 8U * cia402::size_of(type);
+  return (std::int64_t{1} << (cia402::is_signed(type) ? bits - 1U : bits)) - 1;
 }
 
 }  // namespace drivegate::config

@@ -63,6 +63,8 @@ bool is_valid_name(std::string_view s, bool allow_punct) noexcept {
   });
 }
 
+std::string indexed(std::string_view list, std::size_t i) { return std::string{list} + "[" + std::to_string(i) + "]"; }
+
 std::string format_number(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.10g", v);

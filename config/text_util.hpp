@@ -1,5 +1,6 @@
 #pragma once
 // Small text helpers for configuration messages: "did you mean", lists, name patterns, numbers.
+#include <cstddef>
 #include <span>
 #include <string>
 #include <string_view>
@@ -16,6 +17,9 @@ std::string did_you_mean(std::string_view word, std::span<const std::string> can
 
 // "a, b, c" (or "(none)" for an empty list).
 std::string join(std::span<const std::string> items, std::string_view sep = ", ");
+
+// "buses[2]": the path of a list element in messages.
+std::string indexed(std::string_view list, std::size_t i);
 
 // Names of gateways, buses and axes: [A-Za-z0-9_.-]{1,63}. With allow_punct false: [A-Za-z0-9_]{1,63}.
 bool is_valid_name(std::string_view s, bool allow_punct = true) noexcept;

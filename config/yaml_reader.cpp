@@ -232,22 +232,26 @@ std::optional<std::int64_t> MapReader::integer(std::string_view key, Need need, 
   return read_integer(n, field(key), src_, lo, hi, words);
 }
 
-std::optional<core::Duration> MapReader::duration(std::string_view key, Need need, core::Duration min,
-                                                  core::Duration max) const {
-  const YAML::Node n = value(key, need);
-  if (!n.IsDefined()) return std::nullopt;
+std::optional<core::Duration> read_duration(const YAML::Node& n, const std::string& path, const Source& src,
+                                            core::Duration min, core::Duration max) {
   const auto d = n.IsScalar() && !is_quoted(n) ? parse_duration(n.Scalar()) : std::nullopt;
   // A zero minimum means "strictly positive"; any other minimum is inclusive.
   const bool ok = d && (min.count() == 0 ? *d > min : *d >= min) && *d <= max;
   if (!ok) {
     const std::string range = min.count() == 0 ? "> 0 (at most " + format_duration(max) + ")"
                                                : "in " + format_duration(min) + ".." + format_duration(max);
-    src_.error(n.Mark(), field(key),
-               "must be a duration " + range + " such as 250us, 1ms, 0.5s or 2s (a bare number is seconds)" +
-                   got(n));
+    src.error(n.Mark(), path,
+              "must be a duration " + range + " such as 250us, 1ms, 0.5s or 2s (a bare number is seconds)" + got(n));
     return std::nullopt;
   }
   return d;
+}
+
+std::optional<core::Duration> MapReader::duration(std::string_view key, Need need, core::Duration min,
+                                                  core::Duration max) const {
+  const YAML::Node n = value(key, need);
+  if (!n.IsDefined()) return std::nullopt;
+  return read_duration(n, field(key), src_, min, max);
 }
 
 std::optional<bool> MapReader::boolean(std::string_view key, Need need) const {

@@ -51,6 +51,9 @@ std::optional<double> read_number(const YAML::Node& n, const std::string& path, 
 std::optional<std::int64_t> read_integer(const YAML::Node& n, const std::string& path, const Source& src,
                                          std::int64_t lo, std::int64_t hi, std::string_view words = "an integer");
 std::optional<std::string> read_string(const YAML::Node& n, const std::string& path, const Source& src);
+// A duration in min..max; a zero `min` means strictly positive.
+std::optional<core::Duration> read_duration(const YAML::Node& n, const std::string& path, const Source& src,
+                                            core::Duration min, core::Duration max);
 
 // The whole content of a file; an unreadable file is reported (without position) and gives nullopt.
 std::optional<std::string> read_text_file(const std::string& file, const Source& src);

@@ -177,6 +177,24 @@ TEST(CanopenProfiles, GenericMapsEqualItsCyclicObjects) {
   EXPECT_EQ(mapped, p.cyclic_objects.size());
 }
 
+// Start-up write values are range-checked by their type's limits.
+TEST(CanopenProfiles, TypeLimits) {
+  using cia402::DataType;
+  EXPECT_EQ(type_min(DataType::I8), -128);
+  EXPECT_EQ(type_max(DataType::I8), 127);
+  EXPECT_EQ(type_min(DataType::U8), 0);
+  EXPECT_EQ(type_max(DataType::U8), 255);
+  EXPECT_EQ(type_min(DataType::I16), -32768);
+  EXPECT_EQ(type_max(DataType::I16), 32767);
+  EXPECT_EQ(type_min(DataType::U16), 0);
+  EXPECT_EQ(type_max(DataType::U16), 65535);
+  EXPECT_EQ(type_min(DataType::I32), -2147483648LL);
+  EXPECT_EQ(type_max(DataType::I32), 2147483647LL);
+  EXPECT_EQ(type_min(DataType::U32), 0);
+  EXPECT_EQ(type_max(DataType::U32), 4294967295LL);
+  EXPECT_EQ(data_type_names(), (Strings{"i8", "u8", "i16", "u16", "i32", "u32"}));
+}
+
 TEST(CanopenProfiles, SimServoHasNoCanopenSection) { EXPECT_FALSE(load("sim-servo").canopen.present); }
 
 class CanopenProfileErrors : public test::TempDir {
@@ -313,7 +331,8 @@ TEST_F(CanopenProfileErrors, ScalarFields) {
   EXPECT_REPORTED(e, at(8, 17) + "canopen.sdo_channels: must be an integer in 1..4, got \"5\"");
   EXPECT_REPORTED(e, at(9, 18) + "canopen.error_control: must be one of heartbeat, guarding, got \"polling\"");
   EXPECT_REPORTED(e, at(11, 24) + "canopen.fixed_mapping_count: only with pdo_policy: verify");
-  EXPECT_REPORTED(e, at(12, 23) + "canopen.sync_periods[1]: must be a duration in 100us..1s such as 2ms, got \"0\"");
+  EXPECT_REPORTED(e, at(12, 23) + "canopen.sync_periods[1]: must be a duration in 100us..1s such as 250us, 1ms, 0.5s or 2s "
+                                 "(a bare number is seconds), got \"0\"");
   EXPECT_REPORTED(e, at(12, 26) + "canopen.sync_periods[2]:");
   EXPECT_REPORTED(e, at(13, 3) + "canopen.colour: unknown field");
 }
