@@ -4,24 +4,13 @@
 #include <string>
 
 #include "config/loader.hpp"
+#include "tests/config/test_support.hpp"
 
 namespace drivegate::config {
 namespace {
 
-LoadOptions test_options() {
-  LoadOptions o;
-  o.device_dirs = {DRIVEGATE_DEVICE_DIR_SOURCE, DRIVEGATE_TEST_DEVICE_DIR};
-  return o;
-}
-
-std::string errors_of(const std::string& yaml, const LoadOptions& options = test_options()) {
-  try {
-    load_plan_from_string(yaml, "t.yaml", options);
-  } catch (const ConfigError& e) {
-    return e.what();
-  }
-  return "(loaded without error)";
-}
+using test::errors_of;
+using test::test_options;
 
 // A valid file up to and including the first axis' device line (line 11); tests append lines.
 const std::string kHead = R"(gateway:
@@ -38,8 +27,6 @@ axes:
 )";
 // Line 12.
 const std::string kCounts = "    mechanics: { encoder_counts_per_rev: 4096 }\n";
-
-#define EXPECT_REPORTED(errors, text) EXPECT_NE((errors).find(text), std::string::npos) << (errors)
 
 TEST(LoadErrors, HeadIsValid) { EXPECT_NO_THROW(load_plan_from_string(kHead + kCounts, "t.yaml", test_options())); }
 

@@ -2,17 +2,13 @@
 
 #include "config/describe.hpp"
 #include "config/loader.hpp"
+#include "tests/config/test_support.hpp"
 
 namespace drivegate::config {
 namespace {
 
 using namespace std::chrono_literals;
-
-LoadOptions test_options() {
-  LoadOptions o;
-  o.device_dirs = {DRIVEGATE_DEVICE_DIR_SOURCE, DRIVEGATE_TEST_DEVICE_DIR};
-  return o;
-}
+using test::test_options;
 
 constexpr const char* kValid = R"(
 gateway:
