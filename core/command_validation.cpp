@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <cstdarg>
+#include <cstdio>
+#include <limits>
 
 namespace drivegate::core {
 
@@ -59,6 +61,54 @@ Rate resolve_rate(double given, double fallback, double limit) noexcept {
 
 const char* unit_of(const AxisSpec& s) noexcept { return s.user_unit.c_str(); }
 
+// How a value must survive the conversion into a drive object (DESIGN.md §4: commands are
+// validated in drive units). Rates, accelerations, torques and homing speeds are Magnitudes: a
+// non-zero request that rounds to 0 is refused, because many drives read 0 in those objects as
+// "keep the previous value" (a move at 1e-300 mm/s ran at the last profile velocity). Positions
+// are Positions: rounding to the drive's resolution is the normal quantisation, only overflow is
+// refused.
+enum class Kind { Position, Magnitude };
+
+// Converts `user` (in `unit`) by `factor` drive units per user unit into the drive object type T.
+// On refusal fills `c` and returns false.
+template <typename T>
+bool to_drive(double user, double factor, Kind kind, const char* what, const char* unit, T& out,
+              Conversion& c) noexcept {
+  const double drive = std::round(user * factor);
+  constexpr double lo = static_cast<double>(std::numeric_limits<T>::lowest());
+  constexpr double hi = static_cast<double>(std::numeric_limits<T>::max());
+  if (!std::isfinite(drive) || drive < lo || drive > hi) {
+    c.ok = false;
+    if (user < 0 && lo == 0)
+      c.reason.format("%s %.6g %s must not be negative", what, user, unit);
+    else
+      c.reason.format("%s %.6g %s does not fit the drive's %d-bit object after unit conversion (range %.6g to %.6g %s)",
+                      what, user, unit, static_cast<int>(sizeof(T) * 8), lo / factor, hi / factor, unit);
+    return false;
+  }
+  if (kind == Kind::Magnitude && user != 0 && drive == 0) {
+    c.ok = false;
+    c.reason.format("%s %.6g %s is 0 in drive units (the drive's resolution is %.6g %s); refused, since 0 would make the "
+                    "drive keep its previous value",
+                    what, user, unit, 1.0 / factor, unit);
+    return false;
+  }
+  out = static_cast<T>(drive);
+  return true;
+}
+
+// "mm", "mm/s", "mm/s^2" for the axis.
+struct Units {
+  char pos[40];
+  char vel[44];
+  char acc[48];
+  explicit Units(const AxisSpec& s) noexcept {
+    std::snprintf(pos, sizeof pos, "%s", unit_of(s));
+    std::snprintf(vel, sizeof vel, "%s/s", unit_of(s));
+    std::snprintf(acc, sizeof acc, "%s/s^2", unit_of(s));
+  }
+};
+
 }  // namespace
 
 Mode mode_for(CommandKind kind, const ModeSet& modes, Mode requested) noexcept {
@@ -104,6 +154,7 @@ Conversion validate_and_convert(const AxisSpec& spec, const Command& cmd, double
 
   const auto& lim = spec.limits;
   const auto& u = spec.units;
+  const Units un(spec);
   switch (cmd.kind) {
     case CommandKind::Move: {
       const double end = cmd.relative ? relative_base + cmd.position : cmd.position;
@@ -119,16 +170,14 @@ Conversion validate_and_convert(const AxisSpec& spec, const Command& cmd, double
       if (!a.ok || !dc.ok)
         return reject("acceleration/deceleration must be >= 0 and at most %.6g %s/s^2", lim.max_acceleration,
                       unit_of(spec));
-      const auto pos = to_int32(u.position_to_drive(end));
-      const auto pv = to_uint32(u.velocity_to_drive(v.value));
-      const auto pa = to_uint32(u.acceleration_to_drive(a.value));
-      const auto pd = to_uint32(u.acceleration_to_drive(dc.value));
-      if (!pos || !pv || !pa || !pd) return reject("move values do not fit the drive's 32-bit objects after unit conversion");
-      d.target_position = *pos;
+      if (!to_drive(end, u.position_factor(), Kind::Position, "move target", un.pos, d.target_position, out) ||
+          !to_drive(v.value, u.velocity_factor(), Kind::Magnitude, "move velocity", un.vel, d.profile_velocity, out) ||
+          !to_drive(a.value, u.acceleration_factor(), Kind::Magnitude, "acceleration", un.acc, d.profile_acceleration,
+                    out) ||
+          !to_drive(dc.value, u.acceleration_factor(), Kind::Magnitude, "deceleration", un.acc,
+                    d.profile_deceleration, out))
+        return out;
       d.relative = false;  // resolved above
-      d.profile_velocity = *pv;
-      d.profile_acceleration = *pa;
-      d.profile_deceleration = *pd;
       break;
     }
     case CommandKind::Velocity: {
@@ -140,24 +189,25 @@ Conversion validate_and_convert(const AxisSpec& spec, const Command& cmd, double
       if (!a.ok || !dc.ok)
         return reject("acceleration/deceleration must be >= 0 and at most %.6g %s/s^2", lim.max_acceleration,
                       unit_of(spec));
-      const auto v = to_int32(u.velocity_to_drive(cmd.velocity));
-      const auto pa = to_uint32(u.acceleration_to_drive(a.value));
-      const auto pd = to_uint32(u.acceleration_to_drive(dc.value));
-      if (!v || !pa || !pd) return reject("velocity values do not fit the drive's objects after unit conversion");
-      d.target_velocity = *v;
-      d.profile_acceleration = *pa;
-      d.profile_deceleration = *pd;
+      if (!to_drive(cmd.velocity, u.velocity_factor(), Kind::Magnitude, "velocity", un.vel, d.target_velocity, out) ||
+          !to_drive(a.value, u.acceleration_factor(), Kind::Magnitude, "acceleration", un.acc, d.profile_acceleration,
+                    out) ||
+          !to_drive(dc.value, u.acceleration_factor(), Kind::Magnitude, "deceleration", un.acc,
+                    d.profile_deceleration, out))
+        return out;
       break;
     }
     case CommandKind::Torque: {
       if (lim.max_torque > 0 && std::fabs(cmd.torque) > lim.max_torque)
         return reject("torque %.6g exceeds the limit of axis '%s' (%.6g)", cmd.torque, spec.name.c_str(),
                       lim.max_torque);
-      const auto t = to_int16(u.torque_to_drive(cmd.torque));
-      const auto slope = to_uint32(u.torque_to_drive(spec.defaults.torque_slope));
-      if (!t || !slope) return reject("torque does not fit the drive's 16-bit object after unit conversion");
-      d.target_torque = *t;
-      d.torque_slope = *slope;
+      const char* tq_unit = u.torque_in_nm() ? "Nm" : "%";
+      char slope_unit[8];
+      std::snprintf(slope_unit, sizeof slope_unit, "%s/s", tq_unit);
+      if (!to_drive(cmd.torque, u.torque_factor(), Kind::Magnitude, "torque", tq_unit, d.target_torque, out) ||
+          !to_drive(spec.defaults.torque_slope, u.torque_factor(), Kind::Magnitude, "torque slope", slope_unit,
+                    d.torque_slope, out))
+        return out;
       break;
     }
     case CommandKind::Home: {
@@ -175,16 +225,15 @@ Conversion validate_and_convert(const AxisSpec& spec, const Command& cmd, double
       const Rate s2 = resolve_rate(cmd.homing_zero_velocity, h.zero_velocity, lim.max_velocity);
       if (!s1.ok || !s2.ok)
         return reject("homing speeds must be >= 0 and at most %.6g %s/s", lim.max_velocity, unit_of(spec));
-      const auto off = to_int32(u.position_to_drive(offset));
-      const auto v1 = to_uint32(u.velocity_to_drive(s1.value));
-      const auto v2 = to_uint32(u.velocity_to_drive(s2.value));
-      const auto acc = to_uint32(u.acceleration_to_drive(h.acceleration));
-      if (!off || !v1 || !v2 || !acc) return reject("homing values do not fit the drive's objects after unit conversion");
       d.homing_method = static_cast<std::int8_t>(method);
-      d.home_offset = *off;
-      d.homing_search_velocity = *v1;
-      d.homing_zero_velocity = *v2;
-      d.homing_acceleration = *acc;
+      if (!to_drive(offset, u.position_factor(), Kind::Position, "home offset", un.pos, d.home_offset, out) ||
+          !to_drive(s1.value, u.velocity_factor(), Kind::Magnitude, "homing search velocity", un.vel,
+                    d.homing_search_velocity, out) ||
+          !to_drive(s2.value, u.velocity_factor(), Kind::Magnitude, "homing zero velocity", un.vel,
+                    d.homing_zero_velocity, out) ||
+          !to_drive(h.acceleration, u.acceleration_factor(), Kind::Magnitude, "homing acceleration", un.acc,
+                    d.homing_acceleration, out))
+        return out;
       break;
     }
     case CommandKind::RunBlock:

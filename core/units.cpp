@@ -11,6 +11,7 @@ UnitConverter::UnitConverter(const Mechanics& m, const NativeUnits& n) noexcept 
   pos_ = rev_per_user * n.position_per_rev;
   vel_ = rev_per_user * n.velocity_per_rps;
   acc_ = rev_per_user * n.acceleration_per_rps2;
+  torque_in_nm_ = m.rated_torque > 0;
   tq_ = m.rated_torque > 0 ? n.torque_per_rated / m.rated_torque : n.torque_per_rated / 100.0;
 }
 

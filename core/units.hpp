@@ -48,12 +48,15 @@ class UnitConverter {
   [[nodiscard]] double velocity_factor() const noexcept { return vel_; }
   [[nodiscard]] double acceleration_factor() const noexcept { return acc_; }
   [[nodiscard]] double torque_factor() const noexcept { return tq_; }
+  // Torque in Nm (the axis gives its rated torque) rather than percent of rated.
+  [[nodiscard]] bool torque_in_nm() const noexcept { return torque_in_nm_; }
 
  private:
   double pos_ = 1.0;
   double vel_ = 1.0;
   double acc_ = 1.0;
   double tq_ = 1.0;
+  bool torque_in_nm_ = false;
 };
 
 // Rounded conversions that refuse values the drive's data type cannot hold (instead of wrapping).

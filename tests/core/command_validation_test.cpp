@@ -131,6 +131,69 @@ TEST(CommandValidation, TorqueOutsideLimitAndOverflowAreRejected) {
   EXPECT_FALSE(validate_and_convert(spec, t, 0).ok);
 }
 
+// Validated in drive units after conversion: a value that becomes 0 would make the drive keep its
+// previous profile velocity (a move at 1e-300 mm/s ran at 200 mm/s), so it is refused.
+TEST(CommandValidation, RatesThatRoundToZeroDriveUnitsAreRefused) {
+  const auto spec = drivegate::test::linear_axis_spec();  // 1000 drive units per mm (and per mm/s)
+  auto c = move_to(10);
+  c.velocity = 1e-300;
+  auto r = validate_and_convert(spec, c, 0);
+  ASSERT_FALSE(r.ok);
+  EXPECT_NE(r.reason.view().find("move velocity 1e-300 mm/s is 0 in drive units"), std::string_view::npos)
+      << r.reason.view();
+  EXPECT_NE(r.reason.view().find("resolution is 0.001 mm/s"), std::string_view::npos) << r.reason.view();
+  c.velocity = 0.0004;  // 0.4 drive units: rounds to 0
+  EXPECT_FALSE(validate_and_convert(spec, c, 0).ok);
+  c.velocity = 0.0006;  // 0.6: rounds to 1, the slowest the drive can go
+  r = validate_and_convert(spec, c, 0);
+  ASSERT_TRUE(r.ok) << r.reason.view();
+  EXPECT_EQ(r.drive.profile_velocity, 1u);
+  c.velocity = 10;
+  c.acceleration = 1e-9;
+  r = validate_and_convert(spec, c, 0);
+  ASSERT_FALSE(r.ok);
+  EXPECT_NE(r.reason.view().find("acceleration"), std::string_view::npos) << r.reason.view();
+  c.acceleration = 0;
+  c.deceleration = 1e-9;
+  EXPECT_FALSE(validate_and_convert(spec, c, 0).ok);
+
+  // A velocity command of exactly 0 is a legitimate "stand still"; a tiny one of either sign is not.
+  Command v;
+  v.kind = CommandKind::Velocity;
+  v.velocity = 0;
+  EXPECT_TRUE(validate_and_convert(spec, v, 0).ok);
+  v.velocity = -1e-12;
+  r = validate_and_convert(spec, v, 0);
+  ASSERT_FALSE(r.ok);
+  EXPECT_NE(r.reason.view().find("velocity -1e-12 mm/s is 0 in drive units"), std::string_view::npos)
+      << r.reason.view();
+
+  Command t;
+  t.kind = CommandKind::Torque;
+  t.torque = 0.01;  // 0.1 per mille
+  r = validate_and_convert(spec, t, 0);
+  ASSERT_FALSE(r.ok);
+  EXPECT_NE(r.reason.view().find("torque 0.01 % is 0 in drive units"), std::string_view::npos) << r.reason.view();
+
+  Command h;
+  h.kind = CommandKind::Home;
+  h.homing_search_velocity = 1e-7;
+  EXPECT_FALSE(validate_and_convert(spec, h, 0).ok);
+}
+
+// Positions are quantised to the drive's resolution as usual; only overflow is refused.
+TEST(CommandValidation, PositionsRoundButMustFitTheDriveObject) {
+  auto spec = drivegate::test::linear_axis_spec();
+  auto r = validate_and_convert(spec, move_to(1e-7), 0);
+  ASSERT_TRUE(r.ok) << r.reason.view();
+  EXPECT_EQ(r.drive.target_position, 0);
+  spec.limits = AxisLimits{};  // no soft limits: the 32-bit object is the only bound
+  r = validate_and_convert(spec, move_to(3e6), 0);  // 3e9 counts
+  ASSERT_FALSE(r.ok);
+  EXPECT_NE(r.reason.view().find("move target 3e+06 mm does not fit the drive's 32-bit object"), std::string_view::npos)
+      << r.reason.view();
+}
+
 TEST(CommandValidation, SetpointsAreCheckedForTheModeTheyFeed) {
   const auto spec = drivegate::test::linear_axis_spec();
   Text why;
