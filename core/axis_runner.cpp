@@ -7,6 +7,19 @@
 
 namespace drivegate::core {
 
+namespace {
+// Commands that end a velocity or torque run (a new velocity or torque command included).
+bool ends_live_run(CommandKind k) noexcept {
+  switch (k) {
+    case CommandKind::Enable:
+    case CommandKind::Halt:
+    case CommandKind::Resume:
+    case CommandKind::FaultReset: return false;
+    default: return true;
+  }
+}
+}  // namespace
+
 AxisRunner::AxisRunner(AxisIndex index, const AxisSpec& spec, AxisController& controller) noexcept
     : index_(index), spec_(spec), controller_(controller) {
   snapshot_.axis = index;
@@ -48,6 +61,7 @@ void AxisRunner::command(const Command& cmd, TimePoint now, RunnerOutput& out) n
   // A controller may finish a trivial command inside submit(); completed()/failed() then queue
   // Accepted first so that every command's replies arrive in order.
   submitting_ = cmd.id;
+  submitting_kind_ = cmd.kind;
   accepted_sent_ = false;
   const Admission adm = controller_.submit(conv.drive, now, *this);
   submitting_ = 0;
@@ -56,6 +70,18 @@ void AxisRunner::command(const Command& cmd, TimePoint now, RunnerOutput& out) n
     return;
   }
   if (!accepted_sent_) send_reply(cmd.id, ReplyStatus::Accepted, {});
+  // Every motion or device command takes over from a running velocity or torque command: that run
+  // has ended as the client asked. Halt, resume, enable and fault reset leave it running.
+  if (live_command_ != 0 && live_command_ != cmd.id && ends_live_run(cmd.kind)) {
+    if (is_internal(cmd.id))
+      end_live_command(ReplyStatus::Failed, ending_.empty() ? std::string_view("stopped by the gateway") : ending_.view());
+    else
+      end_live_command(ReplyStatus::Completed, {});
+  }
+  if (!is_internal(cmd.id) && (cmd.kind == CommandKind::Velocity || cmd.kind == CommandKind::Torque)) {
+    live_command_ = cmd.id;
+    live_reached_ = false;
+  }
 
   if (!is_internal(cmd.id)) active_command_ = cmd.id;
   if (cmd.kind == CommandKind::Move) {
@@ -160,6 +186,7 @@ void AxisRunner::observe_link(TimePoint now, LinkState link, std::string_view de
     if (was_up) {
       live_armed_ = false;
       controller_.link_lost(now, *this);
+      end_live_command(ReplyStatus::Failed, "link to drive lost");
     }
   }
 }
@@ -169,6 +196,7 @@ void AxisRunner::update(TimePoint now, RunnerOutput& out) noexcept {
   now_ = now;
   ++cycle_;
   controller_.update(now, *this);
+  watch_live_command();
   select_default_mode(now);
   build_snapshot(now);
   check_command_timeout(now);
@@ -200,15 +228,22 @@ void AxisRunner::select_default_mode(TimePoint now) noexcept {
   }
 }
 
-void AxisRunner::internal_stop(CommandKind kind, TimePoint now) noexcept {
+void AxisRunner::internal_stop(CommandKind kind, TimePoint now, std::string_view why) noexcept {
   DriveCommand stop;
   stop.id = next_internal_++;
   stop.kind = kind;
+  // A command of a client that the controller aborts for this stop fails with `why`.
+  ending_.assign(why);
+  submitting_ = stop.id;
+  submitting_kind_ = kind;
   const Admission adm = controller_.submit(stop, now, *this);
+  submitting_ = 0;
+  end_live_command(ReplyStatus::Failed, why);
+  ending_.clear();
   if (!adm.accepted) {
-    Text why;
-    why.format("the gateway's %s was refused by the profile: %s", to_string(kind).data(), adm.reason.c_str());
-    emit(EventKind::Warning, 0, why.view());
+    Text refused;
+    refused.format("the gateway's %s was refused by the profile: %s", to_string(kind).data(), adm.reason.c_str());
+    emit(EventKind::Warning, 0, refused.view());
   }
 }
 
@@ -232,7 +267,7 @@ void AxisRunner::check_command_timeout(TimePoint now) noexcept {
            static_cast<long long>(limit_ms), to_string(fb.mode).data(),
            kind == CommandKind::Stop ? "stopping the axis" : "quick stop");
   emit(EventKind::CommandTimeout, 0, t.view());
-  internal_stop(kind, now);
+  internal_stop(kind, now, t.view());
 }
 
 // Profile position and homing keep to the limits through the checked target; the modes that set
@@ -263,7 +298,7 @@ void AxisRunner::check_soft_limits(TimePoint now) noexcept {
   t.format("position %.6g %s is outside the soft limits [%.6g, %.6g] %s and moving out: quick stop", pos,
            spec_.user_unit.c_str(), lim.min_position, lim.max_position, spec_.user_unit.c_str());
   emit(EventKind::Warning, 0, t.view());
-  internal_stop(CommandKind::QuickStop, now);
+  internal_stop(CommandKind::QuickStop, now, t.view());
 }
 
 void AxisRunner::build_snapshot(TimePoint now) noexcept {
@@ -297,6 +332,11 @@ void AxisRunner::completed(CommandId id) noexcept {
     accepted_sent_ = true;
   }
   if (id == move_in_flight_) move_in_flight_ = 0;
+  if (id == live_command_) {
+    // The drive runs at the commanded speed or torque: the run goes on until something ends it.
+    live_reached_ = true;
+    return;
+  }
   if (id == active_command_) active_command_ = 0;
   send_reply(id, ReplyStatus::Completed, {});
 }
@@ -308,7 +348,41 @@ void AxisRunner::failed(CommandId id, std::string_view reason) noexcept {
   }
   if (id == move_in_flight_) move_in_flight_ = 0;
   if (id == active_command_) active_command_ = 0;
+  if (id == live_command_) {
+    live_command_ = 0;
+    // Aborted by a later command of a client: that run ended as asked. Stopped by the gateway
+    // itself: the gateway's reason, not the internal command that carried the stop out.
+    if (submitting_ != 0 && id != submitting_ && ends_live_run(submitting_kind_)) {
+      if (!is_internal(submitting_)) return send_reply(id, ReplyStatus::Completed, {});
+      return send_reply(id, ReplyStatus::Failed,
+                        ending_.empty() ? std::string_view("stopped by the gateway") : ending_.view());
+    }
+  }
   send_reply(id, ReplyStatus::Failed, reason);
+}
+
+void AxisRunner::end_live_command(ReplyStatus status, std::string_view reason) noexcept {
+  if (live_command_ == 0) return;
+  const CommandId id = live_command_;
+  live_command_ = 0;
+  if (id == active_command_) active_command_ = 0;
+  // Still in the controller's hands: the controller reports its end itself (failed() above).
+  if (!live_reached_) return;
+  send_reply(id, status, reason);
+}
+
+// A run the drive gave up by itself (fault, quick stop, power stage off) has failed.
+void AxisRunner::watch_live_command() noexcept {
+  if (live_command_ == 0 || !live_reached_) return;
+  const DriveFeedback& fb = controller_.feedback();
+  if (fb.state == AxisState::OperationEnabled) return;
+  Text why;
+  if (fb.state == AxisState::Fault || fb.state == AxisState::FaultReactionActive)
+    why.format("drive left operation_enabled: %s%s%s", to_string(fb.state).data(), fb.fault_text.empty() ? "" : ": ",
+               fb.fault_text.c_str());
+  else
+    why.format("drive left operation_enabled: now %s", to_string(fb.state).data());
+  end_live_command(ReplyStatus::Failed, why.view());
 }
 
 void AxisRunner::event(EventKind kind, std::uint32_t code, std::string_view text) noexcept { emit(kind, code, text); }

@@ -22,11 +22,6 @@ class RunnerOutput {
   ~RunnerOutput() = default;
 };
 
-// Commands the gateway issues itself (command timeout, shutdown) carry ids with this bit set;
-// their outcomes produce no reply.
-inline constexpr CommandId kInternalCommandBit = CommandId{1} << 63;
-constexpr bool is_internal(CommandId id) noexcept { return (id & kInternalCommandBit) != 0; }
-
 class AxisRunner final : private ControllerSink {
  public:
   AxisRunner(AxisIndex index, const AxisSpec& spec, AxisController& controller) noexcept;
@@ -61,7 +56,9 @@ class AxisRunner final : private ControllerSink {
   void emit(EventKind kind, std::uint32_t code, std::string_view text) noexcept;
   void check_command_timeout(TimePoint now) noexcept;
   void check_soft_limits(TimePoint now) noexcept;
-  void internal_stop(CommandKind kind, TimePoint now) noexcept;
+  void internal_stop(CommandKind kind, TimePoint now, std::string_view why) noexcept;
+  void end_live_command(ReplyStatus status, std::string_view reason) noexcept;
+  void watch_live_command() noexcept;
   void select_default_mode(TimePoint now) noexcept;
   void build_snapshot(TimePoint now) noexcept;
 
@@ -85,9 +82,17 @@ class AxisRunner final : private ControllerSink {
   bool default_mode_pending_ = true;
   int default_mode_attempts_ = 0;
 
+  // The velocity or torque command that set the axis running (DESIGN.md §4). Its final reply is
+  // given when the run ends, not when the drive reaches the speed: completed when a later command
+  // ends it, failed (with the reason) when the gateway or the drive does.
+  CommandId live_command_ = 0;
+  bool live_reached_ = false;  // the controller finished its handshake; the reply is held back
+  Text ending_;                // while the gateway stops the axis itself: why (non-empty)
+
   LinkState last_link_ = LinkState::Offline;
   CommandId active_command_ = 0;
   CommandId submitting_ = 0;    // id inside controller_.submit(), for inline completion
+  CommandKind submitting_kind_ = CommandKind::Enable;
   bool accepted_sent_ = false;  // Accepted already queued for submitting_
   std::uint64_t cycle_ = 0;
   std::uint64_t rejected_setpoints_ = 0;

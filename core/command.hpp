@@ -19,6 +19,11 @@ using AxisIndex = std::uint16_t;  // index of an axis within its bus
 inline constexpr AxisIndex kNoAxis = 0xFFFF;
 using Text = FixedString<160>;
 
+// Commands the gateway issues itself (command timeout, shutdown) carry ids with this bit set;
+// their outcomes produce no reply.
+inline constexpr CommandId kInternalCommandBit = CommandId{1} << 63;
+constexpr bool is_internal(CommandId id) noexcept { return (id & kInternalCommandBit) != 0; }
+
 // A command in user units. A rate or acceleration of 0 means "use the axis default from the
 // configuration"; NaN and infinity are always rejected.
 struct Command {

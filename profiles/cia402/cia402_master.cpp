@@ -176,12 +176,14 @@ void Cia402Master::complete_slot(Slot& slot, core::ControllerSink& sink) noexcep
 
 void Cia402Master::abort_slot(Slot& slot, const core::DriveCommand& by, core::ControllerSink& sink) noexcept {
   if (!slot.active) return;
+  // Command ids are the gateway's own bookkeeping, meaningless to the client that reads this.
   core::Text reason;
-  if (slot.kind == by.kind) {
-    reason.format("superseded by command %llu", static_cast<unsigned long long>(by.id));
-  } else {
-    reason.format("aborted by %s command %llu", core::to_string(by.kind).data(), static_cast<unsigned long long>(by.id));
-  }
+  if (core::is_internal(by.id))
+    reason.format("aborted by the gateway's %s", core::to_string(by.kind).data());
+  else if (slot.kind == by.kind)
+    reason.format("superseded by a newer %s command", core::to_string(by.kind).data());
+  else
+    reason.format("aborted by a %s command", core::to_string(by.kind).data());
   fail_slot(slot, reason.view(), sink);
 }
 

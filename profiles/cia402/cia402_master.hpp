@@ -5,7 +5,7 @@
 // Command slots: a device-control command (enable, disable, quick_stop, fault_reset), a motion
 // command (set_mode, move, velocity, torque, home, stop) and a halt command (halt, resume) can be in
 // flight at the same time. A newer command of the same kind supersedes the older one ("superseded
-// by command N"); a newer conflicting one aborts it ("aborted by <kind> command N"). Disable and
+// by a newer move command"); a newer conflicting one aborts it ("aborted by a stop command"). Disable and
 // quick stop abort everything. A new motion command clears halt (it implies resume). Acyclic
 // requests of a command that ends early are cancelled (ObjectAccess::cancel).
 //

@@ -166,6 +166,10 @@ client::CommandResult CanopenE2e::send(const client::CommandRequest& r, std::chr
   return client_->send(r, true, timeout);
 }
 
+client::CommandResult CanopenE2e::start(const client::CommandRequest& r, std::chrono::milliseconds timeout) {
+  return client_->send(r, false, timeout);
+}
+
 client::CommandResult CanopenE2e::send(const std::string& axis, const std::string& kind,
                                        std::chrono::milliseconds timeout) {
   return send(request(axis, kind), timeout);

@@ -52,6 +52,9 @@ class CanopenE2e : public ::testing::Test {
   client::CommandRequest request(const std::string& axis, const std::string& kind) const;
   // Sends and waits for the final reply.
   client::CommandResult send(const client::CommandRequest& r, std::chrono::milliseconds timeout = 10s);
+  // Sends and waits for the first reply only: a velocity or torque command runs (and has no final
+  // reply) until a later command, the command timeout or the drive ends it.
+  client::CommandResult start(const client::CommandRequest& r, std::chrono::milliseconds timeout = 10s);
   client::CommandResult send(const std::string& axis, const std::string& kind,
                              std::chrono::milliseconds timeout = 10s);
 

@@ -25,8 +25,8 @@ class CanopenE2eFaults : public CanopenE2eUp {
   void jog(const std::string& axis, double velocity) {
     auto v = request(axis, "velocity");
     v.velocity = velocity;
-    const auto r = send(v);
-    ASSERT_EQ(r.outcome, Outcome::Completed) << axis << ": " << r.reason << diagnostics();
+    const auto r = start(v);
+    ASSERT_EQ(r.outcome, Outcome::Accepted) << axis << ": " << r.reason << diagnostics();
     ASSERT_TRUE(keep_alive_until(axis, 0, velocity, 0, [&](const AxisState& s) {
       return std::fabs(s.velocity - velocity) < 0.1 * velocity;
     }, 5s)) << diagnostics();

@@ -23,6 +23,11 @@ class CanopenE2eModes : public CanopenE2eUp {
         << result.reason << diagnostics();
   }
   void expect_completed(const std::string& axis, const std::string& kind) { expect_completed(request(axis, kind)); }
+  void expect_running(const client::CommandRequest& r) {
+    const auto result = start(r);
+    ASSERT_EQ(result.outcome, Outcome::Accepted)
+        << r.axis << " " << r.kind << ": " << client::to_string(result.outcome) << ", " << result.reason << diagnostics();
+  }
 
   void enable(const std::string& axis) {
     ASSERT_NO_FATAL_FAILURE(expect_completed(axis, "enable"));
@@ -55,7 +60,7 @@ class CanopenE2eModes : public CanopenE2eUp {
     auto v = request(axis, "velocity");
     v.mode = mode;
     v.velocity = velocity;
-    ASSERT_NO_FATAL_FAILURE(expect_completed(v));
+    ASSERT_NO_FATAL_FAILURE(expect_running(v));
     ASSERT_TRUE(keep_alive_until(axis, 0, velocity, 0, [&](const AxisState& s) {
       return s.mode == shown && std::fabs(s.velocity - velocity) < tolerance;
     }, 5s)) << shown << diagnostics();
@@ -66,7 +71,7 @@ class CanopenE2eModes : public CanopenE2eUp {
   void torque(const std::string& axis, double percent) {
     auto t = request(axis, "torque");
     t.torque = percent;
-    ASSERT_NO_FATAL_FAILURE(expect_completed(t));
+    ASSERT_NO_FATAL_FAILURE(expect_running(t));
     ASSERT_TRUE(keep_alive_until(axis, 0, 0, percent, [&](const AxisState& s) {
       return s.mode == "profile_torque" && std::fabs(s.torque - percent) < 0.2;
     }, 5s)) << diagnostics();

@@ -93,7 +93,7 @@ TEST(ProfilePosition, NewerMoveSupersedesAndGetsAFreshEdge) {
   ASSERT_TRUE(h.submit(move(7, 100)).accepted);
   EXPECT_EQ(h.cycle(kSwEnabled), 0x001F);
   ASSERT_TRUE(h.submit(move(8, 200)).accepted);
-  EXPECT_EQ(h.sink.failure(7), "superseded by command 8");
+  EXPECT_EQ(h.sink.failure(7), "superseded by a newer move command");
   EXPECT_EQ(h.cycle(kSwEnabled), 0x000F);  // bit 4 low for a cycle ...
   EXPECT_EQ(h.cycle(kSwEnabled), 0x001F);  // ... then the new rising edge
   EXPECT_EQ(h.io.value(obj::kTargetPosition.id), 200);
@@ -202,7 +202,7 @@ TEST(ProfileVelocity, StopSetsVelocityZeroAndKeepsEnable) {
   ASSERT_TRUE(h.submit(c).accepted);
   h.cycle(kSwEnabled);
   ASSERT_TRUE(h.submit(command(8, CommandKind::Stop)).accepted);
-  EXPECT_EQ(h.sink.failure(7), "aborted by stop command 8");
+  EXPECT_EQ(h.sink.failure(7), "aborted by a stop command");
   EXPECT_EQ(h.cycle(kSwEnabled), 0x000F);
   EXPECT_EQ(h.io.value(obj::kTargetVelocity.id), 0);
   for (int i = 0; i < 3; ++i) h.cycle(kSwEnabledReached);
@@ -412,7 +412,7 @@ TEST(Halt, NewMoveImpliesResume) {
   ASSERT_TRUE(h.submit(command(7, CommandKind::Halt)).accepted);
   h.cycle(kSwEnabled);
   ASSERT_TRUE(h.submit(move(8, 5)).accepted);
-  EXPECT_EQ(h.sink.failure(7), "aborted by move command 8");
+  EXPECT_EQ(h.sink.failure(7), "aborted by a move command");
   EXPECT_EQ(h.cycle(kSwEnabled), 0x001F);
 }
 
@@ -423,7 +423,7 @@ TEST(Stop, ProfilePositionHaltsAndKeepsEnable) {
   h.cycle(kSwEnabled);
   h.cycle(kSwEnabledAck);
   ASSERT_TRUE(h.submit(command(8, CommandKind::Stop)).accepted);
-  EXPECT_EQ(h.sink.failure(7), "aborted by stop command 8");
+  EXPECT_EQ(h.sink.failure(7), "aborted by a stop command");
   EXPECT_EQ(h.cycle(kSwEnabled), 0x010F);
   for (int i = 0; i < 3; ++i) h.cycle(kSwEnabledReached);
   EXPECT_TRUE(h.sink.done(8));

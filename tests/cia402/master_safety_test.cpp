@@ -227,7 +227,7 @@ TEST(DeviceCommands, DisableInFaultOrNotReadyCompletesAtOnce) {
   EXPECT_EQ(h.cycle(kSwFault), 0x0080);
   ASSERT_TRUE(h.submit(command(2, CommandKind::Disable)).accepted);
   EXPECT_TRUE(h.sink.done(2));
-  EXPECT_EQ(h.sink.failure(1), "aborted by disable command 2");
+  EXPECT_EQ(h.sink.failure(1), "aborted by a disable command");
   EXPECT_EQ(h.cycle(kSwFault), 0x0000);
   Harness n;
   n.cycle(0x0000);  // not ready to switch on

@@ -20,6 +20,9 @@ class FakeController final : public AxisController {
   Admission submit(const DriveCommand& cmd, TimePoint, ControllerSink& sink) noexcept override {
     submitted.push_back(cmd);
     if (refuse) return Admission::reject("axis is in fault: send fault_reset first");
+    // Like the CiA 402 master: a new command aborts the one in flight.
+    if (abort_in_flight && in_flight != 0) sink.failed(in_flight, "aborted by a newer command");
+    in_flight = cmd.id;
     if (complete_inline) sink.completed(cmd.id);
     if (cmd.kind == CommandKind::Velocity) fb.mode = Mode::ProfileVelocity;
     return Admission::accept();
@@ -42,6 +45,8 @@ class FakeController final : public AxisController {
   int link_losses = 0;
   bool refuse = false;
   bool complete_inline = false;
+  bool abort_in_flight = false;
+  CommandId in_flight = 0;
   CommandId complete_next = 0;
 };
 
@@ -53,6 +58,13 @@ class Recorder final : public RunnerOutput {
   std::vector<Reply> replies;
   std::vector<Event> events;
   std::vector<ParamReply> params;
+  // The replies to one command, in order.
+  std::vector<Reply> to(CommandId id) const {
+    std::vector<Reply> v;
+    for (const auto& r : replies)
+      if (r.id == id) v.push_back(r);
+    return v;
+  }
   bool has_event(EventKind k) const {
     for (const auto& e : events)
       if (e.kind == k) return true;
@@ -151,6 +163,96 @@ TEST_F(RunnerFixture, SilenceAfterVelocityCommandStopsTheAxis) {
   // Only once.
   runner.update(now + 2s, LinkState::Operational, out);
   EXPECT_EQ(ctl.submitted.size(), 2u);
+}
+
+// A velocity command's final reply comes when the run ends, not when the speed is reached: here
+// the command timeout ends it, so it fails with the timeout as its reason.
+TEST_F(RunnerFixture, VelocityStoppedByTheCommandTimeoutFailsWithTheTimeout) {
+  auto v = cmd(31, CommandKind::Velocity);
+  v.velocity = 20;
+  runner.command(v, now, out);
+  ctl.complete_next = 31;  // the drive reached the speed
+  runner.update(now + 10ms, LinkState::Operational, out);
+  ASSERT_EQ(out.to(31).size(), 1u);
+  EXPECT_EQ(out.to(31)[0].status, ReplyStatus::Accepted);
+  EXPECT_EQ(runner.snapshot().active_command, 31u);  // still running
+  runner.update(now + 200ms, LinkState::Operational, out);
+  ASSERT_EQ(ctl.submitted.back().kind, CommandKind::QuickStop);
+  const auto r = out.to(31);
+  ASSERT_EQ(r.size(), 2u);
+  EXPECT_EQ(r[1].status, ReplyStatus::Failed);
+  EXPECT_NE(r[1].reason.view().find("command timeout 100 ms"), std::string_view::npos) << r[1].reason.view();
+  runner.update(now + 1s, LinkState::Operational, out);
+  EXPECT_EQ(out.to(31).size(), 2u);  // exactly one final reply
+}
+
+// The same while the drive is still accelerating: the controller aborts the command for the
+// gateway's stop, and the reply names the timeout instead of the internal stop command.
+TEST_F(RunnerFixture, VelocityAbortedByTheTimeoutBeforeReachingSpeedFailsWithTheTimeout) {
+  ctl.abort_in_flight = true;
+  auto v = cmd(32, CommandKind::Velocity);
+  v.velocity = 20;
+  runner.command(v, now, out);
+  runner.update(now + 200ms, LinkState::Operational, out);
+  const auto r = out.to(32);
+  ASSERT_EQ(r.size(), 2u);
+  EXPECT_EQ(r[1].status, ReplyStatus::Failed);
+  EXPECT_NE(r[1].reason.view().find("no command or set-point"), std::string_view::npos) << r[1].reason.view();
+  EXPECT_EQ(r[1].reason.view().find("command 9"), std::string_view::npos) << r[1].reason.view();
+}
+
+// A client's stop (or any later motion command) ends the run as asked: completed.
+TEST_F(RunnerFixture, VelocityEndedByTheClientsStopCompletes) {
+  auto v = cmd(33, CommandKind::Velocity);
+  v.velocity = 20;
+  runner.command(v, now, out);
+  ctl.complete_next = 33;
+  runner.update(now + 10ms, LinkState::Operational, out);
+  runner.command(cmd(34, CommandKind::Halt), now + 20ms, out);  // a pause does not end it
+  EXPECT_EQ(out.to(33).size(), 1u);
+  runner.command(cmd(35, CommandKind::Stop), now + 30ms, out);
+  auto r = out.to(33);
+  ASSERT_EQ(r.size(), 2u);
+  EXPECT_EQ(r[1].status, ReplyStatus::Completed);
+  // Not yet at speed, replaced by a new velocity command: completed too.
+  ctl.abort_in_flight = true;
+  auto w = cmd(36, CommandKind::Velocity);
+  w.velocity = 10;
+  runner.command(w, now + 40ms, out);
+  auto w2 = cmd(37, CommandKind::Velocity);
+  w2.velocity = 15;
+  runner.command(w2, now + 50ms, out);
+  r = out.to(36);
+  ASSERT_EQ(r.size(), 2u);
+  EXPECT_EQ(r[1].status, ReplyStatus::Completed);
+}
+
+// A drive that leaves operation enabled by itself (fault) or a lost link ends the run: failed.
+TEST_F(RunnerFixture, VelocityEndedByAFaultOrLinkLossFails) {
+  auto t = cmd(38, CommandKind::Torque);
+  t.torque = 10;
+  runner.command(t, now, out);
+  ctl.complete_next = 38;
+  runner.update(now + 10ms, LinkState::Operational, out);
+  ctl.fb.state = AxisState::Fault;
+  ctl.fb.fault_text.assign("F501 bus overvoltage");
+  runner.update(now + 20ms, LinkState::Operational, out);
+  auto r = out.to(38);
+  ASSERT_EQ(r.size(), 2u);
+  EXPECT_EQ(r[1].status, ReplyStatus::Failed);
+  EXPECT_NE(r[1].reason.view().find("F501"), std::string_view::npos) << r[1].reason.view();
+
+  ctl.fb.state = AxisState::OperationEnabled;
+  auto v = cmd(39, CommandKind::Velocity);
+  v.velocity = 5;
+  runner.command(v, now + 30ms, out);
+  ctl.complete_next = 39;
+  runner.update(now + 40ms, LinkState::Operational, out);
+  runner.update(now + 50ms, LinkState::Lost, out);
+  r = out.to(39);
+  ASSERT_EQ(r.size(), 2u);
+  EXPECT_EQ(r[1].status, ReplyStatus::Failed);
+  EXPECT_EQ(r[1].reason.view(), "link to drive lost");
 }
 
 TEST_F(RunnerFixture, HaltAndResumeKeepTheCommandTimeoutArmed) {
