@@ -43,7 +43,7 @@ const DeviceProfile* read_device(const MapReader& axis, AxisContext& ctx) {
     const auto available = ctx.devices.available();
     std::vector<std::string> dirs;
     for (const auto& d : ctx.devices.dirs()) dirs.push_back(d.string());
-    axis.error("device", "unknown device profile \"" + *name + "\"" + did_you_mean(*name, available) +
+    axis.error("device", "unknown device profile " + in_quotes(*name) + did_you_mean(*name, available) +
                              " (available: " + join(available) + "; searched: " + join(dirs) + ")");
     return nullptr;
   }
@@ -54,14 +54,27 @@ const DeviceProfile* read_device(const MapReader& axis, AxisContext& ctx) {
   return device;
 }
 
+// Sane ranges (config/README.md "Ranges"): wide enough for any real machine, narrow enough that
+// no accepted value makes a conversion overflow or round every command to nothing.
+constexpr double kMaxCounts = 4294967296.0;  // 2^32 counts per motor revolution
+constexpr double kMaxRatio = 1e6;            // gear ratio and feed
+constexpr double kMaxUserValue = 1e12;       // positions, speeds and ramps in user units
+constexpr double kMaxTorque = 1e6;           // percent or Nm
+
 void read_mechanics(const MapReader& m, const DeviceProfile* device, AxisPlan& a) {
   m.check_keys({"encoder_counts_per_rev", "gear_ratio", "feed", "rated_torque"});
   const bool counts_needed = device && device->units.position_base == UnitBase::EncoderCounts;
   const auto counts = m.number("encoder_counts_per_rev", counts_needed ? Need::Required : Need::Optional,
-                               NumberRule::positive());
-  a.mechanics.gear_ratio = m.number("gear_ratio", Need::Optional, NumberRule::positive()).value_or(1.0);
-  a.mechanics.feed = m.number("feed", Need::Optional, NumberRule::positive()).value_or(1.0);
-  a.mechanics.rated_torque = m.number("rated_torque", Need::Optional, NumberRule::non_negative()).value_or(0.0);
+                               NumberRule::range(1, kMaxCounts, "a number of counts per motor revolution in 1..2^32"));
+  const NumberRule ratio = NumberRule::range(1e-6, kMaxRatio);
+  a.mechanics.gear_ratio = m.number("gear_ratio", Need::Optional, ratio).value_or(1.0);
+  a.mechanics.feed = m.number("feed", Need::Optional, ratio).value_or(1.0);
+  const auto rated = m.number("rated_torque", Need::Optional,
+                              NumberRule::range(0, kMaxTorque, "0 (torque in percent) or a torque in 0.001..1e6 Nm"));
+  if (rated && *rated > 0 && *rated < 1e-3)
+    m.error("rated_torque", "must be 0 (torque in percent) or a torque in 0.001..1e6 Nm, got " + format_number(*rated));
+  else
+    a.mechanics.rated_torque = rated.value_or(0.0);
   if (device) {
     // Without an encoder resolution, a device with fixed position units defines the revolution.
     a.encoder_counts_per_rev = counts.value_or(device->units.position_base == UnitBase::Fixed
@@ -69,6 +82,12 @@ void read_mechanics(const MapReader& m, const DeviceProfile* device, AxisPlan& a
                                                    : 1.0);
     a.native = device->units.resolve(a.encoder_counts_per_rev);
     a.spec.units = core::UnitConverter(a.mechanics, a.native);
+    // Each factor alone is in range; together they must still give a usable scaling.
+    const double f = a.spec.units.position_factor();
+    if (!(f >= 1e-6 && f <= 1e15))
+      m.error(m.has("feed") ? "feed" : "gear_ratio",
+              "gives " + format_number(f) + " drive position units per " + a.spec.user_unit +
+                  " with this encoder, gear ratio and feed; it must be in 1e-06..1e15");
   }
 }
 
@@ -82,8 +101,9 @@ void check_fits_int32(const MapReader& m, std::string_view key, double drive_val
 void read_limits(const MapReader& m, AxisPlan& a, bool scaled) {
   m.check_keys({"min_position", "max_position", "max_velocity", "max_acceleration", "max_torque"});
   auto& l = a.spec.limits;
-  const auto min = m.number("min_position", Need::Optional, NumberRule::any());
-  const auto max = m.number("max_position", Need::Optional, NumberRule::any());
+  const NumberRule position = NumberRule::range(-kMaxUserValue, kMaxUserValue);
+  const auto min = m.number("min_position", Need::Optional, position);
+  const auto max = m.number("max_position", Need::Optional, position);
   if (m.has("min_position") != m.has("max_position")) {
     m.error(m.has("min_position") ? "max_position" : "min_position",
             "missing: give both min_position and max_position, or neither for no position limits");
@@ -100,9 +120,10 @@ void read_limits(const MapReader& m, AxisPlan& a, bool scaled) {
       }
     }
   }
-  l.max_velocity = m.number("max_velocity", Need::Optional, NumberRule::positive()).value_or(0.0);
-  l.max_acceleration = m.number("max_acceleration", Need::Optional, NumberRule::positive()).value_or(0.0);
-  l.max_torque = m.number("max_torque", Need::Optional, NumberRule::positive()).value_or(0.0);
+  const NumberRule rate = NumberRule::positive_up_to(kMaxUserValue);
+  l.max_velocity = m.number("max_velocity", Need::Optional, rate).value_or(0.0);
+  l.max_acceleration = m.number("max_acceleration", Need::Optional, rate).value_or(0.0);
+  l.max_torque = m.number("max_torque", Need::Optional, NumberRule::positive_up_to(kMaxTorque)).value_or(0.0);
   if (scaled && l.max_velocity > 0 && !core::to_uint32(a.spec.units.velocity_to_drive(l.max_velocity)))
     m.error("max_velocity", "is beyond the drive's 32-bit velocity range with this axis' scaling");
 }
@@ -128,10 +149,11 @@ void read_defaults(const MapReader& m, const DeviceProfile* device, AxisPlan& a)
   m.check_keys({"mode", "velocity", "acceleration", "deceleration", "torque_slope"});
   auto& d = a.spec.defaults;
   a.spec.default_mode = read_mode(m, "mode", device).value_or(core::Mode::None);
-  d.velocity = m.number("velocity", Need::Optional, NumberRule::positive()).value_or(0.0);
-  d.acceleration = m.number("acceleration", Need::Optional, NumberRule::positive()).value_or(0.0);
-  d.deceleration = m.number("deceleration", Need::Optional, NumberRule::positive()).value_or(0.0);
-  d.torque_slope = m.number("torque_slope", Need::Optional, NumberRule::non_negative()).value_or(0.0);
+  const NumberRule rate = NumberRule::positive_up_to(kMaxUserValue);
+  d.velocity = m.number("velocity", Need::Optional, rate).value_or(0.0);
+  d.acceleration = m.number("acceleration", Need::Optional, rate).value_or(0.0);
+  d.deceleration = m.number("deceleration", Need::Optional, rate).value_or(0.0);
+  d.torque_slope = m.number("torque_slope", Need::Optional, NumberRule::range(0, kMaxUserValue)).value_or(0.0);
   const auto& l = a.spec.limits;
   if (l.max_velocity > 0 && d.velocity > l.max_velocity)
     m.error("velocity", "must not exceed limits.max_velocity (" + format_number(l.max_velocity) + "), got " +
@@ -163,10 +185,11 @@ void read_homing(const MapReader& m, const DeviceProfile* device, AxisPlan& a) {
     else
       h.method = static_cast<std::int16_t>(*method);
   }
-  h.offset = m.number("offset", Need::Optional, NumberRule::any()).value_or(0.0);
-  h.search_velocity = m.number("search_velocity", Need::Optional, NumberRule::positive()).value_or(0.0);
-  h.zero_velocity = m.number("zero_velocity", Need::Optional, NumberRule::positive()).value_or(0.0);
-  h.acceleration = m.number("acceleration", Need::Optional, NumberRule::positive()).value_or(0.0);
+  const NumberRule rate = NumberRule::positive_up_to(kMaxUserValue);
+  h.offset = m.number("offset", Need::Optional, NumberRule::range(-kMaxUserValue, kMaxUserValue)).value_or(0.0);
+  h.search_velocity = m.number("search_velocity", Need::Optional, rate).value_or(0.0);
+  h.zero_velocity = m.number("zero_velocity", Need::Optional, rate).value_or(0.0);
+  h.acceleration = m.number("acceleration", Need::Optional, rate).value_or(0.0);
   h.timeout = m.duration("timeout", Need::Optional, 0ns, kMaxTimeout).value_or(h.timeout);
 }
 
@@ -175,12 +198,14 @@ void read_sim(const MapReader& m, AxisPlan& a, bool scaled) {
                 "max_acceleration"});
   const auto& u = a.spec.units;
   auto& s = a.sim;
-  const auto start = m.number("start_position", Need::Optional, NumberRule::any());
-  const auto home = m.number("home_switch", Need::Optional, NumberRule::any());
-  const auto neg = m.number("negative_limit_switch", Need::Optional, NumberRule::any());
-  const auto pos = m.number("positive_limit_switch", Need::Optional, NumberRule::any());
-  const auto vmax = m.number("max_velocity", Need::Optional, NumberRule::positive());
-  const auto amax = m.number("max_acceleration", Need::Optional, NumberRule::positive());
+  const NumberRule position = NumberRule::range(-kMaxUserValue, kMaxUserValue);
+  const NumberRule rate = NumberRule::positive_up_to(kMaxUserValue);
+  const auto start = m.number("start_position", Need::Optional, position);
+  const auto home = m.number("home_switch", Need::Optional, position);
+  const auto neg = m.number("negative_limit_switch", Need::Optional, position);
+  const auto pos = m.number("positive_limit_switch", Need::Optional, position);
+  const auto vmax = m.number("max_velocity", Need::Optional, rate);
+  const auto amax = m.number("max_acceleration", Need::Optional, rate);
   if (neg && pos && *neg >= *pos)
     m.error("negative_limit_switch", "must be less than positive_limit_switch (" + format_number(*pos) +
                                          "), got " + format_number(*neg));
@@ -215,7 +240,7 @@ ReadAxis read_axis(const MapReader& axis, AxisContext& ctx) {
     const auto it = std::find_if(ctx.buses.begin(), ctx.buses.end(), [&](const BusPlan& b) { return b.name == *bus; });
     if (it == ctx.buses.end()) {
       const auto known = bus_names(ctx.buses);
-      axis.error("bus", "unknown bus \"" + *bus + "\"" + did_you_mean(*bus, known) + " (buses: " + join(known) + ")");
+      axis.error("bus", "unknown bus " + in_quotes(*bus) + did_you_mean(*bus, known) + " (buses: " + join(known) + ")");
     } else {
       out.bus = static_cast<std::size_t>(it - ctx.buses.begin());
       bus_type = ctx.bus_types.find(it->type);

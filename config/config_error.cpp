@@ -14,12 +14,17 @@ std::string Diagnostic::to_string() const {
 }
 
 namespace {
+// A file of garbage could produce an error per line: the first ones say enough.
+constexpr std::size_t kShownProblems = 50;
+
 std::string render(const std::vector<Diagnostic>& problems) {
   std::string s;
-  for (const auto& d : problems) {
+  for (std::size_t i = 0; i < problems.size() && i < kShownProblems; ++i) {
     if (!s.empty()) s += '\n';
-    s += d.to_string();
+    s += problems[i].to_string();
   }
+  if (problems.size() > kShownProblems)
+    s += "\n... and " + std::to_string(problems.size() - kShownProblems) + " more problems";
   return s;
 }
 }  // namespace

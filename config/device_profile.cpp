@@ -81,8 +81,8 @@ void read_units(const MapReader& units, NativeUnitsSpec& out) {
   if (const YAML::Node n = pos.find("per_rev"); n.IsScalar() && n.Scalar() == "counts") {
     out.position_base = UnitBase::EncoderCounts;
   } else if (pos.present()) {
-    NumberRule rule = NumberRule::positive();
-    rule.words = "\"counts\" (the axis' encoder_counts_per_rev) or a number > 0";
+    NumberRule rule = NumberRule::positive_up_to(1e12);
+    rule.words = "\"counts\" (the axis' encoder_counts_per_rev) or a number > 0 and at most 1e12";
     if (const auto v = pos.number("per_rev", Need::Required, rule)) {
       out.position_base = UnitBase::Fixed;
       out.position_per_rev = *v;
@@ -103,7 +103,7 @@ void read_units(const MapReader& units, NativeUnitsSpec& out) {
     if (m.has("unit")) {
       if (const auto u = m.choice("unit", Need::Required, bases))
         base = (*u == "velocity_per_s") ? UnitBase::Velocity : UnitBase::Position;
-    } else if (const auto v = m.number(fixed_key, Need::Required, NumberRule::positive())) {
+    } else if (const auto v = m.number(fixed_key, Need::Required, NumberRule::positive_up_to(1e12))) {
       base = UnitBase::Fixed;
       value = *v;
     }
@@ -115,7 +115,7 @@ void read_units(const MapReader& units, NativeUnitsSpec& out) {
 
   const MapReader torque = units.map("torque", Need::Optional);
   torque.check_keys({"per_rated"});
-  if (const auto v = torque.number("per_rated", Need::Optional, NumberRule::positive()))
+  if (const auto v = torque.number("per_rated", Need::Optional, NumberRule::positive_up_to(1e9)))
     out.torque_per_rated = *v;
 }
 

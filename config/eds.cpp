@@ -298,7 +298,7 @@ bool same_text(std::string_view a, std::string_view b) noexcept {
 }  // namespace
 
 std::optional<std::vector<EdsObject>> parse_eds(const std::filesystem::path& file, Problems& problems) {
-  const auto text = read_text_file(file.string(), Source{file.string(), &problems});
+  const auto text = read_text_file(file.string(), Source{file.string(), &problems}, kMaxEdsBytes);
   if (!text) return std::nullopt;
   return parse_eds_text(*text, file.string(), problems);
 }

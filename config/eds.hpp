@@ -40,6 +40,9 @@ struct EdsObject {
   }
 };
 
+// EDS files of real drives run to a few hundred kilobytes; larger ones are refused.
+inline constexpr std::uint64_t kMaxEdsBytes = 16 * 1024 * 1024;
+
 // Parses an EDS file. Problems go to `problems` as "FILE:LINE:1: [SECTION].KEY: message"; the
 // result is nullopt when there was any.
 std::optional<std::vector<EdsObject>> parse_eds(const std::filesystem::path& file, Problems& problems);

@@ -96,10 +96,10 @@ void read_bus(const MapReader& b, const BusTypeRegistry& registry, BusPlan& bus)
     type = registry.find(*t);
     const auto available = registry.available_names();
     if (!type) {
-      b.error("type", "unknown bus type \"" + *t + "\"" + did_you_mean(*t, registry.names()) +
+      b.error("type", "unknown bus type " + in_quotes(*t) + did_you_mean(*t, registry.names()) +
                           " (available: " + join(available) + ")");
     } else if (!type->available) {
-      b.error("type", "bus type \"" + *t + "\" has no adapter in this build (available: " + join(available) + ")");
+      b.error("type", "bus type " + in_quotes(*t) + " has no adapter in this build (available: " + join(available) + ")");
       type = nullptr;
     } else {
       bus.type = *t;

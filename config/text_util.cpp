@@ -31,6 +31,9 @@ std::string closest_match(std::string_view word, std::span<const std::string> ca
   std::string best;
   std::size_t best_d = limit + 1;
   for (const auto& c : candidates) {
+    // The distance is at least the difference in length: skip the quadratic work for hopeless ones.
+    const std::size_t gap = word.size() > c.size() ? word.size() - c.size() : c.size() - word.size();
+    if (gap >= best_d) continue;
     const std::size_t d = edit_distance(word, c);
     if (d < best_d) {
       best_d = d;
@@ -69,6 +72,24 @@ std::string format_number(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.10g", v);
   return buf;
+}
+
+}  // namespace drivegate::config
+
+namespace drivegate::config {
+
+namespace {
+constexpr std::size_t kEchoLimit = 60;
+}
+
+std::string clipped(std::string_view value) {
+  if (value.size() <= kEchoLimit) return std::string{value};
+  return std::string{value.substr(0, kEchoLimit)} + "...(" + std::to_string(value.size()) + " characters)";
+}
+
+std::string in_quotes(std::string_view value) {
+  if (value.size() <= kEchoLimit) return "\"" + std::string{value} + "\"";
+  return "\"" + std::string{value.substr(0, kEchoLimit)} + "\"...(" + std::to_string(value.size()) + " characters)";
 }
 
 }  // namespace drivegate::config

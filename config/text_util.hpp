@@ -24,6 +24,12 @@ std::string indexed(std::string_view list, std::size_t i);
 // Names of gateways, buses and axes: [A-Za-z0-9_.-]{1,63}. With allow_punct false: [A-Za-z0-9_]{1,63}.
 bool is_valid_name(std::string_view s, bool allow_punct = true) noexcept;
 
+// `"value"` for messages, cut after 60 characters ("…(4096 characters)") so that a hostile or
+// mistaken value cannot flood the terminal or the journal.
+std::string in_quotes(std::string_view value);
+// The same without quotes, for field paths built from keys.
+std::string clipped(std::string_view value);
+
 // Shortest readable form of a number: "5", "0.5", "26214.4", "1e-06".
 std::string format_number(double v);
 

@@ -4,8 +4,10 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
-#include <fstream>
-#include <sstream>
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <limits>
 
 #include "config/scalars.hpp"
@@ -42,12 +44,18 @@ void Source::warning(const YAML::Mark& mark, std::string path, std::string messa
 
 std::string describe_value(const YAML::Node& node) {
   switch (node.Type()) {
-    case YAML::NodeType::Scalar: return "\"" + node.Scalar() + "\"";
+    case YAML::NodeType::Scalar: return in_quotes(node.Scalar());
     case YAML::NodeType::Map: return "a map";
     case YAML::NodeType::Sequence: return "a list";
     default: return "nothing";
   }
 }
+
+NumberRule NumberRule::range(double lo, double hi, std::string what) {
+  return {lo, hi, false, what.empty() ? "a number in " + format_number(lo) + ".." + format_number(hi) : std::move(what)};
+}
+
+NumberRule NumberRule::positive_up_to(double hi) { return {0, hi, true, "a number > 0 and at most " + format_number(hi)}; }
 
 std::optional<double> read_number(const YAML::Node& n, const std::string& path, const Source& src,
                                   const NumberRule& rule) {
@@ -86,20 +94,67 @@ std::optional<std::string> read_string(const YAML::Node& n, const std::string& p
   return n.Scalar();
 }
 
-std::optional<std::string> read_text_file(const std::string& file, const Source& src) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) {
-    src.error(YAML::Mark::null_mark(), "", "cannot open file: " + std::string{std::strerror(errno)});
+std::optional<std::string> read_text_file(const std::string& file, const Source& src, std::uint64_t max_bytes) {
+  const auto fail = [&](const std::string& why) {
+    src.error(YAML::Mark::null_mark(), "", why);
     return std::nullopt;
+  };
+  // Opened first and checked on the descriptor, so the file checked is the file read. O_NONBLOCK:
+  // opening a FIFO must not hang waiting for a writer.
+  const int fd = ::open(file.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK | O_NOCTTY);
+  if (fd < 0) return fail("cannot open file: " + std::string{std::strerror(errno)});
+  struct Closer {
+    int fd;
+    ~Closer() { ::close(fd); }
+  } closer{fd};
+  struct stat st{};
+  if (::fstat(fd, &st) != 0) return fail("cannot read file: " + std::string{std::strerror(errno)});
+  if (S_ISDIR(st.st_mode)) return fail("is a directory, not a file");
+  if (!S_ISREG(st.st_mode))
+    return fail(std::string{"is not a regular file (it is a "} +
+                (S_ISCHR(st.st_mode)    ? "character device"
+                 : S_ISBLK(st.st_mode)  ? "block device"
+                 : S_ISFIFO(st.st_mode) ? "pipe"
+                 : S_ISSOCK(st.st_mode) ? "socket"
+                                        : "special file") +
+                ")");
+  const auto too_big = [&](std::uint64_t size) {
+    return fail("is " + std::to_string(size) + " bytes; this kind of file is limited to " +
+                std::to_string(max_bytes / (1024 * 1024)) + " MiB");
+  };
+  if (static_cast<std::uint64_t>(st.st_size) > max_bytes) return too_big(static_cast<std::uint64_t>(st.st_size));
+  // Read at most one byte past the limit: a file that grows while it is read is caught too.
+  std::string text;
+  text.resize(static_cast<std::size_t>(st.st_size) + 1);
+  std::size_t have = 0;
+  for (;;) {
+    if (have == text.size()) {
+      if (text.size() > max_bytes) return too_big(have);
+      text.resize(std::min<std::size_t>(text.size() * 2, max_bytes + 1));
+    }
+    const ssize_t n = ::read(fd, text.data() + have, text.size() - have);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) return fail("cannot read file: " + std::string{std::strerror(errno)});
+    if (n == 0) break;
+    have += static_cast<std::size_t>(n);
   }
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
+  if (have > max_bytes) return too_big(have);
+  text.resize(have);
+  return text;
 }
 
 std::optional<YAML::Node> parse_document(const std::string& text, const Source& src) {
   try {
-    return YAML::Load(text);
+    // Every document is parsed so that a second one is an error rather than silently ignored.
+    std::vector<YAML::Node> docs = YAML::LoadAll(text);
+    if (docs.empty()) return YAML::Node{};
+    if (docs.size() > 1) {
+      src.error(docs[1].Mark(), "",
+                "a second YAML document starts here (after \"---\"); a configuration is one document: merge "
+                "them or remove the separator");
+      return std::nullopt;
+    }
+    return docs.front();
   } catch (const YAML::ParserException& e) {
     src.error(e.mark, "", "YAML syntax error: " + e.msg);
   } catch (const YAML::Exception& e) {
@@ -134,12 +189,12 @@ void MapReader::check_keys(std::span<const std::string> allowed) const {
     }
     const std::string& key = k.Scalar();
     if (std::find(seen.begin(), seen.end(), key) != seen.end()) {
-      src_.error(k.Mark(), field(key), "given more than once");
+      src_.error(k.Mark(), field(clipped(key)), "given more than once");
       continue;
     }
     seen.push_back(key);
     if (std::find(allowed.begin(), allowed.end(), key) == allowed.end())
-      src_.error(k.Mark(), field(key),
+      src_.error(k.Mark(), field(clipped(key)),
                  "unknown field" + did_you_mean(key, allowed) + " (allowed: " + join(allowed) + ")");
   }
 }

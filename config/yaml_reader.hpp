@@ -36,6 +36,10 @@ struct NumberRule {
   static NumberRule any() { return {}; }
   static NumberRule positive() { return {0, 1e300, true, "a number > 0"}; }
   static NumberRule non_negative() { return {0, 1e300, false, "a number >= 0"}; }
+  // min..max inclusive; `words` defaults to "a number in MIN..MAX".
+  static NumberRule range(double lo, double hi, std::string what = {});
+  // > 0 and at most `hi`.
+  static NumberRule positive_up_to(double hi);
   [[nodiscard]] bool allows(double v) const noexcept {
     return (min_exclusive ? v > min : v >= min) && v <= max;
   }
@@ -55,10 +59,17 @@ std::optional<std::string> read_string(const YAML::Node& n, const std::string& p
 std::optional<core::Duration> read_duration(const YAML::Node& n, const std::string& path, const Source& src,
                                             core::Duration min, core::Duration max);
 
-// The whole content of a file; an unreadable file is reported (without position) and gives nullopt.
-std::optional<std::string> read_text_file(const std::string& file, const Source& src);
+// Configuration and device profile files are refused above this size: the YAML parser needs about
+// a hundred times a file's size in memory, and a real deployment is a few kilobytes.
+inline constexpr std::uint64_t kMaxYamlBytes = 1024 * 1024;
 
-// Parses one YAML document; a syntax error is reported at its position and gives nullopt.
+// The whole content of a regular file of at most `max_bytes`; a directory, device, pipe, socket,
+// an unreadable or a too large file is reported (without position) and gives nullopt.
+std::optional<std::string> read_text_file(const std::string& file, const Source& src,
+                                          std::uint64_t max_bytes = kMaxYamlBytes);
+
+// Parses a YAML text that must hold one document; a syntax error is reported at its position, a
+// second document is an error, and both give nullopt.
 std::optional<YAML::Node> parse_document(const std::string& text, const Source& src);
 
 class MapReader {

@@ -1,9 +1,12 @@
 // Every class of configuration error is reported with FILE:LINE:COL and the field path.
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
+
 #include <string>
 
 #include "config/loader.hpp"
+#include "config/yaml_reader.hpp"
 #include "tests/config/test_support.hpp"
 
 namespace drivegate::config {
@@ -52,7 +55,7 @@ TEST(LoadErrors, WrongTypes) {
                                   "    limits: { max_velocity: fast }\n"
                                   "    defaults: [pp]\n"
                                   "    command_timeout: \"1s\"\n");
-  EXPECT_REPORTED(e, "t.yaml:13:29: axes[0].limits.max_velocity: must be a number > 0, got \"fast\"");
+  EXPECT_REPORTED(e, "t.yaml:13:29: axes[0].limits.max_velocity: must be a number > 0 and at most 1e+12, got \"fast\"");
   EXPECT_REPORTED(e, "t.yaml:14:15: axes[0].defaults: must be a map of fields, got a list");
   EXPECT_REPORTED(e, "t.yaml:15:22: axes[0].command_timeout: must be a duration > 0");
 }
@@ -203,17 +206,17 @@ axes:
   EXPECT_REPORTED(e, "t.yaml:22:26: axes[0].enable_step_timeout: must be a duration > 0");
   EXPECT_REPORTED(e, "t.yaml:23:19: axes[0].timeout_stop: must be one of quick_stop, halt, got \"brake\"");
   EXPECT_REPORTED(e, "t.yaml:24:29: axes[0].limits.min_position: must be less than max_position (10), got 10");
-  EXPECT_REPORTED(e, "t.yaml:24:69: axes[0].limits.max_acceleration: must be a number > 0, got \"-1\"");
+  EXPECT_REPORTED(e, "t.yaml:24:69: axes[0].limits.max_acceleration: must be a number > 0 and at most 1e+12, got \"-1\"");
   EXPECT_REPORTED(e, "t.yaml:25:24: axes[0].homing.timeout: must be a duration > 0");
-  EXPECT_REPORTED(e, "t.yaml:26:30: axes[0].mechanics.gear_ratio: must be a number > 0, got \"0\"");
-  EXPECT_REPORTED(e, "t.yaml:26:39: axes[0].mechanics.feed: must be a number > 0, got \"-5\"");
+  EXPECT_REPORTED(e, "t.yaml:26:30: axes[0].mechanics.gear_ratio: must be a number in 1e-06..1000000, got \"0\"");
+  EXPECT_REPORTED(e, "t.yaml:26:39: axes[0].mechanics.feed: must be a number in 1e-06..1000000, got \"-5\"");
 }
 
 TEST(LoadErrors, NonFiniteNumbers) {
   const std::string e = errors_of(kHead + kCounts + "    limits: { min_position: -.inf, max_position: .nan, max_velocity: .inf }\n");
-  EXPECT_REPORTED(e, "t.yaml:13:29: axes[0].limits.min_position: must be a finite number, got \"-.inf\" (not a finite number)");
-  EXPECT_REPORTED(e, "t.yaml:13:50: axes[0].limits.max_position: must be a finite number, got \".nan\"");
-  EXPECT_REPORTED(e, "t.yaml:13:70: axes[0].limits.max_velocity: must be a number > 0, got \".inf\"");
+  EXPECT_REPORTED(e, "t.yaml:13:29: axes[0].limits.min_position: must be a number in -1e+12..1e+12, got \"-.inf\" (not a finite number)");
+  EXPECT_REPORTED(e, "t.yaml:13:50: axes[0].limits.max_position: must be a number in -1e+12..1e+12, got \".nan\"");
+  EXPECT_REPORTED(e, "t.yaml:13:70: axes[0].limits.max_velocity: must be a number > 0 and at most 1e+12, got \".inf\"");
 }
 
 TEST(LoadErrors, OnlyOnePositionLimit) {
@@ -316,6 +319,74 @@ TEST(LoadErrors, MissingFile) {
   } catch (const ConfigError& e) {
     EXPECT_REPORTED(std::string{e.what()}, "/nonexistent/drivegate.yaml: cannot open file: No such file");
   }
+}
+
+// What load_plan(path) reports, or "(loaded without error)".
+std::string file_errors(const std::string& path) {
+  try {
+    load_plan(path, test_options());
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "(loaded without error)";
+}
+
+// Only regular files are read: a directory, a device (/dev/zero grew to 24 GB), a pipe (would
+// block) are refused at once with what they are.
+using FileErrors = test::TempDir;
+
+TEST_F(FileErrors, NonRegularFilesAreRefusedWithWhatTheyAre) {
+  EXPECT_REPORTED(file_errors(dir_.string()), dir_.string() + ": is a directory, not a file");
+  EXPECT_REPORTED(file_errors("/dev/zero"), "/dev/zero: is not a regular file (it is a character device)");
+  const auto fifo = dir_ / "fifo.yaml";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_REPORTED(file_errors(fifo.string()), "fifo.yaml: is not a regular file (it is a pipe)");
+}
+
+TEST_F(FileErrors, FilesAboveTheLimitAreRefusedBeforeParsing) {
+  std::string big = kHead + kCounts;
+  big.resize(static_cast<std::size_t>(kMaxYamlBytes) + 1, '#');
+  const auto p = write("big.yaml", big);
+  EXPECT_REPORTED(file_errors(p.string()), "big.yaml: is " + std::to_string(kMaxYamlBytes + 1) +
+                                               " bytes; this kind of file is limited to 1 MiB");
+  // At the limit it is read (and here loads: the rest is a comment).
+  big.resize(static_cast<std::size_t>(kMaxYamlBytes));
+  EXPECT_EQ(file_errors(write("limit.yaml", big).string()), "(loaded without error)");
+}
+
+TEST(LoadErrors, ASecondDocumentIsAnError) {
+  const std::string e = errors_of(kHead + kCounts + "---\ngateway: { name: other }\n");
+  EXPECT_REPORTED(e, "t.yaml:14:1: a second YAML document starts here");
+}
+
+// A value echoed in a message is cut: a megabyte of garbage must not come back as a megabyte of
+// error text. Hundreds of errors are summarised after the first 50.
+TEST(LoadErrors, EchoedValuesAreCutAndManyErrorsSummarised) {
+  const std::string junk(5000, 'z');
+  const std::string e = errors_of(kHead + kCounts + "    unit: [1]\n    limits: { max_velocity: " + junk + " }\n");
+  EXPECT_REPORTED(e, "got \"" + std::string(60, 'z') + "\"...(5000 characters)");
+  EXPECT_LT(e.size(), 1000u) << e.size();
+  std::string many = kHead + kCounts + "    limits:\n";
+  for (int i = 0; i < 300; ++i) many += "      k" + std::to_string(i) + ": 1\n";
+  const std::string m = errors_of(many);
+  EXPECT_REPORTED(m, "... and 250 more problems");
+}
+
+// Every mechanics and limit value has a sane range: an encoder of 1e-6 counts aborted the daemon,
+// a feed of 1e-300 was accepted.
+TEST(LoadErrors, MechanicsAndLimitsHaveSaneRanges) {
+  std::string e = errors_of(kHead + "    mechanics: { encoder_counts_per_rev: 1e-6 }\n");
+  EXPECT_REPORTED(e, "axes[0].mechanics.encoder_counts_per_rev: must be a number of counts per motor revolution in 1..2^32");
+  e = errors_of(kHead + "    mechanics: { encoder_counts_per_rev: 4096, feed: 1e-300, gear_ratio: 1e9, rated_torque: 1e-9 }\n");
+  EXPECT_REPORTED(e, "axes[0].mechanics.feed: must be a number in 1e-06..1000000, got \"1e-300\"");
+  EXPECT_REPORTED(e, "axes[0].mechanics.gear_ratio: must be a number in 1e-06..1000000");
+  EXPECT_REPORTED(e, "axes[0].mechanics.rated_torque: must be 0 (torque in percent) or a torque in 0.001..1e6 Nm");
+  e = errors_of(kHead + kCounts + "    limits: { max_velocity: 1e300 }\n    homing: { offset: -1e20 }\n");
+  EXPECT_REPORTED(e, "axes[0].limits.max_velocity: must be a number > 0 and at most 1e+12");
+  EXPECT_REPORTED(e, "axes[0].homing.offset: must be a number in -1e+12..1e+12");
+  // Within range each, but together a scaling nothing could be commanded with.
+  e = errors_of(kHead + "    mechanics: { encoder_counts_per_rev: 4294967296, feed: 1e-6, gear_ratio: 1e6 }\n");
+  EXPECT_REPORTED(e, "drive position units per");
 }
 
 TEST(LoadErrors, EmptyDocument) {

@@ -58,8 +58,11 @@ DriveModel::DriveModel(DriveModelConfig config) : config_(std::move(config)), od
 
 void DriveModel::populate_dictionary() {
   using A = Access;
+  // Speeds and ramps derived from the axis' scaling: kept within 1..INT32_MAX drive units so that
+  // no scaling the configuration accepts can make a default fall outside its object's range.
   const auto vel = [this](double rps) {
-    return static_cast<std::int64_t>(std::llround(rps * config_.position_units_per_rev * vel_scale_));
+    const double v = std::round(rps * config_.position_units_per_rev * vel_scale_);
+    return static_cast<std::int64_t>(std::clamp(std::isfinite(v) ? v : 1.0, 1.0, 2147483647.0));
   };
   const std::int64_t vmax = vel(config_.max_velocity_rps);
   const std::int64_t no_min = type_min(DataType::I32);
