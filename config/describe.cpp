@@ -1,5 +1,6 @@
 #include "config/describe.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <sstream>
 
@@ -204,6 +205,89 @@ std::string describe_plan(const Plan& plan) {
     for (const auto& w : plan.warnings) out << "  " << w << '\n';
   }
   return out.str();
+}
+
+namespace {
+
+// The printout as sections ("gateway demo-cell", "bus sim0", "axis x") of "key: value" rows; a key
+// that repeats within a section (start-up writes) keeps all its values in order.
+struct Section {
+  std::string name;
+  std::vector<std::pair<std::string, std::vector<std::string>>> rows;
+};
+
+std::vector<Section> sections_of(const std::string& printout) {
+  std::vector<Section> out;
+  std::istringstream in(printout);
+  std::string line;
+  while (std::getline(in, line)) {
+    const auto text = line.find_first_not_of(' ');
+    if (text == std::string::npos) continue;
+    const std::string body = line.substr(text);
+    const auto colon = body.find(": ");
+    const bool heading = body.rfind("gateway ", 0) == 0 || body.rfind("bus ", 0) == 0 || body.rfind("axis ", 0) == 0;
+    if (heading && colon == std::string::npos) {
+      out.push_back({body, {}});
+      continue;
+    }
+    if (out.empty() || colon == std::string::npos) continue;  // the "configuration FILE" line
+    std::string key = body.substr(0, colon);
+    const auto value_at = body.find_first_not_of(' ', colon + 1);
+    std::string value = value_at == std::string::npos ? std::string{} : body.substr(value_at);
+    auto& rows = out.back().rows;
+    const auto it = std::find_if(rows.begin(), rows.end(), [&](const auto& r) { return r.first == key; });
+    if (it == rows.end())
+      rows.push_back({std::move(key), {std::move(value)}});
+    else
+      it->second.push_back(std::move(value));
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<std::string> describe_changes(const Plan& running, const Plan& next) {
+  const auto before = sections_of(describe_plan(running));
+  const auto after = sections_of(describe_plan(next));
+  const auto find = [](const std::vector<Section>& v, const std::string& name) -> const Section* {
+    for (const auto& s : v)
+      if (s.name == name) return &s;
+    return nullptr;
+  };
+  std::vector<std::string> changes;
+  for (const auto& b : before)
+    if (!find(after, b.name)) changes.push_back(b.name + ": removed");
+  for (const auto& a : after) {
+    const Section* b = find(before, a.name);
+    if (!b) {
+      changes.push_back(a.name + ": added");
+      continue;
+    }
+    const auto values = [](const Section& s, const std::string& key) -> std::vector<std::string> {
+      for (const auto& r : s.rows)
+        if (r.first == key) return r.second;
+      return {};
+    };
+    std::vector<std::string> keys;
+    for (const auto& r : b->rows) keys.push_back(r.first);
+    for (const auto& r : a.rows)
+      if (std::find(keys.begin(), keys.end(), r.first) == keys.end()) keys.push_back(r.first);
+    for (const auto& key : keys) {
+      const auto old_v = values(*b, key);
+      const auto new_v = values(a, key);
+      if (old_v == new_v) continue;
+      if (old_v.size() <= 1 && new_v.size() <= 1) {
+        changes.push_back(a.name + ": " + key + ": " + (old_v.empty() ? "(none)" : old_v[0]) + " -> " +
+                          (new_v.empty() ? "(none)" : new_v[0]));
+        continue;
+      }
+      for (const auto& v : old_v)
+        if (std::find(new_v.begin(), new_v.end(), v) == new_v.end()) changes.push_back(a.name + ": " + key + " removed: " + v);
+      for (const auto& v : new_v)
+        if (std::find(old_v.begin(), old_v.end(), v) == old_v.end()) changes.push_back(a.name + ": " + key + " added: " + v);
+    }
+  }
+  return changes;
 }
 
 }  // namespace drivegate::config

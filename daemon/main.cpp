@@ -1,11 +1,13 @@
 // drivegated: loads a deployment, brings its buses and axes up, and serves them over DDS.
 #include <signal.h>
+#include <string.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 #include <sys/signalfd.h>
 #include <unistd.h>
 
 #include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -32,13 +34,18 @@ namespace {
 using namespace drivegate;
 using namespace std::chrono_literals;
 
+// A second stop signal within this time after the first is taken as a duplicate, not as "exit now".
+constexpr std::chrono::milliseconds kSecondSignalGrace{2000};
+
 constexpr const char* kUsage = R"(usage: drivegated --config FILE [--log-level LEVEL]
        drivegated --check-config FILE
        drivegated --version | --help
 
 Runs the gateway described by FILE: brings up every bus and axis, runs one cycle thread per bus
-and serves the axes over DDS. SIGTERM or SIGINT stops and disables every axis, then exits 0; a
-second signal exits at once.
+and serves the axes over DDS. SIGTERM, SIGINT and every other signal that would end the process
+stop and disable every axis, then exit 0; a second such signal at least 2 s after the first, or
+SIGQUIT, exits at once. SIGHUP re-reads and checks FILE and logs what a restart would change;
+SIGPIPE, SIGTSTP, SIGTTIN and SIGTTOU are ignored.
 
   --config FILE        the deployment (YAML); see config/README.md
   --check-config FILE  validate FILE and print the compiled plan without touching any bus
@@ -105,11 +112,37 @@ void setup_logging(const std::string& level) {
 }
 
 // Signals are taken synchronously through a signalfd so that shutdown runs on the main thread.
-int make_signal_fd() {
+// Every signal whose default action would end or stop the process and that can be caught is in
+// this set: none may leave an axis moving (DESIGN.md §4). Synchronous fault signals (SIGSEGV,
+// SIGBUS, SIGILL, SIGFPE, SIGABRT, SIGSYS, SIGTRAP) are left alone: they cannot be deferred, and
+// the drives' own communication watchdogs stop them when the process dies.
+sigset_t watched_signals() {
   sigset_t set;
   sigemptyset(&set);
-  sigaddset(&set, SIGTERM);
-  sigaddset(&set, SIGINT);
+  for (const int s : {SIGTERM, SIGINT, SIGHUP, SIGQUIT, SIGUSR1, SIGUSR2, SIGALRM, SIGVTALRM, SIGPROF, SIGXCPU,
+                      SIGXFSZ, SIGIO, SIGPWR, SIGSTKFLT, SIGTSTP, SIGTTIN, SIGTTOU})
+    sigaddset(&set, s);
+  for (int s = SIGRTMIN; s <= SIGRTMAX; ++s) sigaddset(&set, s);
+  return set;
+}
+
+// What the daemon does with a signal from the watched set.
+enum class SignalAction { Stop, Reload, Ignore };
+SignalAction action_of(int sig) noexcept {
+  switch (sig) {
+    case SIGHUP: return SignalAction::Reload;
+    // A daemon must not be frozen from a terminal: its cycle threads would stop with axes moving.
+    case SIGTSTP:
+    case SIGTTIN:
+    case SIGTTOU: return SignalAction::Ignore;
+    default: return SignalAction::Stop;
+  }
+}
+
+int make_signal_fd() {
+  // A write to a closed socket or pipe is an error return (EPIPE), not a reason to die.
+  std::signal(SIGPIPE, SIG_IGN);
+  const sigset_t set = watched_signals();
   pthread_sigmask(SIG_BLOCK, &set, nullptr);  // before any thread starts, so all inherit it
   return signalfd(-1, &set, SFD_CLOEXEC | SFD_NONBLOCK);
 }
@@ -123,6 +156,42 @@ int wait_signal(int fd, std::chrono::milliseconds timeout) {
   signalfd_siginfo info{};
   if (read(fd, &info, sizeof info) != static_cast<ssize_t>(sizeof info)) return 0;
   return static_cast<int>(info.ssi_signo);
+}
+
+const char* signal_name(int sig) {
+  const char* abbrev = sigabbrev_np(sig);
+  static thread_local char buf[16];
+  if (abbrev != nullptr) {
+    std::snprintf(buf, sizeof buf, "SIG%s", abbrev);
+  } else if (sig >= SIGRTMIN && sig <= SIGRTMAX) {
+    std::snprintf(buf, sizeof buf, "SIGRTMIN+%d", sig - SIGRTMIN);
+  } else {
+    std::snprintf(buf, sizeof buf, "signal %d", sig);
+  }
+  return buf;
+}
+
+// SIGHUP: re-read and check the configuration, say what a restart would change, change nothing.
+void reload_check(const Args& args, const config::Plan& running, daemon::SystemdNotifier& notifier) {
+  notifier.reloading();
+  try {
+    const config::Plan next = config::load_plan(args.config);
+    const auto changes = config::describe_changes(running, next);
+    for (const auto& w : next.warnings) spdlog::warn("configuration reload: {}", w);
+    if (changes.empty()) {
+      spdlog::info("SIGHUP: {} re-read and checked: no changes", args.config);
+    } else {
+      spdlog::warn("SIGHUP: {} re-read and checked: {} change(s), not applied while running; restart drivegated "
+                   "to apply them:",
+                   args.config, changes.size());
+      for (const auto& c : changes) spdlog::warn("  would change {}", c);
+    }
+  } catch (const config::ConfigError& e) {
+    spdlog::error("SIGHUP: {} has errors; the running configuration stays:\n{}", args.config, e.what());
+  } catch (const std::exception& e) {
+    spdlog::error("SIGHUP: cannot re-read {}: {}; the running configuration stays", args.config, e.what());
+  }
+  notifier.ready();
 }
 
 int run(const Args& args) {
@@ -196,7 +265,16 @@ int run(const Args& args) {
   auto last_ping = last_status;
   bool was_healthy = true;
   int sig = 0;
-  while ((sig = wait_signal(sigfd, 100ms)) == 0) {
+  for (;;) {
+    sig = wait_signal(sigfd, 100ms);
+    if (sig != 0) {
+      const SignalAction action = action_of(sig);
+      if (action == SignalAction::Stop) break;
+      if (action == SignalAction::Reload)
+        reload_check(args, plan, notifier);
+      else
+        spdlog::warn("{} ignored: a gateway with axes must not be stopped from a terminal", signal_name(sig));
+    }
     const auto now = std::chrono::steady_clock::now();
     const bool ok = gateway->healthy();
     if (ok != was_healthy) {
@@ -217,14 +295,26 @@ int run(const Args& args) {
     }
   }
 
-  spdlog::info("{} received: stopping and disabling every axis", strsignal(sig));
+  spdlog::info("{} received: stopping and disabling every axis", signal_name(sig));
   notifier.stopping();
   notifier.status("stopping: disabling axes");
-  // A second signal ends the process at once.
-  std::thread second([sigfd] {
-    while (wait_signal(sigfd, 1000ms) == 0) {
+  // A second stop signal skips the orderly stop only when it is meant as one: SIGQUIT, or any stop
+  // signal at least kSecondSignalGrace after the first. GNU timeout and a kill of the process
+  // group deliver one SIGTERM twice within milliseconds; those repeats are ignored.
+  const auto first = std::chrono::steady_clock::now();
+  std::thread second([sigfd, first] {
+    for (;;) {
+      const int again = wait_signal(sigfd, 1000ms);
+      if (again == 0 || action_of(again) != SignalAction::Stop) continue;
+      const auto since = std::chrono::steady_clock::now() - first;
+      if (again == SIGQUIT || since >= kSecondSignalGrace) break;
+      std::fprintf(stderr, "drivegated: %s ignored %lld ms after the first: still stopping the axes (send it again "
+                   "after %lld ms, or SIGQUIT, to exit at once)\n",
+                   signal_name(again),
+                   static_cast<long long>(std::chrono::duration_cast<std::chrono::milliseconds>(since).count()),
+                   static_cast<long long>(kSecondSignalGrace.count()));
     }
-    std::fputs("drivegated: second signal, exiting at once\n", stderr);
+    std::fputs("drivegated: second signal, exiting at once without stopping the axes\n", stderr);
     std::_Exit(130);
   });
   second.detach();

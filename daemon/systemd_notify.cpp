@@ -15,6 +15,7 @@ bool send(const char* message) { return sd_notify(0, message) > 0; }
 
 bool SystemdNotifier::ready() const { return send("READY=1"); }
 bool SystemdNotifier::stopping() const { return send("STOPPING=1"); }
+bool SystemdNotifier::reloading() const { return send("RELOADING=1"); }
 bool SystemdNotifier::watchdog() const { return send("WATCHDOG=1"); }
 
 bool SystemdNotifier::status(std::string_view text) const {

@@ -15,6 +15,7 @@ class SystemdNotifier {
   // Each returns true when the message was sent to the service manager.
   bool ready() const;    // READY=1: start-up finished, all buses configured
   bool stopping() const;  // STOPPING=1: shutdown began (axes are being stopped)
+  bool reloading() const;  // RELOADING=1: SIGHUP is being handled (followed by ready() when done)
   bool watchdog() const;  // WATCHDOG=1: keep-alive, send at least every watchdog_interval() / 2
   // STATUS=text, shown by `systemctl status`. Line breaks would start new assignments in the
   // notify protocol, so they are sent as spaces.
