@@ -25,6 +25,7 @@ std::string_view to_string(LinkState s) noexcept {
     case LinkState::Ready: return "ready";
     case LinkState::Operational: return "operational";
     case LinkState::Lost: return "lost";
+    case LinkState::Degraded: return "degraded";
   }
   return "offline";
 }
@@ -103,6 +104,7 @@ std::string_view to_string(EventKind k) noexcept {
     case EventKind::Warning: return "warning";
     case EventKind::CommandTimeout: return "command_timeout";
     case EventKind::Info: return "info";
+    case EventKind::ControlLost: return "control_lost";
   }
   return "info";
 }

@@ -20,7 +20,9 @@ enum class AxisState : std::uint8_t {
   Unknown,  // no valid status from the drive yet (link not up)
 };
 
-enum class LinkState : std::uint8_t { Offline, Booting, Configuring, Ready, Operational, Lost };
+// Degraded: the drive answers but stopped following the gateway (its controlword or telegram);
+// the gateway is stopping it over the acyclic channel and will reconfigure it.
+enum class LinkState : std::uint8_t { Offline, Booting, Configuring, Ready, Operational, Lost, Degraded };
 
 enum class Mode : std::uint8_t {
   None,  // no mode selected yet
@@ -65,6 +67,7 @@ enum class EventKind : std::uint8_t {
   Warning,
   CommandTimeout,  // set-point source went silent; the axis was stopped
   Info,
+  ControlLost,  // the drive stopped following the gateway's controlword/telegram; it is being stopped
 };
 
 // Modes that need a live command source: silence longer than the axis' command timeout stops them.

@@ -23,6 +23,7 @@ bool is_disabled(core::AxisState s) noexcept {
 std::string_view severity_of(core::EventKind k) {
   switch (k) {
     case core::EventKind::Fault:
+    case core::EventKind::ControlLost:
     case core::EventKind::CommandTimeout: return "error";
     case core::EventKind::Warning: return "warning";
     default: return "info";
@@ -255,9 +256,15 @@ ShutdownReport Gateway::shutdown(core::Duration phase_budget) {
     }
     wait_all([&](std::size_t i, const core::AxisSnapshot& s) { return !reachable(s) || (fresh(i, s) && is_disabled(s.state)); },
              phase_budget);
+    // An axis whose drive stopped following the gateway is being stopped over the acyclic channel
+    // by its bus (link degraded): the bus must not be released before that is done.
+    const auto degraded = [](const core::AxisSnapshot& s) { return s.link == core::LinkState::Degraded; };
+    wait_all([&](std::size_t, const core::AxisSnapshot& s) { return !degraded(s); }, phase_budget);
     for (std::size_t i = 0; i < refs_.size(); ++i) {
       const auto s = snapshot(i);
-      if (!reachable(s) || is_disabled(s.state))
+      if (degraded(s))
+        report.unconfirmed.push_back(axes_[i].name + " (out of the gateway's control, still being stopped)");
+      else if (!reachable(s) || is_disabled(s.state))
         ++report.disabled;
       else
         report.unconfirmed.push_back(axes_[i].name + " (" + std::string(core::to_string(s.state)) + ")");

@@ -7,6 +7,7 @@
 #include "profiles/cia402/master_settings.hpp"
 #include "profiles/cia402/op_modes.hpp"
 #include "profiles/cia402/sdo_abort.hpp"
+#include "profiles/cia402/statusword.hpp"
 
 namespace drivegate::canopen {
 namespace {
@@ -15,6 +16,9 @@ using Phase = CanopenBus::Phase;
 
 // How long to wait for a drive's boot-up before probing it by SDO.
 constexpr core::Duration kBootUpWait = std::chrono::milliseconds(500);
+// A drive out of the gateway's control gets this long on its quick-stop ramp before its power
+// stage is switched off (disable voltage) whatever it shows.
+constexpr core::Duration kSafeStopBudget = std::chrono::seconds(3);
 
 std::vector<SdoChannelConfig> sdo_channels_for(const config::BusPlan& plan) {
   std::vector<SdoChannelConfig> out;
@@ -86,7 +90,13 @@ CanopenBus::CanopenBus(const config::BusPlan& plan, std::unique_ptr<Transport> t
       sync_(cob::kSync, plan.cycle_time) {
   for (std::size_t i = 0; i < plan.axes.size(); ++i) {
     const auto& a = plan.axes[i];
-    auto n = std::make_unique<Node>(static_cast<int>(i), build_boot_steps(a, plan));
+    auto steps = build_boot_steps(a, plan);
+    // What the boot writes belongs to the gateway: a client may read it, not change it.
+    std::vector<OwnedObject> owned;
+    for (const auto& st : steps)
+      if (st.kind == BootStep::Kind::Write)
+        owned.push_back({st.def.id, "set by the CANopen bus at every boot (" + st.stage + ")"});
+    auto n = std::make_unique<Node>(static_cast<int>(i), std::move(steps));
     n->id = static_cast<NodeId>(a.address);
     n->channel = static_cast<int>(i);
     if (a.device.canopen.error_control == config::ErrorControl::Guarding)
@@ -97,7 +107,7 @@ CanopenBus::CanopenBus(const config::BusPlan& plan, std::unique_ptr<Transport> t
     if (!n->pdos.configure(pdo.rpdos, pdo.tpdos))
       throw core::BusError("bus '" + name_ + "' axis '" + a.spec.name + "': PDO maps exceed the process image");
     seed_mode_object(a, n->pdos.image());
-    n->io = std::make_unique<NodeAccess>(n->id, n->channel, n->pdos, sdo_, emcy_);
+    n->io = std::make_unique<NodeAccess>(n->id, n->channel, n->pdos, sdo_, emcy_, std::move(owned));
     n->master = std::make_unique<cia402::Cia402Master>(*n->io, cia402::settings_from(a.spec));
     n->master->set_fault_table(tables_[i].faults);
     by_id_[n->id] = n.get();
@@ -186,6 +196,7 @@ void CanopenBus::enter(Node& n, Phase p, core::TimePoint now) noexcept {
     case Phase::Operational: link = core::LinkState::Operational; break;
     case Phase::Backoff: link = n.had_link ? core::LinkState::Lost : core::LinkState::Offline; break;
     case Phase::Lost: link = core::LinkState::Lost; break;
+    case Phase::SafeStop: link = core::LinkState::Degraded; break;
   }
   n.link.store(link, std::memory_order_relaxed);
 }
@@ -377,7 +388,73 @@ void CanopenBus::advance(Node& n, core::TimePoint now) noexcept {
       if (now - n.since >= (n.backoff == core::Duration::zero() ? options_.boot_retry : n.backoff))
         enter(n, Phase::Probe, now);
       break;
-    case Phase::Operational: break;
+    case Phase::Operational:
+      if (core::FixedString<200> why; n.io->take_control_lost(why)) {
+        n.detail = why;
+        start_safe_stop(n, now);
+      }
+      break;
+    case Phase::SafeStop: run_safe_stop(n, now); break;
+  }
+}
+
+// The drive no longer follows the controlword in the RPDOs (DESIGN.md §4): what the gateway says
+// now goes over SDO, which answers for itself.
+void CanopenBus::start_safe_stop(Node& n, core::TimePoint now) noexcept {
+  n.had_link = true;
+  n.pdos.enable(false, now);
+  sdo_.reset_channel(n.channel);  // the profile's transfers give way to the stop
+  n.io->forget_requests();
+  n.safe_step = 0;
+  n.probe = kNoSdoRequest;
+  enter(n, Phase::SafeStop, now);
+}
+
+void CanopenBus::run_safe_stop(Node& n, core::TimePoint now) noexcept {
+  const auto finished = [&]() -> std::optional<SdoResult> {
+    const SdoResult r = sdo_.result(n.probe);
+    if (r.status == SdoStatus::Queued || r.status == SdoStatus::InFlight) return std::nullopt;
+    if (r.status != SdoStatus::Unknown) sdo_.take(n.probe);
+    n.probe = kNoSdoRequest;
+    return r;
+  };
+  switch (n.safe_step) {
+    case 0:  // quick stop: the drive brakes on its quick-stop ramp
+      n.probe = sdo_.write(n.channel, cia402::obj::kControlword.id, 0x0002, 2);
+      if (n.probe != kNoSdoRequest) n.safe_step = 1;
+      break;
+    case 1:
+      if (finished()) n.safe_step = 2;
+      break;
+    case 2:  // until it left operation enabled and the quick-stop ramp, or the budget ran out
+      n.probe = sdo_.read(n.channel, cia402::obj::kStatusword.id, 2);
+      if (n.probe != kNoSdoRequest) n.safe_step = 3;
+      break;
+    case 3:
+      if (const auto r = finished()) {
+        const auto state = cia402::decode_state(static_cast<std::uint16_t>(r->value));
+        const bool braking = r->status == SdoStatus::Done &&
+                             (state == core::AxisState::OperationEnabled || state == core::AxisState::QuickStopActive);
+        n.safe_step = braking && now - n.since < kSafeStopBudget ? 2 : 4;
+      }
+      break;
+    case 4:  // disable voltage: the power stage goes off
+      n.probe = sdo_.write(n.channel, cia402::obj::kControlword.id, 0x0000, 2);
+      if (n.probe != kNoSdoRequest) n.safe_step = 5;
+      break;
+    default:
+      if (!finished()) break;
+      // Out of operational, then its communication objects back to their defaults: the boot-up
+      // that follows (or the probe, for drives that do not repeat it) configures it from scratch.
+      nmt_.command(NmtCommand::Stop, n.id, tx_);
+      nmt_.command(NmtCommand::ResetCommunication, n.id, tx_);
+      nmt_.unwatch(n.id);
+      emcy_.reset(n.id);
+      n.detail.format("node %u was stopped over SDO after it stopped following its controlword: configuring it "
+                      "again",
+                      unsigned{n.id});
+      enter(n, Phase::WaitBootUp, now);
+      break;
   }
 }
 

@@ -9,6 +9,10 @@
 //   operational:  PDOs after each SYNC, heartbeat or guarding supervision, EMCY
 //   lost / failed: link Lost or Offline with the reason; probed again with back-off, and on its
 //                 next boot-up or answer reconfigured from scratch, coming back disabled
+//   safe stop:    the profile found the drive not following its controlword: link Degraded, the
+//                 RPDOs stop, quick stop (6040h := 0002h) over SDO until 6041h shows it left
+//                 operation enabled, disable voltage (0000h), NMT stop, NMT reset communication;
+//                 then reconfigured from scratch like a lost node, coming back disabled
 // A bus-off of the gateway's controller takes every node to Lost; when the controller is back,
 // every node is probed and reconfigured. Nothing needs a daemon restart.
 //
@@ -48,7 +52,7 @@ std::unique_ptr<Transport> make_transport(const config::BusPlan& plan);
 
 class CanopenBus final : public core::Bus {
  public:
-  enum class Phase : std::uint8_t { Start, WaitBootUp, Probe, Configuring, Operational, Backoff, Lost };
+  enum class Phase : std::uint8_t { Start, WaitBootUp, Probe, Configuring, Operational, Backoff, Lost, SafeStop };
 
   CanopenBus(const config::BusPlan& plan, std::unique_ptr<Transport> transport,
              std::unique_ptr<CyclePeer> peer = nullptr);
@@ -88,6 +92,7 @@ class CanopenBus final : public core::Bus {
     core::TimePoint since{};
     core::Duration backoff{};
     SdoRequestId probe = kNoSdoRequest;
+    int safe_step = 0;  // SafeStop: which of its SDO steps runs
     bool had_link = false;  // was operational before: a loss shows as Lost, not Offline
     cia402::ObjectId watchdog{};  // how the drive watches the gateway (1016h:01 or 100Ch); index 0: not
     std::uint64_t boots = 0;
@@ -103,6 +108,8 @@ class CanopenBus final : public core::Bus {
   void enter(Node& n, Phase p, core::TimePoint now) noexcept;
   void drop_node(Node& n, Phase next, core::TimePoint now) noexcept;
   void fail_node(Node& n, core::TimePoint now) noexcept;
+  void start_safe_stop(Node& n, core::TimePoint now) noexcept;
+  void run_safe_stop(Node& n, core::TimePoint now) noexcept;
   Node* node_by_id(NodeId id) noexcept { return id <= kMaxNodeId ? by_id_[id] : nullptr; }
   void flush(core::TimePoint now) noexcept;
   void release_watchdogs() noexcept;

@@ -66,4 +66,31 @@ cia402::DriveFaultReport NodeAccess::fault_report() const noexcept {
   return {true, r->emcy.code, r->text.view()};
 }
 
+// The communication profile's objects the gateway configures and relies on [CiA 301 §7.5]. Unused
+// PDOs count too: the gateway disabled them, and enabling one would put frames on the bus that
+// nothing planned for.
+std::string_view NodeAccess::owner_of(cia402::ObjectId id) const noexcept {
+  const auto in = [&](unsigned lo, unsigned hi) { return id.index >= lo && id.index <= hi; };
+  if (id.index == 0x1005 || id.index == 0x1006 || id.index == 0x1007)
+    return "owned by the CANopen bus (SYNC)";
+  if (id.index == 0x100C || id.index == 0x100D)
+    return "owned by the CANopen bus (node guarding)";
+  if (id.index == 0x1014) return "owned by the CANopen bus (EMCY COB-ID)";
+  if (id.index == 0x1016) return "owned by the CANopen bus (heartbeat consumer)";
+  if (id.index == 0x1017) return "owned by the CANopen bus (heartbeat producer)";
+  if (in(0x1200, 0x12FF)) return "owned by the CANopen bus (SDO channel)";
+  if (in(0x1400, 0x15FF)) return "owned by the CANopen bus (RPDO communication parameter)";
+  if (in(0x1600, 0x17FF)) return "owned by the CANopen bus (RPDO mapping)";
+  if (in(0x1800, 0x19FF)) return "owned by the CANopen bus (TPDO communication parameter)";
+  if (in(0x1A00, 0x1BFF)) return "owned by the CANopen bus (TPDO mapping)";
+  for (const auto& o : owned_)
+    if (o.id.index == id.index && o.id.sub == id.sub) return o.what;
+  return {};
+}
+
+void NodeAccess::control_lost(std::string_view why) noexcept {
+  control_lost_ = true;
+  lost_why_.assign(why);
+}
+
 }  // namespace drivegate::canopen

@@ -6,18 +6,30 @@
 // profile never competes with the boot sequence for the SDO channel.
 #include <array>
 #include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
 
 #include "adapters/canopen/master/emcy_consumer.hpp"
+#include "core/fixed_string.hpp"
 #include "adapters/canopen/master/pdo.hpp"
 #include "adapters/canopen/master/sdo_client.hpp"
 #include "profiles/cia402/object_access.hpp"
 
 namespace drivegate::canopen {
 
+// An object the gateway writes when it configures the node, and what it is (for the refusal).
+struct OwnedObject {
+  cia402::ObjectId id;
+  std::string what;  // "set by the gateway at every boot (start-up write)"
+};
+
 class NodeAccess final : public cia402::ObjectAccess {
  public:
-  NodeAccess(NodeId node, int sdo_channel, NodePdos& pdos, SdoClient& sdo, const EmcyConsumer& emcy) noexcept
-      : node_(node), channel_(sdo_channel), pdos_(pdos), sdo_(sdo), emcy_(emcy) {}
+  // `owned`: the objects the node's boot writes besides the communication profile's ranges.
+  NodeAccess(NodeId node, int sdo_channel, NodePdos& pdos, SdoClient& sdo, const EmcyConsumer& emcy,
+             std::vector<OwnedObject> owned = {})
+      : node_(node), channel_(sdo_channel), pdos_(pdos), sdo_(sdo), emcy_(emcy), owned_(std::move(owned)) {}
 
   // Called by the bus at the start of each cycle.
   void begin_cycle(core::TimePoint now, bool operational) noexcept {
@@ -37,6 +49,16 @@ class NodeAccess final : public cia402::ObjectAccess {
   cia402::RequestResult poll(cia402::RequestId id) noexcept override;
   void cancel(cia402::RequestId id) noexcept override;
   [[nodiscard]] cia402::DriveFaultReport fault_report() const noexcept override;
+  [[nodiscard]] std::string_view owner_of(cia402::ObjectId id) const noexcept override;
+  void control_lost(std::string_view why) noexcept override;
+
+  // The bus takes a loss the profile reported (once): true and the reason, then cleared.
+  bool take_control_lost(core::FixedString<200>& why) noexcept {
+    if (!control_lost_) return false;
+    control_lost_ = false;
+    why = lost_why_;
+    return true;
+  }
 
  private:
   struct Pending {
@@ -54,6 +76,9 @@ class NodeAccess final : public cia402::ObjectAccess {
   core::TimePoint now_{};
   bool operational_ = false;
   std::array<Pending, 16> pending_{};
+  std::vector<OwnedObject> owned_;
+  bool control_lost_ = false;
+  core::FixedString<200> lost_why_;
 };
 
 }  // namespace drivegate::canopen

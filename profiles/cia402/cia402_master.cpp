@@ -310,6 +310,13 @@ Admission Cia402Master::parameter(const core::ParamRequest& req, core::TimePoint
     no.reason.format("%04Xh is driven by the CiA 402 profile; use the axis commands", static_cast<unsigned>(req.index));
     return no;
   }
+  if (const auto owner = req.write ? io_.owner_of(ObjectId{req.index, req.sub}) : std::string_view{}; !owner.empty()) {
+    no.reason.format("%04Xh:%02X is %.*s: a write would take the drive out of the gateway's control; change the "
+                     "configuration instead",
+                     static_cast<unsigned>(req.index), static_cast<unsigned>(req.sub), static_cast<int>(owner.size()),
+                     owner.data());
+    return no;
+  }
   for (auto& p : params_) {
     if (p.active) continue;
     p = PendingParam{true, req, ObjectDef{{req.index, req.sub}, param_type(req.size, req.is_signed)}, kNoRequest};
@@ -320,7 +327,10 @@ Admission Cia402Master::parameter(const core::ParamRequest& req, core::TimePoint
 }
 
 void Cia402Master::link_lost(core::TimePoint /*now*/, core::ControllerSink& sink) noexcept {
-  constexpr std::string_view kLost = "link to drive lost";
+  // A drive out of the gateway's control is being stopped and reconfigured by the adapter.
+  const std::string_view kLost = control_lost_ ? std::string_view("drive stopped following the gateway's controlword: "
+                                                                  "it is being stopped and reconfigured")
+                                               : std::string_view("link to drive lost");
   fail_slot(device_slot_, kLost, sink);
   fail_slot(motion_.slot, kLost, sink);
   fail_slot(halt_slot_, kLost, sink);
@@ -356,6 +366,8 @@ void Cia402Master::link_lost(core::TimePoint /*now*/, core::ControllerSink& sink
   cw_written_valid_ = false;
   fault_event_pending_ = false;
   fault_read_ = kNoRequest;
+  follow_pending_ = false;
+  control_lost_ = false;
   homed_ = false;
   last_warning_ = false;
   last_remote_ = true;

@@ -94,6 +94,7 @@ class Cia402Master final : public core::AxisController {
   void read_inputs() noexcept;
   void track_state(core::TimePoint now, core::ControllerSink& sink) noexcept;
   void track_fault_code(core::ControllerSink& sink) noexcept;
+  void supervise_control(core::TimePoint now, core::ControllerSink& sink) noexcept;
   void run_device(core::TimePoint now, core::ControllerSink& sink) noexcept;
   void run_parameters(core::ControllerSink& sink) noexcept;
   void write_outputs() noexcept;
@@ -171,6 +172,14 @@ class Cia402Master final : public core::AxisController {
   bool last_warning_ = false;
   bool last_remote_ = true;
   bool flags_seen_ = false;  // warning/remote edges are reported from the second status on
+
+  // Control supervision: since when the drive has stayed in a state its controlword tells it to
+  // leave (towards less power); reported once per loss, until the link is lost and comes back.
+  bool follow_pending_ = false;
+  core::AxisState follow_state_ = core::AxisState::Unknown;
+  std::uint16_t follow_cw_ = 0;
+  core::TimePoint follow_since_{};
+  bool control_lost_ = false;
 
   std::array<PendingParam, kMaxParameterRequests> params_{};
   core::DriveFeedback fb_{};

@@ -16,6 +16,23 @@ using core::Mode;
 
 namespace {
 
+// The controlword `cw` tells a drive in state `s` to leave it towards less power [CiA 402 §6.4.1
+// transitions 5-12]: disable operation, shutdown, quick stop or disable voltage. A drive may refuse
+// to enable (no DC bus, hardware enable off); it may not refuse these.
+bool demands_power_down(AxisState s, std::uint16_t cw) noexcept {
+  const bool disable_voltage = (cw & 0x0002U) == 0;
+  const bool quick_stop = (cw & 0x0006U) == 0x0002U;
+  const bool shutdown = (cw & 0x0007U) == 0x0006U;
+  const bool disable_operation = (cw & 0x000FU) == 0x0007U;
+  switch (s) {
+    case AxisState::OperationEnabled: return disable_voltage || quick_stop || shutdown || disable_operation;
+    case AxisState::SwitchedOn: return disable_voltage || quick_stop || shutdown;
+    case AxisState::ReadyToSwitchOn: return disable_voltage || quick_stop;
+    case AxisState::QuickStopActive: return disable_voltage;  // transition 12
+    default: return false;
+  }
+}
+
 // Keeps one acyclic read of `def` in flight; true (and `value` set) when one came back.
 bool poll_read(ObjectAccess& io, RequestId& request, ObjectDef def, std::int64_t& value) noexcept {
   if (request == kNoRequest) {
@@ -38,6 +55,7 @@ void Cia402Master::update(core::TimePoint now, core::ControllerSink& sink) noexc
   if (status_valid_) {
     track_state(now, sink);
     track_fault_code(sink);
+    supervise_control(now, sink);
     run_device(now, sink);
     run_motion(now, sink);
     run_halt(sink);
@@ -195,6 +213,36 @@ void Cia402Master::run_device(core::TimePoint now, core::ControllerSink& sink) n
   } else if (p == DeviceProgress::Failed) {
     fail_slot(device_slot_, device_.failure().view(), sink);
   }
+}
+
+// Whatever the cause (a mapping changed behind the gateway's back, a second master, a drive
+// firmware that ignores the bus), a drive that does not follow the controlword is out of the
+// gateway's control: that is an event and a safe stop by the adapter, not a stale "operational"
+// (DESIGN.md §4). Judged on fresh status only, against the controlword already sent.
+void Cia402Master::supervise_control(core::TimePoint now, core::ControllerSink& sink) noexcept {
+  if (control_lost_) return;
+  if (io_.mapped(obj::kStatusword.id) && !io_.inputs_fresh()) return;
+  if (!demands_power_down(state_, last_cw_)) {
+    follow_pending_ = false;
+    return;
+  }
+  const std::uint16_t demand = static_cast<std::uint16_t>(last_cw_ & cw::kDeviceControlMask);
+  if (!follow_pending_ || follow_state_ != state_ || follow_cw_ != demand) {
+    follow_pending_ = true;
+    follow_state_ = state_;
+    follow_cw_ = demand;
+    follow_since_ = now;
+    return;
+  }
+  if (now - follow_since_ <= settings_.follow_timeout) return;
+  control_lost_ = true;
+  core::Text why;
+  why.format("drive does not follow its controlword: still %s %lld ms after controlword 0x%04X told it to leave "
+             "(statusword 0x%04X)",
+             core::to_string(state_).data(), ms(now - follow_since_), static_cast<unsigned>(last_cw_),
+             static_cast<unsigned>(statusword_));
+  sink.event(EventKind::ControlLost, 0, why.view());
+  io_.control_lost(why.view());
 }
 
 void Cia402Master::write_outputs() noexcept {

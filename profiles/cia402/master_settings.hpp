@@ -1,6 +1,7 @@
 #pragma once
 // What the CiA 402 master needs to know about its axis besides the drive itself: timeouts and the
 // few device-dependent choices. Built from the axis spec before the cycle thread starts.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -12,6 +13,9 @@ namespace drivegate::cia402 {
 
 struct MasterSettings {
   core::Duration enable_step_timeout = std::chrono::seconds(2);  // per state-machine step, and fault reset
+  // A drive that stays in a state its controlword tells it to leave towards less power (quick
+  // stop, disable, shutdown) for longer than this no longer follows the gateway: control is lost.
+  core::Duration follow_timeout = std::chrono::seconds(1);
   core::Duration mode_confirm_timeout = std::chrono::milliseconds(500);  // 6061h must echo 6060h
   core::Duration setpoint_ack_timeout = std::chrono::milliseconds(500);  // pp SW bit 12 handshake
   core::Duration homing_timeout = std::chrono::seconds(60);
@@ -38,6 +42,7 @@ struct MasterSettings {
 inline MasterSettings settings_from(const core::AxisSpec& spec) {
   MasterSettings s;
   s.enable_step_timeout = spec.enable_step_timeout;
+  s.follow_timeout = std::min(spec.enable_step_timeout, s.follow_timeout);
   s.homing_timeout = spec.homing.timeout;
   // 0.2% of the velocity limit (6 rpm on a 3000 rpm axis): well below any commanded motion, well
   // above encoder jitter. Without a limit, 0.01 user units per second (0.01 mm/s, 0.6 rpm on a

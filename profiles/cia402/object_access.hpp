@@ -55,6 +55,17 @@ class ObjectAccess {
   // effect. Unknown ids and kNoRequest are ignored; later polls of `id` say Unknown.
   virtual void cancel(RequestId id) noexcept = 0;
 
+  // --- What the bus owns ---
+  // Non-empty when the adapter configured `id` itself and depends on it (CANopen: PDO
+  // communication and mapping, SYNC, EMCY, error control, the start-up writes; EtherCAT and
+  // PROFINET: their equivalents): what it is and who owns it, for a refusal of a client's write.
+  // A write there would take the drive out of the gateway's control (DESIGN.md §4).
+  [[nodiscard]] virtual std::string_view owner_of(ObjectId /*id*/) const noexcept { return {}; }
+  // The drive does not follow the controlword the gateway sends (the profile's supervision found
+  // it). The adapter takes over: it marks the link degraded, stops the drive over the acyclic
+  // channel and then reconfigures it, so the axis comes back disabled. Called once per loss.
+  virtual void control_lost(std::string_view /*why*/) noexcept {}
+
   // --- Diagnostics ---
   // The drive's present fault as it announced it (EMCY), if the bus has such a channel. The
   // master prefers it to reading 603Fh, which some drives lack (NORD digest §9).

@@ -5,6 +5,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <string_view>
 
 #include "profiles/cia402/object_access.hpp"
 
@@ -32,6 +33,14 @@ class FakeObjectAccess final : public ObjectAccess {
   void set_fresh(bool fresh) noexcept { fresh_ = fresh; }
   void set_fault_report(DriveFaultReport r) noexcept { report_ = r; }
   DriveFaultReport fault_report() const noexcept override { return report_; }
+  // Objects the fake bus owns (index only), and the control losses the master reported.
+  void own(std::uint16_t index) noexcept { owned_index_ = index; }
+  std::string_view owner_of(ObjectId id) const noexcept override {
+    return id.index == owned_index_ ? std::string_view("owned by the test bus (its own configuration)")
+                                    : std::string_view{};
+  }
+  void control_lost(std::string_view) noexcept override { ++control_losses_; }
+  [[nodiscard]] int control_losses() const noexcept { return control_losses_; }
 
   // Acyclic writes in the order they were submitted (kept up to kLog entries).
   [[nodiscard]] std::size_t acyclic_writes() const noexcept { return log_count_; }
@@ -84,6 +93,9 @@ class FakeObjectAccess final : public ObjectAccess {
   [[nodiscard]] std::size_t cancels() const noexcept { return cancels_; }
 
  private:
+  std::uint16_t owned_index_ = 0;
+  int control_losses_ = 0;
+
   struct Object {
     bool used = false;
     ObjectId id{};

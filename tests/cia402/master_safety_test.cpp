@@ -312,3 +312,82 @@ TEST(ParameterOwnership, ProfileObjectsAreReadOnlyForClients) {
 
 }  // namespace
 }  // namespace drivegate::cia402::test
+
+namespace drivegate::cia402::test {
+namespace {
+
+// The drive stays enabled although the gateway sends quick stop (its RPDO was switched off behind
+// the gateway's back): after the follow timeout that is a lost control, reported once to the bus
+// adapter and as an event.
+TEST(ControlSupervision, ADriveThatDoesNotLeaveOperationEnabledIsControlLost) {
+  MasterSettings s;
+  s.follow_timeout = std::chrono::milliseconds(100);
+  Harness h(s);
+  h.enable();
+  ASSERT_TRUE(h.submit(command(2, CommandKind::QuickStop)).accepted);
+  for (int i = 0; i < 100; ++i) h.cycle(kSwEnabled);  // 100 ms: still within the timeout
+  EXPECT_EQ(h.io.control_losses(), 0);
+  for (int i = 0; i < 5; ++i) h.cycle(kSwEnabled);
+  EXPECT_EQ(h.io.control_losses(), 1);
+  bool event = false;
+  for (const auto& e : h.sink.events)
+    if (e.kind == core::EventKind::ControlLost) {
+      event = true;
+      EXPECT_NE(e.text.find("does not follow its controlword: still operation_enabled"), std::string::npos) << e.text;
+    }
+  EXPECT_TRUE(event);
+  for (int i = 0; i < 500; ++i) h.cycle(kSwEnabled);
+  EXPECT_EQ(h.io.control_losses(), 1);  // once per loss
+  // After the link went and came back the supervision starts afresh.
+  h.master.link_lost(h.now, h.sink);
+  h.enable();
+  ASSERT_TRUE(h.submit(command(3, CommandKind::Disable)).accepted);
+  for (int i = 0; i < 150; ++i) h.cycle(kSwEnabled);
+  EXPECT_EQ(h.io.control_losses(), 2);
+}
+
+// A drive that follows in time, or one that refuses to enable (no DC bus), keeps control.
+TEST(ControlSupervision, FollowingOrRefusingToEnableIsNotControlLost) {
+  MasterSettings s;
+  s.follow_timeout = std::chrono::milliseconds(100);
+  Harness h(s);
+  h.enable();
+  ASSERT_TRUE(h.submit(command(2, CommandKind::QuickStop)).accepted);
+  for (int i = 0; i < 50; ++i) h.cycle(kSwEnabled);
+  for (int i = 0; i < 500; ++i) h.cycle(kSwQuickStop);
+  for (int i = 0; i < 50; ++i) h.cycle(kSwSwitchOnDisabled);
+  ASSERT_TRUE(h.submit(command(3, CommandKind::Enable)).accepted);
+  for (int i = 0; i < 1000; ++i) h.cycle(kSwReady);  // stays in ready to switch on: a refusal
+  EXPECT_EQ(h.io.control_losses(), 0);
+  // Stale inputs say nothing about the drive: no verdict on them.
+  Harness stale(s);
+  stale.enable();
+  ASSERT_TRUE(stale.submit(command(2, CommandKind::Disable)).accepted);
+  stale.io.set_fresh(false);
+  for (int i = 0; i < 500; ++i) stale.cycle(kSwEnabled);
+  EXPECT_EQ(stale.io.control_losses(), 0);
+}
+
+// Objects the bus configured are not writable through parameters; reading them is.
+TEST(ControlSupervision, WritesToObjectsTheBusOwnsAreRefusedWithTheOwner) {
+  Harness h;
+  h.io.own(0x1400);
+  h.cycle(kSwSwitchOnDisabled);
+  core::ParamRequest w;
+  w.id = 9;
+  w.write = true;
+  w.index = 0x1400;
+  w.sub = 1;
+  w.size = 4;
+  w.value = 0x80000201;
+  const auto r = h.master.parameter(w, h.now);
+  ASSERT_FALSE(r.accepted);
+  EXPECT_NE(std::string(r.reason.view()).find("1400h:01 is owned by the test bus"), std::string::npos)
+      << r.reason.view();
+  EXPECT_NE(std::string(r.reason.view()).find("out of the gateway's control"), std::string::npos) << r.reason.view();
+  w.write = false;
+  EXPECT_TRUE(h.master.parameter(w, h.now).accepted);
+}
+
+}  // namespace
+}  // namespace drivegate::cia402::test

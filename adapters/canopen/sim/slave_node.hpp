@@ -99,6 +99,12 @@ class SlaveNode final : private SdoBackend, private PdoObjects {
   void inject_sdo_abort(ObjectId object, std::uint32_t code) noexcept;
   // The next `frames` frames this node sends are spoiled.
   void damage_next(std::uint32_t frames, FrameDamage how) noexcept;
+  // A write through the drive's own service interface (keypad, vendor tool on USB), not the bus:
+  // how a drive's configuration changes behind the gateway's back. Returns the SDO abort code the
+  // same write over the bus would get (0: written).
+  std::uint32_t service_write(ObjectId object, std::uint32_t raw, std::size_t size) noexcept {
+    return write_value(object, raw, size);
+  }
 
   // --- Observation ---------------------------------------------------------------------------
   [[nodiscard]] NodeId node() const noexcept { return config_.node; }

@@ -7,7 +7,8 @@
 // Steps every 1 ms on an absolute CLOCK_MONOTONIC schedule until SIGINT or SIGTERM. Fault
 // injection comes on stdin, one command a line, each answered with one line on stdout (kCommands):
 //   power-off NODE | power-on NODE | fault NODE CODE [CAUSE] | clear NODE | silent NODE on|off |
-//   abort NODE INDEX[:SUB] CODE | corrupt NODE COUNT [dlc|garbage] | status
+//   abort NODE INDEX[:SUB] CODE | corrupt NODE COUNT [dlc|garbage] |
+//   service-write NODE INDEX[:SUB] VALUE SIZE | status
 // NODE is a node-ID, or BUS:NODE when several buses have it; numbers are decimal or 0x hex.
 #include <poll.h>
 #include <signal.h>
@@ -75,15 +76,23 @@ std::string hex4(unsigned v) {
   return b.data();
 }
 
+std::string hex8(std::uint32_t v) {
+  std::array<char, 12> b{};
+  std::snprintf(b.data(), b.size(), "0x%08X", static_cast<unsigned>(v));
+  return b.data();
+}
+
 constexpr std::string_view kCommands =
     "power-off NODE, power-on NODE, fault NODE CODE [CAUSE], clear NODE, silent NODE on|off, "
-    "abort NODE INDEX[:SUB] CODE, corrupt NODE COUNT [dlc|garbage], status";
+    "abort NODE INDEX[:SUB] CODE, corrupt NODE COUNT [dlc|garbage], service-write NODE INDEX[:SUB] VALUE SIZE, "
+    "status";
 
 std::string usage_of(const std::string& verb) {
   if (verb == "fault") return "NODE CODE [CAUSE]";
   if (verb == "silent") return "NODE on|off";
   if (verb == "abort") return "NODE INDEX[:SUB] CODE (hex index, e.g. abort 3 0x6081 0x06090031)";
   if (verb == "corrupt") return "NODE COUNT [dlc|garbage]";
+  if (verb == "service-write") return "NODE INDEX[:SUB] VALUE SIZE (hex index, SIZE 1, 2 or 4 bytes)";
   return "NODE";
 }
 
@@ -104,7 +113,7 @@ class Simulator {
     if (verb.empty()) return "error: empty command";
     if (verb == "status") return status();
     if (verb != "power-off" && verb != "power-on" && verb != "fault" && verb != "clear" && verb != "silent" &&
-        verb != "abort" && verb != "corrupt") {
+        verb != "abort" && verb != "corrupt" && verb != "service-write") {
       return "error: unknown command \"" + verb + "\" (" + std::string(kCommands) + ")";
     }
     in >> node_text;
@@ -129,13 +138,29 @@ class Simulator {
       node->set_silent(arg == "on");
       return "ok silent " + id + " " + arg;
     }
+    const auto colon = arg.find(':');
+    const auto index = parse_number(arg.substr(0, colon));
+    const auto sub = colon == std::string::npos ? std::optional<unsigned long>{0} : parse_number(arg.substr(colon + 1));
+    if (verb == "service-write" && !arg.empty()) {
+      // A write through the drive's own service interface, not the bus: its configuration changes
+      // behind the gateway's back.
+      std::string value_text;
+      std::string size_text;
+      in >> value_text >> size_text;
+      const auto value = parse_number(value_text);
+      const auto size = parse_number(size_text);
+      if (!index || *index > 0xFFFF || !sub || *sub > 0xFF || !value || *value > 0xFFFFFFFF || !size ||
+          (*size != 1 && *size != 2 && *size != 4))
+        return "error: service-write takes " + usage_of(verb);
+      const auto code = node->service_write({static_cast<std::uint16_t>(*index), static_cast<std::uint8_t>(*sub)},
+                                            static_cast<std::uint32_t>(*value), *size);
+      if (code != 0) return "error: service-write refused by the drive: abort code " + hex8(code);
+      return "ok service-write " + id;
+    }
     if (verb == "abort" && !arg.empty()) {
       // The next SDO request for the object is answered with this abort code.
       std::string code_text;
       in >> code_text;
-      const auto colon = arg.find(':');
-      const auto index = parse_number(arg.substr(0, colon));
-      const auto sub = colon == std::string::npos ? std::optional<unsigned long>{0} : parse_number(arg.substr(colon + 1));
       const auto code = parse_number(code_text);
       if (!index || *index > 0xFFFF || !sub || *sub > 0xFF || !code || *code == 0 || *code > 0xFFFFFFFF) {
         return "error: abort takes " + usage_of(verb);
