@@ -12,6 +12,7 @@ PACKAGES=(
   libsystemd-dev systemd                 # sd_notify; systemd-analyze verifies the unit in tests
   iproute2                               # network namespaces for tests that need them
   python3-can                            # reference peer for the UDP multicast CAN bus (tests)
+  cyclonedds-dev cyclonedds-tools        # a second DDS implementation: the interoperability test
 )
 
 missing=()
