@@ -8,6 +8,8 @@
 #include <deque>
 #include <map>
 #include <mutex>
+#include <cstdlib>
+#include <optional>
 #include <random>
 #include <stdexcept>
 
@@ -67,6 +69,8 @@ std::string_view to_string(Outcome o) noexcept {
     case Outcome::Failed: return "failed";
     case Outcome::Timeout: return "timeout";
     case Outcome::NoGateway: return "no_gateway";
+    case Outcome::Busy: return "busy";
+    case Outcome::Denied: return "denied";
   }
   return "unknown";
 }
@@ -75,20 +79,32 @@ class Client::Impl : public dds::DataReaderListener {
  public:
   explicit Impl(ClientOptions options) : opt_(std::move(options)) {
     if (opt_.name.empty()) opt_.name = default_name();
-    node_ = std::make_unique<msg::DdsNode>(opt_.domain, opt_.ns, "drivegate-client/" + opt_.name);
-    cmd_w_ = &node_->writer(msg::TopicId::AxisCommand);
-    sp_w_ = &node_->writer(msg::TopicId::Setpoint);
-    param_w_ = &node_->writer(msg::TopicId::ParamRequest);
+    if (opt_.window == 0) opt_.window = 1;
+    msg::DdsOptions o;
+    o.domain = opt_.domain;
+    o.ns = opt_.ns;
+    o.participant_name = "drivegate-client/" + opt_.name;
+    o.interfaces = opt_.interfaces;
+    if (o.interfaces.empty()) o.interfaces = split_list(env("DRIVEGATE_INTERFACES"));
+    const std::string identity = opt_.identity.empty() ? env("DRIVEGATE_IDENTITY") : opt_.identity;
+    if (!identity.empty()) o.security = msg::security_files_in(identity);
+    node_ = std::make_unique<msg::DdsNode>(o);
+    // Under DDS Security an identity may lack the right to publish commands or parameter requests
+    // (role observer, operator): those endpoints are refused and the client says so when used.
+    cmd_w_ = optional_writer(msg::TopicId::AxisCommand, command_refusal_);
+    sp_w_ = optional_writer(msg::TopicId::Setpoint, command_refusal_);
+    param_w_ = optional_writer(msg::TopicId::ParamRequest, parameter_refusal_);
     // Transient-local history can be delivered while create_datareader() is still running, before
     // the reader pointers below are known to on_data_available(). So: create all readers without a
     // listener, then attach it and take whatever already arrived.
     info_r_ = &node_->reader(msg::TopicId::GatewayInfo, nullptr, dds::StatusMask::none());
     state_r_ = &node_->reader(msg::TopicId::AxisState, nullptr, dds::StatusMask::none());
-    reply_r_ = &node_->reader(msg::TopicId::CommandReply, nullptr, dds::StatusMask::none());
     event_r_ = &node_->reader(msg::TopicId::AxisEvent, nullptr, dds::StatusMask::none());
     bus_r_ = &node_->reader(msg::TopicId::BusStatus, nullptr, dds::StatusMask::none());
-    param_r_ = &node_->reader(msg::TopicId::ParamReply, nullptr, dds::StatusMask::none());
+    if (cmd_w_ != nullptr) reply_r_ = optional_reader(msg::TopicId::CommandReply, command_refusal_);
+    if (param_w_ != nullptr) param_r_ = optional_reader(msg::TopicId::ParamReply, parameter_refusal_);
     for (dds::DataReader* r : {info_r_, state_r_, reply_r_, event_r_, bus_r_, param_r_}) {
+      if (r == nullptr) continue;
       r->set_listener(this, dds::StatusMask::data_available());
       on_data_available(r);
     }
@@ -98,7 +114,11 @@ class Client::Impl : public dds::DataReaderListener {
   Impl(const Impl&) = delete;
   Impl& operator=(const Impl&) = delete;
 
+  std::string command_refusal() const { return command_refusal_; }
+  std::string parameter_refusal() const { return parameter_refusal_; }
+
   void on_data_available(dds::DataReader* reader) override {
+    if (reader == nullptr) return;
     if (reader == info_r_) take_infos();
     else if (reader == state_r_) take_states();
     else if (reader == reply_r_) take_replies();
@@ -153,6 +173,11 @@ class Client::Impl : public dds::DataReaderListener {
     const auto deadline = SteadyClock::now() + timeout;
     CommandResult result;
     result.axis = req.axis;
+    if (cmd_w_ == nullptr || reply_r_ == nullptr) {
+      result.outcome = Outcome::Denied;
+      result.reason = command_refusal_;
+      return result;
+    }
     const Route r = wait_route(req.axis, req.gateway, timeout);
     if (!r.error.empty()) {
       result.outcome = Outcome::NoGateway;
@@ -186,16 +211,26 @@ class Client::Impl : public dds::DataReaderListener {
       std::lock_guard lock(mutex_);
       replies_[result.id];  // from now on, replies with this id are kept
     }
-    cmd_w_->write(&out);
+    if (const auto busy = write_in_window(*cmd_w_, &out, deadline)) {
+      std::lock_guard lock(mutex_);
+      replies_.erase(result.id);
+      result.outcome = Outcome::Busy;
+      result.reason = *busy;
+      return result;
+    }
 
     std::unique_lock lock(mutex_);
     bool accepted = false;
+    const auto first_reply = [&] {
+      if (!accepted) release_window_locked();
+    };
     for (;;) {
       auto& queue = replies_[result.id];
       while (!queue.empty()) {
         ReplyRecord rec = std::move(queue.front());
         queue.pop_front();
         if (rec.status == "accepted") {
+          first_reply();
           accepted = true;
           result.outcome = Outcome::Accepted;
           result.reason = rec.reason;
@@ -205,6 +240,7 @@ class Client::Impl : public dds::DataReaderListener {
           }
           continue;
         }
+        first_reply();
         result.outcome = rec.status == "completed" ? Outcome::Completed
                          : rec.status == "rejected" ? Outcome::Rejected
                                                     : Outcome::Failed;
@@ -213,6 +249,7 @@ class Client::Impl : public dds::DataReaderListener {
         return result;
       }
       if (cv_.wait_until(lock, deadline) == std::cv_status::timeout && replies_[result.id].empty()) {
+        first_reply();
         replies_.erase(result.id);
         result.outcome = Outcome::Timeout;
         result.reason = accepted ? "gateway '" + r.gateway + "' accepted the command but did not finish it in time"
@@ -224,6 +261,7 @@ class Client::Impl : public dds::DataReaderListener {
 
   std::string stream_setpoint(std::string_view axis, std::string_view gateway, double position, double velocity,
                               double torque) {
+    if (sp_w_ == nullptr) return command_refusal_;
     const Route r = route(axis, gateway);
     if (!r.error.empty()) return r.error;
     msg::Setpoint out;
@@ -241,6 +279,10 @@ class Client::Impl : public dds::DataReaderListener {
   ParamResult param(const ParamRequest& req, Millis timeout) {
     const auto deadline = SteadyClock::now() + timeout;
     ParamResult result;
+    if (param_w_ == nullptr || param_r_ == nullptr) {
+      result.error = parameter_refusal_;
+      return result;
+    }
     const Route r = wait_route(req.axis, req.gateway, timeout);
     if (!r.error.empty()) {
       result.error = r.error;
@@ -265,16 +307,23 @@ class Client::Impl : public dds::DataReaderListener {
       std::lock_guard lock(mutex_);
       param_replies_[id];
     }
-    param_w_->write(&out);
+    if (const auto busy = write_in_window(*param_w_, &out, deadline)) {
+      std::lock_guard lock(mutex_);
+      param_replies_.erase(id);
+      result.error = *busy;
+      return result;
+    }
     std::unique_lock lock(mutex_);
-    if (!cv_.wait_until(lock, deadline, [&] { return param_replies_[id].has_value(); })) {
+    const bool got = cv_.wait_until(lock, deadline, [&] { return param_replies_[id].has_value(); });
+    release_window_locked();
+    if (!got) {
       param_replies_.erase(id);
       result.error = "no parameter reply from gateway '" + r.gateway + "' in time";
       return result;
     }
-    const ParamResult got = *param_replies_[id];
+    const ParamResult reply = *param_replies_[id];
     param_replies_.erase(id);
-    return got;
+    return reply;
   }
 
   std::vector<GatewayInfo> gateways() const {
@@ -312,6 +361,70 @@ class Client::Impl : public dds::DataReaderListener {
   const std::string& name() const noexcept { return opt_.name; }
 
  private:
+  static std::string env(const char* name) {
+    const char* v = std::getenv(name);
+    return v == nullptr ? std::string{} : std::string{v};
+  }
+  static std::vector<std::string> split_list(const std::string& text) {
+    std::vector<std::string> out;
+    std::size_t at = 0;
+    while (at <= text.size()) {
+      const auto comma = text.find(',', at);
+      const auto item = text.substr(at, comma == std::string::npos ? std::string::npos : comma - at);
+      if (!item.empty()) out.push_back(item);
+      if (comma == std::string::npos) break;
+      at = comma + 1;
+    }
+    return out;
+  }
+
+  dds::DataWriter* optional_writer(msg::TopicId t, std::string& refusal) {
+    try {
+      return &node_->writer(t);
+    } catch (const std::runtime_error& e) {
+      if (!node_->secure()) throw;  // without access control a refusal is a real failure
+      if (refusal.empty()) refusal = std::string(e.what()) + " (client '" + opt_.name + "')";
+      return nullptr;
+    }
+  }
+  dds::DataReader* optional_reader(msg::TopicId t, std::string& refusal) {
+    try {
+      return &node_->reader(t, nullptr, dds::StatusMask::none());
+    } catch (const std::runtime_error& e) {
+      if (!node_->secure()) throw;
+      if (refusal.empty()) refusal = std::string(e.what()) + " (client '" + opt_.name + "')";
+      return nullptr;
+    }
+  }
+
+  // Flow control: at most opt_.window requests of this client wait for their first reply; then
+  // the write, which waits while the gateway's keep-all history is full. Returns why it could not
+  // be sent before `deadline`, or nothing once it was written.
+  template <typename Sample>
+  std::optional<std::string> write_in_window(dds::DataWriter& writer, Sample* sample, SteadyClock::time_point deadline) {
+    {
+      std::unique_lock lock(mutex_);
+      if (!cv_.wait_until(lock, deadline, [&] { return in_flight_ < opt_.window; }))
+        return "busy: " + std::to_string(in_flight_) + " requests of this client still wait for their first reply";
+      ++in_flight_;
+    }
+    for (;;) {
+      const ReturnCode_t rc = writer.write(sample, dds::HANDLE_NIL);
+      if (rc == ReturnCode_t::RETCODE_OK) return std::nullopt;
+      if (rc != ReturnCode_t::RETCODE_TIMEOUT || SteadyClock::now() >= deadline) {
+        std::lock_guard lock(mutex_);
+        release_window_locked();
+        return rc == ReturnCode_t::RETCODE_TIMEOUT
+                   ? std::string("busy: the gateway did not take the request in time (DDS flow control)")
+                   : "the request could not be written (DDS error " + std::to_string(rc()) + ")";
+      }
+    }
+  }
+  void release_window_locked() {
+    if (in_flight_ > 0) --in_flight_;
+    cv_.notify_all();
+  }
+
   // The route for an axis, waiting for discovery: until the axis has an owner, or gateways are known
   // and none appeared for a while (then the axis really is unknown and waiting longer is pointless).
   Route wait_route(std::string_view axis, std::string_view gateway, Millis timeout) const {
@@ -342,11 +455,12 @@ class Client::Impl : public dds::DataReaderListener {
           dds::PublicationMatchedStatus par{};
           dds::SubscriptionMatchedStatus rep{};
           dds::SubscriptionMatchedStatus prep{};
-          cmd_w_->get_publication_matched_status(cmd);
-          param_w_->get_publication_matched_status(par);
-          reply_r_->get_subscription_matched_status(rep);
-          param_r_->get_subscription_matched_status(prep);
           const auto n = static_cast<std::int32_t>(gateways);
+          // Endpoints this identity may not have (observer, operator) do not count.
+          if (cmd_w_ != nullptr) cmd_w_->get_publication_matched_status(cmd); else cmd.current_count = n;
+          if (param_w_ != nullptr) param_w_->get_publication_matched_status(par); else par.current_count = n;
+          if (reply_r_ != nullptr) reply_r_->get_subscription_matched_status(rep); else rep.current_count = n;
+          if (param_r_ != nullptr) param_r_->get_subscription_matched_status(prep); else prep.current_count = n;
           return cmd.current_count >= n && par.current_count >= n && rep.current_count >= n &&
                  prep.current_count >= n;
         },
@@ -477,6 +591,10 @@ class Client::Impl : public dds::DataReaderListener {
   dds::DataReader* bus_r_ = nullptr;
   dds::DataReader* param_r_ = nullptr;
 
+  std::string command_refusal_;    // why this identity may not command (empty: it may)
+  std::string parameter_refusal_;  // likewise for parameter requests
+  std::size_t in_flight_ = 0;      // requests written and waiting for their first reply (mutex_)
+
   std::atomic<std::uint64_t> next_id_{1};
   std::atomic<std::uint64_t> setpoint_seq_{0};
 
@@ -497,6 +615,8 @@ class Client::Impl : public dds::DataReaderListener {
 Client::Client(ClientOptions options) : impl_(std::make_unique<Impl>(std::move(options))) {}
 Client::~Client() = default;
 const std::string& Client::name() const noexcept { return impl_->name(); }
+std::string Client::command_refusal() const { return impl_->command_refusal(); }
+std::string Client::parameter_refusal() const { return impl_->parameter_refusal(); }
 std::vector<GatewayInfo> Client::gateways() const { return impl_->gateways(); }
 std::vector<AxisState> Client::states() const { return impl_->states(); }
 std::optional<AxisState> Client::state(std::string_view axis, std::string_view gateway) const {

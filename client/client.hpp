@@ -4,12 +4,14 @@
 // writes drive parameters. Thread-safe: DDS delivers into internal tables under a mutex, and every
 // public call may come from any thread.
 #include <chrono>
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace drivegate::client {
@@ -20,7 +22,26 @@ struct ClientOptions {
   std::uint32_t domain = 0;
   std::string ns = "drivegate";
   std::string name;  // empty: "<hostname>-<pid>-<random>"
+  // DDS Security identity: a directory as scripts/make-pki.sh writes one (identity_ca.pem,
+  // cert.pem, key.pem, permissions_ca.pem, governance.p7s, permissions.p7s). Empty: the
+  // DRIVEGATE_IDENTITY environment variable, else no security.
+  std::string identity;
+  // UDPv4 on these interfaces only (names or IPv4 addresses). Empty: the DRIVEGATE_INTERFACES
+  // environment variable (comma-separated), else what the Fast DDS profile says.
+  std::vector<std::string> interfaces;
+  // Commands and parameter requests of this client that may wait for their first reply at once;
+  // send() and param() wait for room beyond that (flow control), up to their timeout.
+  std::size_t window = 64;
 };
+
+// Options with the domain, namespace and client name set, everything else at its default.
+inline ClientOptions options_for(std::uint32_t domain, std::string ns, std::string name) {
+  ClientOptions o;
+  o.domain = domain;
+  o.ns = std::move(ns);
+  o.name = std::move(name);
+  return o;
+}
 
 struct AxisInfo {
   std::string gateway;
@@ -120,6 +141,8 @@ enum class Outcome {
   Failed,
   Timeout,    // the gateway did not answer in time
   NoGateway,  // no gateway owns the axis (or the named gateway is unknown)
+  Busy,       // the command could not be sent in time: the window or DDS flow control stayed full
+  Denied,     // this client's DDS identity may not send commands (DDS Security access control)
 };
 std::string_view to_string(Outcome o) noexcept;
 
@@ -169,6 +192,10 @@ class Client {
   Client& operator=(const Client&) = delete;
 
   [[nodiscard]] const std::string& name() const noexcept;
+  // Why this client may not send commands, set-points or parameter requests (its DDS identity's
+  // permissions refused the writer); empty when it may.
+  [[nodiscard]] std::string command_refusal() const;
+  [[nodiscard]] std::string parameter_refusal() const;
 
   // Discovery and latest data (copies, sorted by gateway then axis).
   [[nodiscard]] std::vector<GatewayInfo> gateways() const;

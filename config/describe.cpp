@@ -173,6 +173,13 @@ std::string describe_plan(const Plan& plan) {
   out << "gateway " << g.name << '\n';
   const Printer gp{out, 2, 16};
   gp.row("dds", "domain " + std::to_string(g.domain) + ", namespace " + g.ns);
+  gp.row("dds network", g.dds_interfaces.empty() ? std::string{"every interface (or as the Fast DDS profile says)"}
+                                                 : "UDPv4 on " + join(g.dds_interfaces) + " only");
+  if (!g.dds_profiles_file.empty())
+    gp.row("dds profile", g.dds_profiles_file + (g.dds_profile.empty() ? std::string{} : " (profile " + g.dds_profile + ")"));
+  gp.row("dds security", g.security ? "on: certificate " + g.security->certificate + ", permissions " +
+                                          g.security->permissions
+                                    : std::string{"off: anyone on the DDS domain can command the axes"});
   gp.row("log level", g.log_level);
   gp.row("status rate", format_number(g.status_rate_hz) + " Hz");
   if (!g.device_dirs.empty()) gp.row("device dirs", join(g.device_dirs));

@@ -1,6 +1,7 @@
 #include "config/loader.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <thread>
@@ -18,14 +19,87 @@ namespace {
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
 
+// A file the gateway reads at start: relative paths start at the config file's directory; it must
+// exist and be a regular file.
+std::string read_file_path(const MapReader& m, std::string_view key, const fs::path& base_dir, Need need) {
+  const auto given = m.string(key, need);
+  if (!given) return {};
+  const fs::path p{*given};
+  const fs::path abs = (p.is_absolute() ? p : base_dir / p).lexically_normal();
+  std::error_code ec;
+  if (!fs::exists(abs, ec))
+    m.error(key, "file \"" + abs.string() + "\" does not exist (relative paths start at the config file's directory)");
+  else if (!fs::is_regular_file(abs, ec))
+    m.error(key, "\"" + abs.string() + "\" is not a regular file");
+  return abs.string();
+}
+
+// gateway.security: DDS Security (README "DDS Security"). `dir` names a directory in the layout
+// scripts/make-pki.sh writes; each file may also be named on its own (and then overrides it).
+std::optional<SecurityPlan> read_security(const MapReader& sec, const fs::path& base_dir) {
+  static const std::vector<std::string> kFiles{"identity_ca", "certificate", "private_key",
+                                               "permissions_ca", "governance", "permissions"};
+  std::vector<std::string> keys = kFiles;
+  keys.emplace_back("dir");
+  sec.check_keys(keys);
+  if (!sec.present()) return std::nullopt;
+  static const std::vector<std::string> kInDir{"identity_ca.pem",    "cert.pem",       "key.pem",
+                                               "permissions_ca.pem", "governance.p7s", "permissions.p7s"};
+  std::array<std::string, 6> paths;
+  if (const auto dir = sec.string("dir", Need::Optional)) {
+    const fs::path d = fs::path{*dir}.is_absolute() ? fs::path{*dir} : base_dir / *dir;
+    std::error_code ec;
+    if (!fs::is_directory(d, ec))
+      sec.error("dir", "directory \"" + d.lexically_normal().string() + "\" does not exist");
+    for (std::size_t i = 0; i < kInDir.size(); ++i) {
+      paths[i] = (d / kInDir[i]).lexically_normal().string();
+      if (!sec.has(kFiles[i]) && !fs::is_regular_file(paths[i], ec))
+        sec.error("dir", "\"" + paths[i] + "\" (" + kFiles[i] + ") does not exist; scripts/make-pki.sh makes the set");
+    }
+  }
+  for (std::size_t i = 0; i < kFiles.size(); ++i) {
+    if (sec.has(kFiles[i]))
+      paths[i] = read_file_path(sec, kFiles[i], base_dir, Need::Required);
+    else if (paths[i].empty())
+      sec.error(kFiles[i], "missing: give every security file, or dir with all six");
+  }
+  return SecurityPlan{paths[0], paths[1], paths[2], paths[3], paths[4], paths[5]};
+}
+
+// An interface name as the kernel allows it (1..15 characters, no '/' or space) or an IPv4 address.
+bool is_interface_or_address(const std::string& s) {
+  if (s.empty() || s.size() > 15) return false;
+  return std::none_of(s.begin(), s.end(), [](char c) { return c == '/' || c == ' ' || c == ':' || c < 33 || c > 126; });
+}
+
 void read_gateway(const MapReader& g, const fs::path& base_dir, GatewayPlan& out) {
-  g.check_keys({"name", "dds", "log_level", "status_rate_hz", "device_dirs"});
+  g.check_keys({"name", "dds", "security", "log_level", "status_rate_hz", "device_dirs"});
   out.name = g.name("name", Need::Required).value_or("");
   const MapReader dds = g.map("dds", Need::Optional);
-  dds.check_keys({"domain", "namespace"});
+  dds.check_keys({"domain", "namespace", "profiles_file", "profile", "interfaces", "duplicate_check"});
   // RTPS port arithmetic limits domain ids to 0..232 with the default port parameters.
   out.domain = static_cast<int>(dds.integer("domain", Need::Optional, 0, 232).value_or(0));
   out.ns = dds.name("namespace", Need::Optional, false).value_or(out.ns);
+  if (dds.has("profiles_file")) out.dds_profiles_file = read_file_path(dds, "profiles_file", base_dir, Need::Required);
+  out.dds_profile = dds.string("profile", Need::Optional).value_or("");
+  if (!out.dds_profile.empty() && out.dds_profiles_file.empty())
+    dds.error("profile", "names a profile in profiles_file: give profiles_file too");
+  if (const auto list = dds.list("interfaces", Need::Optional)) {
+    if (list->size() == 0) dds.error("interfaces", "must name at least one interface (or leave it out for all)");
+    for (std::size_t i = 0; i < list->size(); ++i) {
+      const auto name = read_string((*list)[i], indexed(dds.field("interfaces"), i), dds.source());
+      if (!name) continue;
+      if (!is_interface_or_address(*name)) {
+        dds.source().error((*list)[i].Mark(), indexed(dds.field("interfaces"), i),
+                           "must be an interface name (1..15 characters) or an IPv4 address, got " + in_quotes(*name));
+        continue;
+      }
+      out.dds_interfaces.push_back(*name);
+    }
+  }
+  out.duplicate_check = dds.duration("duplicate_check", Need::Optional, 0ns, std::chrono::seconds(30))
+                            .value_or(out.duplicate_check);
+  out.security = read_security(g.map("security", Need::Optional), base_dir);
   static const std::vector<std::string> kLevels{"trace", "debug", "info", "warn", "error", "critical", "off"};
   out.log_level = g.choice("log_level", Need::Optional, kLevels).value_or(out.log_level);
   NumberRule rate{1, 1000, false, "a number in 1..1000 (Hz)"};

@@ -17,10 +17,26 @@
 
 namespace drivegate::config {
 
+// DDS Security files of the gateway (absolute paths; idl/dds_security.hpp says what each is).
+struct SecurityPlan {
+  std::string identity_ca;
+  std::string certificate;
+  std::string private_key;
+  std::string permissions_ca;
+  std::string governance;
+  std::string permissions;
+};
+
 struct GatewayPlan {
   std::string name;
   int domain = 0;
   std::string ns = "drivegate";  // DDS topic name prefix
+  std::string dds_profiles_file;  // Fast DDS XML profiles, absolute; empty: none
+  std::string dds_profile;        // participant profile in it; empty: its default profile
+  std::vector<std::string> dds_interfaces;  // UDPv4 on these only (names or IPv4 addresses)
+  std::optional<SecurityPlan> security;
+  // At start-up, how long to listen for another instance of this gateway before any bus opens.
+  core::Duration duplicate_check = std::chrono::seconds(1);
   std::string log_level = "info";
   double status_rate_hz = 50;
   std::vector<std::string> device_dirs;  // from the file, made absolute

@@ -105,6 +105,7 @@ std::string_view to_string(EventKind k) noexcept {
     case EventKind::CommandTimeout: return "command_timeout";
     case EventKind::Info: return "info";
     case EventKind::ControlLost: return "control_lost";
+    case EventKind::DuplicateGateway: return "duplicate_gateway";
   }
   return "info";
 }

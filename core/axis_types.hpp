@@ -68,6 +68,7 @@ enum class EventKind : std::uint8_t {
   CommandTimeout,  // set-point source went silent; the axis was stopped
   Info,
   ControlLost,  // the drive stopped following the gateway's controlword/telegram; it is being stopped
+  DuplicateGateway,  // another instance of this gateway (same name) is on the DDS domain
 };
 
 // Modes that need a live command source: silence longer than the axis' command timeout stops them.

@@ -3,12 +3,16 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
+#include <deque>
 #include <map>
 #include <mutex>
 #include <optional>
+#include <random>
 #include <set>
 #include <stdexcept>
 #include <thread>
@@ -17,11 +21,14 @@
 #include <fastdds/dds/core/condition/GuardCondition.hpp>
 #include <fastdds/dds/core/condition/StatusCondition.hpp>
 #include <fastdds/dds/core/condition/WaitSet.hpp>
+#include <fastdds/dds/core/status/PublicationMatchedStatus.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/DataWriterListener.hpp>
 #include <fastdds/dds/subscriber/DataReader.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <spdlog/spdlog.h>
 
+#include "daemon/log_limiter.hpp"
 #include "drivegate.h"
 #include "idl/dds_node.hpp"
 
@@ -29,14 +36,28 @@ namespace drivegate::daemon {
 
 namespace dds = eprosima::fastdds::dds;
 using Clock = std::chrono::steady_clock;
+using namespace std::chrono_literals;
 
 namespace {
 
-// Every command gets a final reply, but a gateway that loses replies (its outbound queue full)
-// must not make this bookkeeping grow without bound: the oldest entries go beyond this many.
-constexpr std::size_t kMaxPending = 4096;
 // The Runtime has no wake-up signal, so its outbox is drained at least this often.
-constexpr auto kMaxPoll = std::chrono::milliseconds(5);
+constexpr auto kMaxPoll = 5ms;
+// While requests wait for the Runtime, the bridge comes back sooner.
+constexpr auto kBusyPoll = 1ms;
+// A request that found no place in the Runtime's queue for this long is answered "busy".
+constexpr auto kBusyAfter = 2s;
+// Replies for a client wait this long for its reply reader to match before they go out anyway (a
+// client may read replies through another participant than the one it writes commands with).
+constexpr auto kReplyHold = 1500ms;
+// At most this many requests are taken from DDS per pass; more replies than this waiting to be
+// written make the bridge stop taking requests until they are out.
+constexpr std::size_t kTakePerPass = 256;
+constexpr std::size_t kMaxReplyBacklog = 2048;
+// How long a reply write may block while every matched reader's history is full (keep-all flow
+// control); after that the reply waits in the bridge and is retried.
+constexpr std::chrono::milliseconds kWriteBlock{20};
+// A summary of the traffic instead of a log line per command.
+constexpr auto kSummaryPeriod = 10s;
 
 std::string known_kinds() {
   std::string s;
@@ -66,26 +87,55 @@ std::string host_name() {
   return buf;
 }
 
+// The participant a writer or reader belongs to: the first 12 bytes (GUID prefix) of its handle.
+using Prefix = std::array<std::uint8_t, 12>;
+Prefix prefix_of(const dds::InstanceHandle_t& h) {
+  Prefix p{};
+  for (std::size_t i = 0; i < p.size(); ++i) p[i] = h.value[i];
+  return p;
+}
+
 struct Pending {
   std::string client;
   std::uint64_t client_id = 0;
   std::string axis;
+  Prefix prefix{};
   std::uint16_t index = 0;  // parameter requests: the object accessed
   std::uint8_t sub = 0;
 };
 
-template <typename T>
-void remember(std::map<core::CommandId, T>& pending, core::CommandId id, T value) {
-  pending.emplace(id, std::move(value));
-  while (pending.size() > kMaxPending) pending.erase(pending.begin());
+// A request taken from DDS that the Runtime had no room for yet.
+template <typename Request>
+struct Deferred {
+  std::size_t axis_id;
+  Request request;
+  Pending pending;
+  Clock::time_point since;
+};
+
+// A reply waiting for its client's reader (or for room in the writer's history).
+template <typename Sample>
+struct OutReply {
+  Sample sample;
+  Prefix prefix;
+  Clock::time_point since;
+};
+
+std::int64_t wall_clock_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
 }
 
 }  // namespace
 
-class DdsBridge::Impl {
+class DdsBridge::Impl : private dds::DataWriterListener {
  public:
-  Impl(Runtime& runtime, DdsBridgeOptions options) : rt_(runtime), opt_(std::move(options)) {}
-  ~Impl() { stop(); }
+  Impl(Runtime& runtime, DdsBridgeOptions options) : rt_(runtime), opt_(std::move(options)) {
+    std::random_device rd;
+    instance_ = (std::uint64_t{rd()} << 32) ^ rd();
+    started_ = wall_clock_ns();
+  }
+  ~Impl() override { stop(); }
   Impl(const Impl&) = delete;
   Impl& operator=(const Impl&) = delete;
 
@@ -95,31 +145,69 @@ class DdsBridge::Impl {
     std::lock_guard lock(stats_mutex_);
     return stats_;
   }
+  DuplicateGateway duplicate() const {
+    std::lock_guard lock(dup_mutex_);
+    return duplicate_;
+  }
+  void let_others_see_us(std::chrono::milliseconds budget) {
+    const auto until = Clock::now() + budget;
+    // Our own reader is one match; the other instance's reader makes two.
+    dds::PublicationMatchedStatus st{};
+    while (Clock::now() < until) {
+      info_w_->get_publication_matched_status(st);
+      if (st.current_count >= 2) break;
+      std::this_thread::sleep_for(10ms);
+    }
+    const auto left = std::chrono::duration_cast<std::chrono::nanoseconds>(until - Clock::now()).count();
+    if (left > 0)
+      info_w_->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(
+          static_cast<std::int32_t>(left / 1'000'000'000), static_cast<std::uint32_t>(left % 1'000'000'000)));
+  }
+  DuplicateGateway wait_for_duplicate(std::chrono::milliseconds window) const {
+    std::unique_lock lock(dup_mutex_);
+    dup_cv_.wait_for(lock, window, [&] { return duplicate_.seen; });
+    return duplicate_;
+  }
 
  private:
   void run();
-  void take_commands();
-  void handle_command(const msg::AxisCommand& in);
-  void reject(const msg::AxisCommand& in, const std::string& reason);
+  void take_commands(Clock::time_point now);
+  void handle_command(const msg::AxisCommand& in, const Prefix& from, Clock::time_point now);
+  void reject(const msg::AxisCommand& in, const Prefix& from, const std::string& reason, Clock::time_point now);
   void take_setpoints();
-  void take_params();
-  void handle_param(const msg::ParamRequest& in);
+  void take_params(Clock::time_point now);
+  void handle_param(const msg::ParamRequest& in, const Prefix& from, Clock::time_point now);
+  void fail_param(const msg::ParamRequest& in, const Prefix& from, const std::string& error, Clock::time_point now);
+  void retry_deferred(Clock::time_point now);
   void take_gateway_infos();
-  void publish_outbox();
+  void collect_outbox(Clock::time_point now);
+  void write_replies(Clock::time_point now);
   void publish_states();
   void publish_bus_status();
   void publish_gateway_info();
+  void publish_gateway_event(core::EventKind kind, const std::string& text);
+  void log_summary(Clock::time_point now);
+  [[nodiscard]] bool busy() const noexcept {
+    return !deferred_commands_.empty() || !deferred_params_.empty() ||
+           replies_.size() + param_replies_.size() >= kMaxReplyBacklog;
+  }
   [[nodiscard]] std::optional<std::size_t> find_axis(std::string_view name) const;
   [[nodiscard]] std::string axis_list() const;
+  [[nodiscard]] bool reader_matched(const Prefix& p, bool param) const;
   template <typename F>
   void count(F&& f) {
     std::lock_guard lock(stats_mutex_);
     f(stats_);
   }
 
+  // DataWriterListener of the two reply writers: which participants have a matched reply reader.
+  void on_publication_matched(dds::DataWriter* writer, const dds::PublicationMatchedStatus& info) override;
+
   Runtime& rt_;
   DdsBridgeOptions opt_;
   std::string gateway_;
+  std::uint64_t instance_ = 0;
+  std::int64_t started_ = 0;
 
   std::unique_ptr<msg::DdsNode> node_;
   dds::DataWriter* state_w_ = nullptr;
@@ -142,10 +230,32 @@ class DdsBridge::Impl {
   core::CommandId next_id_ = 1;
   std::map<core::CommandId, Pending> pending_commands_;
   std::map<core::CommandId, Pending> pending_params_;
+  std::deque<Deferred<core::Command>> deferred_commands_;
+  std::deque<Deferred<core::ParamRequest>> deferred_params_;
+  std::deque<OutReply<msg::CommandReply>> replies_;
+  std::deque<OutReply<msg::ParamReply>> param_replies_;
   std::set<std::pair<std::string, std::string>> warned_duplicates_;  // (other gateway, axis)
   std::set<std::pair<std::string, std::string>> warned_setpoints_;   // (client, axis)
+  std::set<std::uint64_t> warned_instances_;                         // other instances of this gateway
   Outbox outbox_;
   std::uint64_t state_seq_ = 0;
+
+  // Traffic summary (instead of a line per command) and rate-limited warnings.
+  LogLimiter warn_limit_;
+  Clock::time_point next_summary_{};
+  std::set<std::string> summary_clients_;
+  std::uint64_t summary_commands_ = 0;
+  std::uint64_t summary_rejected_ = 0;
+  std::uint64_t summary_params_ = 0;
+
+  // Matched reply readers per participant, from the writers' listener (DDS threads).
+  mutable std::mutex match_mutex_;
+  std::map<Prefix, int> reply_readers_;
+  std::map<Prefix, int> param_reply_readers_;
+
+  mutable std::mutex dup_mutex_;
+  mutable std::condition_variable dup_cv_;
+  DuplicateGateway duplicate_;
 
   mutable std::mutex stats_mutex_;
   Stats stats_;
@@ -156,12 +266,20 @@ void DdsBridge::Impl::start() {
   if (!std::isfinite(opt_.status_rate_hz) || opt_.status_rate_hz <= 0 || opt_.status_rate_hz > 1000)
     throw std::invalid_argument("DDS status rate must be in (0, 1000] Hz, got " + std::to_string(opt_.status_rate_hz));
   gateway_ = rt_.gateway_name();
-  node_ = std::make_unique<msg::DdsNode>(opt_.domain, opt_.ns, "drivegated/" + gateway_);
+  msg::DdsOptions o;
+  o.domain = opt_.domain;
+  o.ns = opt_.ns;
+  o.participant_name = "drivegated/" + gateway_;
+  o.profiles_file = opt_.profiles_file;
+  o.profile = opt_.profile;
+  o.interfaces = opt_.interfaces;
+  o.security = opt_.security;
+  node_ = std::make_unique<msg::DdsNode>(o);
   state_w_ = &node_->writer(msg::TopicId::AxisState);
-  reply_w_ = &node_->writer(msg::TopicId::CommandReply);
+  reply_w_ = &node_->writer(msg::TopicId::CommandReply, this, dds::StatusMask::publication_matched(), kWriteBlock);
   event_w_ = &node_->writer(msg::TopicId::AxisEvent);
   bus_w_ = &node_->writer(msg::TopicId::BusStatus);
-  param_w_ = &node_->writer(msg::TopicId::ParamReply);
+  param_w_ = &node_->writer(msg::TopicId::ParamReply, this, dds::StatusMask::publication_matched(), kWriteBlock);
   info_w_ = &node_->writer(msg::TopicId::GatewayInfo);
   cmd_r_ = &node_->reader(msg::TopicId::AxisCommand);
   sp_r_ = &node_->reader(msg::TopicId::Setpoint);
@@ -175,8 +293,10 @@ void DdsBridge::Impl::start() {
   waitset_.attach_condition(wake_);
 
   publish_gateway_info();
-  spdlog::info("dds: gateway '{}' on domain {} namespace '{}', {} axes, state at {} Hz", gateway_, opt_.domain,
-               opt_.ns, rt_.axes().size(), opt_.status_rate_hz);
+  spdlog::info("dds: gateway '{}' on domain {} namespace '{}'{}{}, {} axes, state at {} Hz", gateway_, opt_.domain,
+               opt_.ns, node_->secure() ? ", DDS Security on" : "",
+               opt_.interfaces.empty() ? std::string{} : ", interfaces " + std::to_string(opt_.interfaces.size()),
+               rt_.axes().size(), opt_.status_rate_hz);
   running_ = true;
   thread_ = std::thread([this] { run(); });
 }
@@ -191,26 +311,49 @@ void DdsBridge::Impl::stop() {
   spdlog::info("dds: bridge of gateway '{}' stopped", gateway_);
 }
 
+void DdsBridge::Impl::on_publication_matched(dds::DataWriter* writer, const dds::PublicationMatchedStatus& info) {
+  std::lock_guard lock(match_mutex_);
+  auto& readers = writer == param_w_ ? param_reply_readers_ : reply_readers_;
+  const Prefix p = prefix_of(info.last_subscription_handle);
+  if (info.current_count_change > 0) {
+    ++readers[p];
+  } else if (info.current_count_change < 0) {
+    const auto it = readers.find(p);
+    if (it != readers.end() && --it->second <= 0) readers.erase(it);
+  }
+}
+
+bool DdsBridge::Impl::reader_matched(const Prefix& p, bool param) const {
+  std::lock_guard lock(match_mutex_);
+  const auto& readers = param ? param_reply_readers_ : reply_readers_;
+  return readers.count(p) > 0;
+}
+
 void DdsBridge::Impl::run() {
   const auto state_period =
       std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / opt_.status_rate_hz));
   const auto bus_period = std::max<Clock::duration>(state_period, std::chrono::seconds(1));
   auto next_state = Clock::now();
   auto next_bus = Clock::now();
+  next_summary_ = Clock::now() + kSummaryPeriod;
   dds::ConditionSeq active;
   while (running_) {
     const auto now = Clock::now();
-    const auto wait = std::clamp<Clock::duration>(next_state - now, Clock::duration::zero(), kMaxPoll);
+    const bool waiting = busy() || !replies_.empty() || !param_replies_.empty();
+    const auto wait = std::clamp<Clock::duration>(next_state - now, Clock::duration::zero(),
+                                                  waiting ? Clock::duration(kBusyPoll) : Clock::duration(kMaxPoll));
     const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(wait).count();
     waitset_.wait(active, eprosima::fastrtps::Duration_t(static_cast<std::int32_t>(ns / 1'000'000'000),
                                                          static_cast<std::uint32_t>(ns % 1'000'000'000)));
     if (!running_) break;
-    take_commands();
-    take_setpoints();
-    take_params();
-    take_gateway_infos();
-    publish_outbox();
     const auto t = Clock::now();
+    retry_deferred(t);
+    take_commands(t);
+    take_setpoints();
+    take_params(t);
+    take_gateway_infos();
+    collect_outbox(t);
+    write_replies(t);
     if (t >= next_state) {
       publish_states();
       next_state += state_period;
@@ -220,6 +363,7 @@ void DdsBridge::Impl::run() {
       publish_bus_status();
       next_bus = t + bus_period;
     }
+    log_summary(t);
   }
 }
 
@@ -239,22 +383,28 @@ std::string DdsBridge::Impl::axis_list() const {
   return s.empty() ? "(none)" : s;
 }
 
-void DdsBridge::Impl::take_commands() {
-  msg::take_valid<msg::AxisCommand>(*cmd_r_, [&](const msg::AxisCommand& in) {
+void DdsBridge::Impl::take_commands(Clock::time_point now) {
+  msg::AxisCommand in;
+  dds::SampleInfo info;
+  // While requests wait for the Runtime the rest stay in DDS: the keep-all reader fills and the
+  // clients' writers wait, instead of anything being dropped.
+  for (std::size_t n = 0; n < kTakePerPass && !busy(); ++n) {
+    if (cmd_r_->take_next_sample(&in, &info) != ReturnCode_t::RETCODE_OK) break;
+    if (!info.valid_data) continue;
     if (in.gateway() != gateway_) {
       // Another gateway's axis: the owner answers, we stay silent.
-      spdlog::debug("dds: ignoring {} for {}/{} from '{}' (not our gateway)", in.kind(), in.gateway(), in.axis(),
-                    in.client());
       count([](Stats& s) { ++s.commands_ignored; });
-      return;
+      continue;
     }
-    handle_command(in);
-  });
+    handle_command(in, prefix_of(info.publication_handle), now);
+  }
 }
 
-void DdsBridge::Impl::reject(const msg::AxisCommand& in, const std::string& reason) {
-  spdlog::warn("dds: rejected {} for axis '{}' from '{}' id {}: {}", in.kind(), in.axis(), in.client(), in.id(),
-               reason);
+void DdsBridge::Impl::reject(const msg::AxisCommand& in, const Prefix& from, const std::string& reason,
+                             Clock::time_point now) {
+  if (warn_limit_.allow(now))
+    spdlog::warn("dds: rejected {} for axis '{}' from '{}' id {}: {}", in.kind(), in.axis(), in.client(), in.id(),
+                 reason);
   msg::CommandReply out;
   out.gateway(gateway_);
   out.axis(in.axis());
@@ -262,25 +412,29 @@ void DdsBridge::Impl::reject(const msg::AxisCommand& in, const std::string& reas
   out.id(in.id());
   out.status(std::string(core::to_string(core::ReplyStatus::Rejected)));
   out.reason(reason);
-  reply_w_->write(&out);
+  replies_.push_back({std::move(out), from, now});
+  ++summary_rejected_;
   count([](Stats& s) { ++s.commands_rejected; });
 }
 
-void DdsBridge::Impl::handle_command(const msg::AxisCommand& in) {
-  if (in.client().empty()) return reject(in, "command without a client id (field 'client')");
+void DdsBridge::Impl::handle_command(const msg::AxisCommand& in, const Prefix& from, Clock::time_point now) {
+  ++summary_commands_;
+  summary_clients_.insert(in.client());
+  if (in.client().empty()) return reject(in, from, "command without a client id (field 'client')", now);
   const auto axis = find_axis(in.axis());
   if (!axis)
-    return reject(in, "unknown axis '" + in.axis() + "' on gateway '" + gateway_ + "'; axes here: " + axis_list());
+    return reject(in, from, "unknown axis '" + in.axis() + "' on gateway '" + gateway_ + "'; axes here: " + axis_list(),
+                  now);
   const auto kind = core::parse_command_kind(in.kind());
-  if (!kind) return reject(in, "unknown command kind '" + in.kind() + "'; known: " + known_kinds());
+  if (!kind) return reject(in, from, "unknown command kind '" + in.kind() + "'; known: " + known_kinds(), now);
   core::Mode mode = core::Mode::None;
   if (!in.mode().empty()) {
     const auto m = core::parse_mode(in.mode());
-    if (!m) return reject(in, "unknown mode '" + in.mode() + "'; known: " + known_modes());
+    if (!m) return reject(in, from, "unknown mode '" + in.mode() + "'; known: " + known_modes(), now);
     mode = *m;
   }
   if (*kind == core::CommandKind::SetMode && mode == core::Mode::None)
-    return reject(in, "set_mode needs a mode; known: " + known_modes());
+    return reject(in, from, "set_mode needs a mode; known: " + known_modes(), now);
 
   core::Command cmd;
   cmd.id = next_id_++;
@@ -298,12 +452,63 @@ void DdsBridge::Impl::handle_command(const msg::AxisCommand& in) {
   cmd.homing_search_velocity = in.homing_search_velocity();
   cmd.homing_zero_velocity = in.homing_zero_velocity();
   cmd.block = in.block();
-  if (!rt_.submit_command(*axis, cmd))
-    return reject(in, "gateway busy: the command queue of axis '" + in.axis() + "' is full");
-  remember(pending_commands_, cmd.id, Pending{in.client(), in.id(), in.axis()});
-  spdlog::info("dds: {} for axis '{}' from '{}' id {} -> command {}", in.kind(), in.axis(), in.client(), in.id(),
-               cmd.id);
+  Pending p{in.client(), in.id(), in.axis(), from, 0, 0};
+  spdlog::debug("dds: {} for axis '{}' from '{}' id {} -> command {}", in.kind(), in.axis(), in.client(), in.id(),
+                cmd.id);
+  if (!rt_.submit_command(*axis, cmd)) {
+    deferred_commands_.push_back({*axis, cmd, std::move(p), now});
+    return;
+  }
+  pending_commands_.emplace(cmd.id, std::move(p));
   count([](Stats& s) { ++s.commands_routed; });
+}
+
+void DdsBridge::Impl::retry_deferred(Clock::time_point now) {
+  while (!deferred_commands_.empty()) {
+    auto& d = deferred_commands_.front();
+    if (rt_.submit_command(d.axis_id, d.request)) {
+      pending_commands_.emplace(d.request.id, std::move(d.pending));
+      count([](Stats& s) { ++s.commands_routed; });
+    } else if (now - d.since >= kBusyAfter) {
+      msg::CommandReply out;
+      out.gateway(gateway_);
+      out.axis(d.pending.axis);
+      out.client(d.pending.client);
+      out.id(d.pending.client_id);
+      out.status(std::string(core::to_string(core::ReplyStatus::Rejected)));
+      out.reason("busy: the gateway's command queue for axis '" + d.pending.axis + "' stayed full for " +
+                 std::to_string(std::chrono::duration_cast<std::chrono::milliseconds>(kBusyAfter).count()) +
+                 " ms; send it again");
+      replies_.push_back({std::move(out), d.pending.prefix, now});
+      ++summary_rejected_;
+      count([](Stats& s) { ++s.commands_busy; });
+    } else {
+      break;
+    }
+    deferred_commands_.pop_front();
+  }
+  while (!deferred_params_.empty()) {
+    auto& d = deferred_params_.front();
+    if (rt_.submit_parameter(d.axis_id, d.request)) {
+      pending_params_.emplace(d.request.id, std::move(d.pending));
+      count([](Stats& s) { ++s.params_routed; });
+    } else if (now - d.since >= kBusyAfter) {
+      msg::ParamReply out;
+      out.gateway(gateway_);
+      out.axis(d.pending.axis);
+      out.client(d.pending.client);
+      out.id(d.pending.client_id);
+      out.ok(false);
+      out.error("busy: the gateway's parameter queue for axis '" + d.pending.axis + "' stayed full; send it again");
+      out.index(d.pending.index);
+      out.subindex(d.pending.sub);
+      param_replies_.push_back({std::move(out), d.pending.prefix, now});
+      count([](Stats& s) { ++s.commands_busy; });
+    } else {
+      break;
+    }
+    deferred_params_.pop_front();
+  }
 }
 
 void DdsBridge::Impl::take_setpoints() {
@@ -320,36 +525,46 @@ void DdsBridge::Impl::take_setpoints() {
     }
     count([](Stats& s) { ++s.setpoints_dropped; });
     // Set-points stream at high rate: log the first drop per client and axis only.
-    if (warned_setpoints_.emplace(in.client(), in.axis()).second)
+    if (warned_setpoints_.size() < 1000 && warned_setpoints_.emplace(in.client(), in.axis()).second)
       spdlog::warn("dds: dropping set-points from '{}' for axis '{}': {}", in.client(), in.axis(),
                    axis ? "queue full" : "unknown axis; axes here: " + axis_list());
   });
 }
 
-void DdsBridge::Impl::take_params() {
-  msg::take_valid<msg::ParamRequest>(*param_r_, [&](const msg::ParamRequest& in) {
-    if (in.gateway() != gateway_) return;
-    handle_param(in);
-  });
+void DdsBridge::Impl::take_params(Clock::time_point now) {
+  msg::ParamRequest in;
+  dds::SampleInfo info;
+  for (std::size_t n = 0; n < kTakePerPass && !busy(); ++n) {
+    if (param_r_->take_next_sample(&in, &info) != ReturnCode_t::RETCODE_OK) break;
+    if (!info.valid_data || in.gateway() != gateway_) continue;
+    handle_param(in, prefix_of(info.publication_handle), now);
+  }
 }
 
-void DdsBridge::Impl::handle_param(const msg::ParamRequest& in) {
-  auto fail = [&](const std::string& error) {
+void DdsBridge::Impl::fail_param(const msg::ParamRequest& in, const Prefix& from, const std::string& error,
+                                 Clock::time_point now) {
+  if (warn_limit_.allow(now))
     spdlog::warn("dds: parameter request {:04X}:{} for axis '{}' from '{}' failed: {}", in.index(), in.subindex(),
                  in.axis(), in.client(), error);
-    msg::ParamReply out;
-    out.gateway(gateway_);
-    out.axis(in.axis());
-    out.client(in.client());
-    out.id(in.id());
-    out.ok(false);
-    out.error(error);
-    out.index(in.index());
-    out.subindex(in.subindex());
-    param_w_->write(&out);
-  };
+  msg::ParamReply out;
+  out.gateway(gateway_);
+  out.axis(in.axis());
+  out.client(in.client());
+  out.id(in.id());
+  out.ok(false);
+  out.error(error);
+  out.index(in.index());
+  out.subindex(in.subindex());
+  param_replies_.push_back({std::move(out), from, now});
+}
+
+void DdsBridge::Impl::handle_param(const msg::ParamRequest& in, const Prefix& from, Clock::time_point now) {
+  ++summary_params_;
+  summary_clients_.insert(in.client());
   const auto axis = find_axis(in.axis());
-  if (!axis) return fail("unknown axis '" + in.axis() + "' on gateway '" + gateway_ + "'; axes here: " + axis_list());
+  if (!axis)
+    return fail_param(in, from,
+                      "unknown axis '" + in.axis() + "' on gateway '" + gateway_ + "'; axes here: " + axis_list(), now);
   core::ParamRequest req;
   req.id = next_id_++;
   req.write = in.write();
@@ -360,7 +575,7 @@ void DdsBridge::Impl::handle_param(const msg::ParamRequest& in) {
   req.value = in.value();
   if (!in.name().empty()) {
     const ParameterLookup p = rt_.lookup_parameter(*axis, in.name());
-    if (!p.ok) return fail(p.error);
+    if (!p.ok) return fail_param(in, from, p.error, now);
     req.index = p.index;
     req.sub = p.sub;
     if (p.size != 0) {
@@ -369,22 +584,41 @@ void DdsBridge::Impl::handle_param(const msg::ParamRequest& in) {
     }
   }
   if (req.size != 1 && req.size != 2 && req.size != 4)
-    return fail("parameter size must be 1, 2 or 4 bytes, got " + std::to_string(req.size));
-  if (!rt_.submit_parameter(*axis, req))
-    return fail("gateway busy: the parameter queue of axis '" + in.axis() + "' is full");
-  remember(pending_params_, req.id, Pending{in.client(), in.id(), in.axis(), req.index, req.sub});
-  spdlog::info("dds: parameter {} {:04X}:{} for axis '{}' from '{}' id {} -> request {}", in.write() ? "write" : "read",
-               req.index, req.sub, in.axis(), in.client(), in.id(), req.id);
+    return fail_param(in, from, "parameter size must be 1, 2 or 4 bytes, got " + std::to_string(req.size), now);
+  Pending p{in.client(), in.id(), in.axis(), from, req.index, req.sub};
+  spdlog::debug("dds: parameter {} {:04X}:{} for axis '{}' from '{}' id {} -> request {}",
+                in.write() ? "write" : "read", req.index, req.sub, in.axis(), in.client(), in.id(), req.id);
+  if (!rt_.submit_parameter(*axis, req)) {
+    deferred_params_.push_back({*axis, req, std::move(p), now});
+    return;
+  }
+  pending_params_.emplace(req.id, std::move(p));
   count([](Stats& s) { ++s.params_routed; });
 }
 
 void DdsBridge::Impl::take_gateway_infos() {
   msg::take_valid<msg::GatewayInfo>(*info_r_, [&](const msg::GatewayInfo& in) {
-    if (in.gateway() == gateway_) return;
+    if (in.gateway() == gateway_) {
+      if (in.instance() == instance_ || !warned_instances_.insert(in.instance()).second) return;
+      // Two masters on one set of drives: both say so loudly, the one that started later stops.
+      const bool this_one_later = started_ > in.started() || (started_ == in.started() && instance_ > in.instance());
+      const std::string text = "another drivegated runs as gateway '" + gateway_ + "' on this DDS domain (host " +
+                               in.host() + ", pid " + std::to_string(in.pid()) + "): two gateways would command the "
+                               "same axes; " +
+                               (this_one_later ? "this one started later and stops" : "that one started later and must stop");
+      spdlog::critical("dds: {}", text);
+      publish_gateway_event(core::EventKind::DuplicateGateway, text);
+      {
+        std::lock_guard lock(dup_mutex_);
+        duplicate_ = {true, this_one_later || duplicate_.this_one_stops, text};
+      }
+      dup_cv_.notify_all();
+      return;
+    }
     spdlog::info("dds: gateway '{}' on {} (pid {}) owns {} axes", in.gateway(), in.host(), in.pid(), in.axes().size());
     for (const auto& other : in.axes()) {
-      if (!find_axis(other.name())) return;
-      if (!warned_duplicates_.emplace(in.gateway(), other.name()).second) return;
+      if (!find_axis(other.name())) continue;
+      if (!warned_duplicates_.emplace(in.gateway(), other.name()).second) continue;
       const std::string text = "axis '" + other.name() + "' is claimed by gateway '" + gateway_ + "' and by gateway '" +
                                in.gateway() + "'; clients must name the gateway for this axis";
       spdlog::warn("dds: {}", text);
@@ -400,7 +634,17 @@ void DdsBridge::Impl::take_gateway_infos() {
   });
 }
 
-void DdsBridge::Impl::publish_outbox() {
+void DdsBridge::Impl::publish_gateway_event(core::EventKind kind, const std::string& text) {
+  msg::AxisEvent ev;
+  ev.gateway(gateway_);
+  ev.kind(std::string(core::to_string(kind)));
+  ev.state(std::string(core::to_string(core::AxisState::Unknown)));
+  ev.text(text);
+  ev.stamp(std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch()).count());
+  event_w_->write(&ev);
+}
+
+void DdsBridge::Impl::collect_outbox(Clock::time_point now) {
   outbox_.clear();
   rt_.drain(outbox_);
   const auto axes = rt_.axes();
@@ -419,9 +663,9 @@ void DdsBridge::Impl::publish_outbox() {
     out.id(it->second.client_id);
     out.status(std::string(core::to_string(r.reply.status)));
     out.reason(r.reply.reason.str());
-    reply_w_->write(&out);
-    spdlog::info("dds: command {} ('{}' id {} on '{}'): {}{}{}", r.reply.id, out.client(), out.id(), out.axis(),
-                 out.status(), out.reason().empty() ? "" : ": ", out.reason());
+    spdlog::debug("dds: command {} ('{}' id {} on '{}'): {}{}{}", r.reply.id, out.client(), out.id(), out.axis(),
+                  out.status(), out.reason().empty() ? "" : ": ", out.reason());
+    replies_.push_back({std::move(out), it->second.prefix, now});
     if (r.reply.status != core::ReplyStatus::Accepted) pending_commands_.erase(it);
   }
 
@@ -437,7 +681,6 @@ void DdsBridge::Impl::publish_outbox() {
     out.stamp(e.event.stamp_ns);
     // The gateway logs every event once when it drains it; here only the publication is traced.
     event_w_->write(&out);
-    spdlog::trace("dds: published event {} on '{}'", out.kind(), out.axis().empty() ? out.bus() : out.axis());
   }
 
   for (const auto& p : outbox_.param_replies) {
@@ -457,11 +700,55 @@ void DdsBridge::Impl::publish_outbox() {
     out.error(p.reply.error.str());
     out.index(it->second.index);
     out.subindex(it->second.sub);
-    param_w_->write(&out);
-    spdlog::info("dds: parameter request {} ('{}' id {}): {}", p.reply.id, out.client(), out.id(),
-                 out.ok() ? "ok" : "error: " + out.error());
+    spdlog::debug("dds: parameter request {} ('{}' id {}): {}", p.reply.id, out.client(), out.id(),
+                  out.ok() ? "ok" : "error: " + out.error());
+    param_replies_.push_back({std::move(out), it->second.prefix, now});
     pending_params_.erase(it);
   }
+}
+
+// Replies go out in order per client once that client's reply reader is matched (or after the hold
+// time). A write that cannot go out because the readers' histories are full (flow control) is
+// retried on the next pass, with everything after it.
+void DdsBridge::Impl::write_replies(Clock::time_point now) {
+  const auto flush = [&](auto& queue, dds::DataWriter* writer, bool param) {
+    std::set<Prefix> blocked;  // clients whose earlier reply is still waiting: keep their order
+    for (auto it = queue.begin(); it != queue.end();) {
+      if (blocked.count(it->prefix) > 0) {
+        ++it;
+        continue;
+      }
+      const bool matched = reader_matched(it->prefix, param);
+      if (!matched && now - it->since < kReplyHold) {
+        blocked.insert(it->prefix);
+        ++it;
+        continue;
+      }
+      const ReturnCode_t rc = writer->write(&it->sample, dds::HANDLE_NIL);
+      if (rc == ReturnCode_t::RETCODE_TIMEOUT) return;  // every history full: try again next pass
+      if (rc != ReturnCode_t::RETCODE_OK) spdlog::error("dds: a reply could not be written (error {})", rc());
+      count([&](Stats& s) {
+        ++s.replies_written;
+        if (!matched) ++s.replies_unmatched;
+      });
+      it = queue.erase(it);
+    }
+  };
+  flush(replies_, reply_w_, false);
+  flush(param_replies_, param_w_, true);
+}
+
+void DdsBridge::Impl::log_summary(Clock::time_point now) {
+  if (now < next_summary_) return;
+  next_summary_ = now + kSummaryPeriod;
+  const auto suppressed = warn_limit_.take_suppressed();
+  if (summary_commands_ == 0 && summary_params_ == 0 && suppressed == 0) return;
+  spdlog::info("dds: in the last {} s: {} commands ({} rejected or busy) and {} parameter requests from {} client(s){}",
+               std::chrono::duration_cast<std::chrono::seconds>(kSummaryPeriod).count(), summary_commands_,
+               summary_rejected_, summary_params_, summary_clients_.size(),
+               suppressed == 0 ? std::string{} : "; " + std::to_string(suppressed) + " similar warnings not logged");
+  summary_commands_ = summary_rejected_ = summary_params_ = 0;
+  summary_clients_.clear();
 }
 
 void DdsBridge::Impl::publish_states() {
@@ -525,6 +812,8 @@ void DdsBridge::Impl::publish_gateway_info() {
   out.gateway(gateway_);
   out.host(host_name());
   out.pid(static_cast<std::uint32_t>(::getpid()));
+  out.instance(instance_);
+  out.started(started_);
   for (const auto& a : rt_.axes()) {
     msg::AxisDescription d;
     d.name(a.name);
@@ -545,6 +834,11 @@ DdsBridge::DdsBridge(Runtime& runtime, DdsBridgeOptions options)
 DdsBridge::~DdsBridge() = default;
 void DdsBridge::start() { impl_->start(); }
 void DdsBridge::stop() { impl_->stop(); }
+DuplicateGateway DdsBridge::wait_for_duplicate(std::chrono::milliseconds window) const {
+  return impl_->wait_for_duplicate(window);
+}
+DuplicateGateway DdsBridge::duplicate() const { return impl_->duplicate(); }
+void DdsBridge::let_others_see_us(std::chrono::milliseconds budget) { impl_->let_others_see_us(budget); }
 DdsBridge::Stats DdsBridge::stats() const { return impl_->stats(); }
 
 }  // namespace drivegate::daemon

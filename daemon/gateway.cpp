@@ -24,6 +24,7 @@ std::string_view severity_of(core::EventKind k) {
   switch (k) {
     case core::EventKind::Fault:
     case core::EventKind::ControlLost:
+    case core::EventKind::DuplicateGateway:
     case core::EventKind::CommandTimeout: return "error";
     case core::EventKind::Warning: return "warning";
     default: return "info";
@@ -65,6 +66,7 @@ void Gateway::start() {
   for (auto& b : buses_) {
     const auto now = core::SteadyClock{}.now();
     try {
+      if (const auto resource = bus_resource(*b.plan); !resource.empty()) b.lock = std::make_unique<BusLock>(resource);
       b.bus->open(now);
     } catch (const core::BusError& e) {
       throw core::BusError("bus '" + b.plan->name + "' (" + b.plan->type + "): " + e.what());
@@ -276,6 +278,7 @@ ShutdownReport Gateway::shutdown(core::Duration phase_budget) {
       b.bus->close();
       b.open = false;
     }
+    b.lock.reset();
   }
   return report;
 }

@@ -12,6 +12,7 @@
 #include "config/plan.hpp"
 #include "core/bus.hpp"
 #include "core/bus_runner.hpp"
+#include "daemon/bus_lock.hpp"
 #include "daemon/cycle_thread.hpp"
 #include "daemon/runtime.hpp"
 
@@ -30,7 +31,8 @@ class Gateway final : public Runtime {
   Gateway(const Gateway&) = delete;
   Gateway& operator=(const Gateway&) = delete;
 
-  // Opens every bus and starts its cycle thread. Throws core::BusError naming the bus.
+  // Takes each bus' interface lock (bus_lock.hpp), opens the bus and starts its cycle thread.
+  // Throws core::BusError naming the bus.
   void start();
   // Quick stop every enabled axis, then disable every axis, each phase bounded by `phase_budget`;
   // then stop the cycle threads and release the buses. New client commands are refused from the
@@ -60,6 +62,7 @@ class Gateway final : public Runtime {
   struct BusSlot {
     const config::BusPlan* plan = nullptr;
     std::vector<core::AxisSpec> specs;
+    std::unique_ptr<BusLock> lock;  // held while the bus is open
     std::unique_ptr<core::Bus> bus;
     std::unique_ptr<core::BusRunner> runner;
     std::unique_ptr<CycleThread> thread;

@@ -234,26 +234,52 @@ int run(const Args& args) {
   std::unique_ptr<daemon::Gateway> gateway;
   try {
     gateway = std::make_unique<daemon::Gateway>(plan);
-    gateway->start();
   } catch (const std::exception& e) {
     spdlog::critical("start-up failed: {}", e.what());
     notifier.status(std::string("start-up failed: ") + e.what());
     return 1;
   }
-  for (const auto& n : gateway->scheduling_notes()) spdlog::warn("{}", n);
 
+  // DDS first: before any bus is opened, make sure no other instance of this gateway runs on the
+  // domain (two masters commanding the same drives).
   daemon::DdsBridgeOptions dds;
   dds.domain = static_cast<std::uint32_t>(plan.gateway.domain);
   dds.ns = plan.gateway.ns;
   dds.status_rate_hz = plan.gateway.status_rate_hz;
+  dds.profiles_file = plan.gateway.dds_profiles_file;
+  dds.profile = plan.gateway.dds_profile;
+  dds.interfaces = plan.gateway.dds_interfaces;
+  if (const auto& sec = plan.gateway.security)
+    dds.security = msg::SecurityFiles{sec->identity_ca,    sec->certificate, sec->private_key,
+                                      sec->permissions_ca, sec->governance,  sec->permissions};
   daemon::DdsBridge bridge(*gateway, dds);
   try {
     bridge.start();
   } catch (const std::exception& e) {
     spdlog::critical("DDS start-up failed: {}", e.what());
+    notifier.status(std::string("DDS start-up failed: ") + e.what());
+    return 1;
+  }
+  if (const auto dup = bridge.wait_for_duplicate(
+          std::chrono::duration_cast<std::chrono::milliseconds>(plan.gateway.duplicate_check));
+      dup.seen) {
+    spdlog::critical("refusing to start: {}", dup.text);
+    notifier.status("refused to start: " + dup.text);
+    bridge.let_others_see_us(2s);
+    bridge.stop();
+    return 1;
+  }
+
+  try {
+    gateway->start();
+  } catch (const std::exception& e) {
+    spdlog::critical("start-up failed: {}", e.what());
+    notifier.status(std::string("start-up failed: ") + e.what());
+    bridge.stop();
     gateway->shutdown(2s);
     return 1;
   }
+  for (const auto& n : gateway->scheduling_notes()) spdlog::warn("{}", n);
 
   spdlog::info("gateway {} running: {} (DDS domain {}, namespace '{}')", plan.gateway.name, gateway->status_line(),
                plan.gateway.domain, plan.gateway.ns);
@@ -265,7 +291,12 @@ int run(const Args& args) {
   auto last_ping = last_status;
   bool was_healthy = true;
   int sig = 0;
+  bool duplicate = false;
   for (;;) {
+    if (bridge.duplicate().this_one_stops) {
+      duplicate = true;  // logged by the bridge; the later instance stops, the earlier goes on
+      break;
+    }
     sig = wait_signal(sigfd, 100ms);
     if (sig != 0) {
       const SignalAction action = action_of(sig);
@@ -295,7 +326,10 @@ int run(const Args& args) {
     }
   }
 
-  spdlog::info("{} received: stopping and disabling every axis", signal_name(sig));
+  if (duplicate)
+    spdlog::critical("another instance of gateway {} started first: stopping and disabling every axis", plan.gateway.name);
+  else
+    spdlog::info("{} received: stopping and disabling every axis", signal_name(sig));
   notifier.stopping();
   notifier.status("stopping: disabling axes");
   // A second stop signal skips the orderly stop only when it is meant as one: SIGQUIT, or any stop
@@ -321,7 +355,7 @@ int run(const Args& args) {
 
   const auto report = gateway->shutdown(3s);
   spdlog::info("{} axes quick-stopped, {} disabled", report.stopped, report.disabled);
-  int rc = 0;
+  int rc = duplicate ? 1 : 0;
   for (const auto& a : report.unconfirmed) {
     spdlog::error("axis {} did not confirm it is disabled", a);
     rc = 1;

@@ -1,5 +1,10 @@
 #include "idl/dds_node.hpp"
 
+#include <arpa/inet.h>
+#include <ifaddrs.h>
+#include <netinet/in.h>
+
+#include <algorithm>
 #include <memory>
 #include <stdexcept>
 
@@ -13,6 +18,7 @@
 #include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
 #include <fastdds/dds/topic/Topic.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
+#include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
 
 #include "drivegatePubSubTypes.h"
 
@@ -22,33 +28,51 @@ namespace dds = eprosima::fastdds::dds;
 
 namespace {
 
-struct TopicQos {
-  dds::ReliabilityQosPolicyKind reliability;
-  dds::DurabilityQosPolicyKind durability;
-  std::int32_t depth;  // keep-last depth (per instance for keyed topics)
-};
+// Per DESIGN.md §6. Commands and parameter requests, and their replies, are reliable, volatile and
+// keep-all: nothing is overwritten before it was acknowledged, a burst is flow-controlled instead
+// of dropped, and a gateway that starts late never acts on old commands. A reply written before the
+// gateway's writer knew a client's reader would be lost to volatile durability, so the gateway
+// holds a client's replies until its reader is matched (daemon/dds_bridge.cpp). State and
+// set-points are best effort, newest only; events transient-local so a late joiner sees recent
+// faults; gateway_info and bus_status transient-local so a CLI started now sees them at once.
+constexpr std::array<TopicQos, kTopicCount> kQos{{
+    {TopicId::AxisState, false, false, false, 1, "gateway, axis"},
+    {TopicId::AxisCommand, true, false, true, 1024, ""},
+    {TopicId::CommandReply, true, false, true, 4096, ""},
+    {TopicId::Setpoint, false, false, false, 1, "gateway, axis"},
+    {TopicId::AxisEvent, true, true, false, 100, ""},
+    {TopicId::BusStatus, true, true, false, 1, "gateway, bus"},
+    {TopicId::ParamRequest, true, false, true, 1024, ""},
+    {TopicId::ParamReply, true, false, true, 4096, ""},
+    {TopicId::GatewayInfo, true, true, false, 1, "gateway"},
+}};
 
-// Per DESIGN.md §6: commands and parameter requests reliable + volatile with a deep history so a
-// burst is not lost, and so that a gateway that starts late never acts on old commands. Their
-// replies are reliable + transient-local: a reply writer may match a client's reader only after it
-// wrote the reply (discovery is asymmetric: the client sees its reader matched before the gateway's
-// writer has matched it), and with volatile durability that reply would be lost; transient-local
-// hands the recent replies to the late match and the client picks its own by client name and id.
-// State and set-points are best effort, newest only; events transient-local so a late joiner sees
-// recent faults; gateway_info and bus_status transient-local so a CLI started now sees them at once.
-TopicQos qos_of(TopicId t) noexcept {
-  switch (t) {
-    case TopicId::AxisState: return {dds::BEST_EFFORT_RELIABILITY_QOS, dds::VOLATILE_DURABILITY_QOS, 1};
-    case TopicId::Setpoint: return {dds::BEST_EFFORT_RELIABILITY_QOS, dds::VOLATILE_DURABILITY_QOS, 1};
-    case TopicId::AxisCommand:
-    case TopicId::ParamRequest: return {dds::RELIABLE_RELIABILITY_QOS, dds::VOLATILE_DURABILITY_QOS, 64};
-    case TopicId::CommandReply:
-    case TopicId::ParamReply: return {dds::RELIABLE_RELIABILITY_QOS, dds::TRANSIENT_LOCAL_DURABILITY_QOS, 64};
-    case TopicId::AxisEvent: return {dds::RELIABLE_RELIABILITY_QOS, dds::TRANSIENT_LOCAL_DURABILITY_QOS, 100};
-    case TopicId::BusStatus: return {dds::RELIABLE_RELIABILITY_QOS, dds::TRANSIENT_LOCAL_DURABILITY_QOS, 1};
-    case TopicId::GatewayInfo: return {dds::RELIABLE_RELIABILITY_QOS, dds::TRANSIENT_LOCAL_DURABILITY_QOS, 1};
+template <typename Qos>
+void apply(const TopicQos& q, Qos& qos) {
+  qos.reliability().kind = q.reliable ? dds::RELIABLE_RELIABILITY_QOS : dds::BEST_EFFORT_RELIABILITY_QOS;
+  qos.durability().kind = q.transient_local ? dds::TRANSIENT_LOCAL_DURABILITY_QOS : dds::VOLATILE_DURABILITY_QOS;
+  if (q.keep_all) {
+    qos.history().kind = dds::KEEP_ALL_HISTORY_QOS;
+    // Unkeyed: one instance holds every sample. Memory grows with use, not up front.
+    qos.resource_limits().max_samples = q.depth;
+    qos.resource_limits().max_instances = 1;
+    qos.resource_limits().max_samples_per_instance = q.depth;
+    qos.resource_limits().allocated_samples = std::min<std::int32_t>(q.depth, 64);
+  } else {
+    qos.history().kind = dds::KEEP_LAST_HISTORY_QOS;
+    qos.history().depth = q.depth;
   }
-  return {dds::RELIABLE_RELIABILITY_QOS, dds::VOLATILE_DURABILITY_QOS, 64};
+}
+
+// Why a participant could not be made, with what to check: Fast DDS logs little for most of these.
+std::string participant_failure(const DdsOptions& o) {
+  std::string s = "cannot create the DDS participant on domain " + std::to_string(o.domain);
+  if (!o.profiles_file.empty()) s += " (check the Fast DDS profile in " + o.profiles_file + ")";
+  if (o.security)
+    s += "; with DDS Security on, check that the certificate is valid now (not expired) and signed by identity_ca, "
+         "that the permissions' subject names the certificate's subject exactly, and that governance and "
+         "permissions are signed by permissions_ca (scripts/make-pki.sh makes a consistent set)";
+  return s;
 }
 
 dds::TopicDataType* make_type(TopicId t) {
@@ -90,21 +114,88 @@ std::string topic_name(std::string_view ns, TopicId t) {
   return name;
 }
 
-DdsNode::DdsNode(std::uint32_t domain, std::string ns, const std::string& participant_name)
-    : ns_(std::move(ns)) {
+const std::array<TopicQos, kTopicCount>& qos_table() noexcept { return kQos; }
+
+const TopicQos& qos_of(TopicId t) noexcept { return kQos[static_cast<std::size_t>(t)]; }
+
+std::string reliability_text(const TopicQos& q) { return q.reliable ? "reliable" : "best effort"; }
+std::string durability_text(const TopicQos& q) { return q.transient_local ? "transient local" : "volatile"; }
+std::string history_text(const TopicQos& q) {
+  if (q.keep_all) return "keep all (up to " + std::to_string(q.depth) + ")";
+  return "keep last " + std::to_string(q.depth) + (q.key.empty() ? "" : " per instance");
+}
+
+std::vector<std::string> resolve_interfaces(const std::vector<std::string>& interfaces) {
+  std::vector<std::string> out;
+  ifaddrs* list = nullptr;
+  if (::getifaddrs(&list) != 0) throw std::runtime_error("cannot list network interfaces");
+  std::unique_ptr<ifaddrs, void (*)(ifaddrs*)> guard(list, ::freeifaddrs);
+  for (const auto& want : interfaces) {
+    in_addr literal{};
+    if (::inet_pton(AF_INET, want.c_str(), &literal) == 1) {
+      bool local = false;
+      for (const ifaddrs* a = list; a != nullptr; a = a->ifa_next)
+        local = local || (a->ifa_addr != nullptr && a->ifa_addr->sa_family == AF_INET &&
+                          reinterpret_cast<const sockaddr_in*>(a->ifa_addr)->sin_addr.s_addr == literal.s_addr);
+      if (!local) throw std::runtime_error("DDS interface " + want + " is not an address of this machine");
+      out.push_back(want);
+      continue;
+    }
+    bool named = false;
+    std::size_t found = 0;
+    for (const ifaddrs* a = list; a != nullptr; a = a->ifa_next) {
+      if (a->ifa_name == nullptr || want != a->ifa_name) continue;
+      named = true;
+      if (a->ifa_addr == nullptr || a->ifa_addr->sa_family != AF_INET) continue;
+      char text[INET_ADDRSTRLEN] = {};
+      ::inet_ntop(AF_INET, &reinterpret_cast<const sockaddr_in*>(a->ifa_addr)->sin_addr, text, sizeof text);
+      out.emplace_back(text);
+      ++found;
+    }
+    if (!named) throw std::runtime_error("DDS interface " + want + " does not exist on this machine");
+    if (found == 0) throw std::runtime_error("DDS interface " + want + " has no IPv4 address");
+  }
+  return out;
+}
+
+DdsNode::DdsNode(const DdsOptions& options) : ns_(options.ns) {
   // Standard domain ids for the default RTPS port mapping are 0..232.
-  if (domain > 232) throw std::runtime_error("DDS domain id " + std::to_string(domain) + " is out of range 0..232");
-  dds::DomainParticipantQos pqos = dds::PARTICIPANT_QOS_DEFAULT;
-  pqos.name(participant_name);
-  participant_ = dds::DomainParticipantFactory::get_instance()->create_participant(
-      static_cast<dds::DomainId_t>(domain), pqos);
-  if (participant_ == nullptr)
-    throw std::runtime_error("cannot create DDS participant on domain " + std::to_string(domain));
+  if (options.domain > 232)
+    throw std::runtime_error("DDS domain id " + std::to_string(options.domain) + " is out of range 0..232");
+  auto* factory = dds::DomainParticipantFactory::get_instance();
+  // The XML defaults (FASTDDS_DEFAULT_PROFILES_FILE, DEFAULT_FASTRTPS_PROFILES.xml) first, then the
+  // file given here; the participant starts from the resulting default QoS, never from the
+  // compiled-in PARTICIPANT_QOS_DEFAULT that would bypass them.
+  factory->load_profiles();
+  if (!options.profiles_file.empty() &&
+      factory->load_XML_profiles_file(options.profiles_file) != ReturnCode_t::RETCODE_OK)
+    throw std::runtime_error("cannot load the Fast DDS XML profiles in " + options.profiles_file);
+  dds::DomainParticipantQos pqos = factory->get_default_participant_qos();
+  if (!options.profile.empty() &&
+      factory->get_participant_qos_from_profile(options.profile, pqos) != ReturnCode_t::RETCODE_OK)
+    throw std::runtime_error("no participant profile named '" + options.profile + "'" +
+                             (options.profiles_file.empty() ? std::string{} : " in " + options.profiles_file));
+  if (!options.participant_name.empty()) pqos.name(options.participant_name);
+  if (!options.interfaces.empty()) {
+    auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
+    udp->interfaceWhiteList = resolve_interfaces(options.interfaces);
+    pqos.transport().use_builtin_transports = false;
+    pqos.transport().user_transports.clear();
+    pqos.transport().user_transports.push_back(udp);
+  }
+  if (options.security) {
+    if (const auto problem = check_security_files(*options.security); !problem.empty())
+      throw std::runtime_error(problem);
+    apply_security(pqos, *options.security);
+    secure_ = true;
+  }
+  participant_ = factory->create_participant(static_cast<dds::DomainId_t>(options.domain), pqos);
+  if (participant_ == nullptr) throw std::runtime_error(participant_failure(options));
   publisher_ = participant_->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
   subscriber_ = participant_->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
   if (publisher_ == nullptr || subscriber_ == nullptr) {
     participant_->delete_contained_entities();
-    dds::DomainParticipantFactory::get_instance()->delete_participant(participant_);
+    factory->delete_participant(participant_);
     throw std::runtime_error("cannot create DDS publisher/subscriber");
   }
 }
@@ -112,6 +203,14 @@ DdsNode::DdsNode(std::uint32_t domain, std::string ns, const std::string& partic
 DdsNode::~DdsNode() {
   participant_->delete_contained_entities();
   dds::DomainParticipantFactory::get_instance()->delete_participant(participant_);
+}
+
+std::string DdsNode::refusal(TopicId t, const char* what) const {
+  std::string s = std::string("cannot create DDS ") + what + " for " + topic_name(ns_, t);
+  if (secure_)
+    s += ": DDS access control refused it (this identity's permissions do not allow " +
+         std::string(what[0] == 'w' ? "publishing" : "subscribing to") + " " + std::string(topic_suffix(t)) + ")";
+  return s;
 }
 
 dds::Topic& DdsNode::topic(TopicId t) {
@@ -128,27 +227,23 @@ dds::Topic& DdsNode::topic(TopicId t) {
   return *slot;
 }
 
-dds::DataWriter& DdsNode::writer(TopicId t, dds::DataWriterListener* listener) {
-  const TopicQos q = qos_of(t);
+dds::DataWriter& DdsNode::writer(TopicId t, dds::DataWriterListener* listener, dds::StatusMask mask,
+                                 std::chrono::milliseconds max_blocking) {
   dds::DataWriterQos qos = dds::DATAWRITER_QOS_DEFAULT;
-  qos.reliability().kind = q.reliability;
-  qos.durability().kind = q.durability;
-  qos.history().kind = dds::KEEP_LAST_HISTORY_QOS;
-  qos.history().depth = q.depth;
-  auto* w = publisher_->create_datawriter(&topic(t), qos, listener);
-  if (w == nullptr) throw std::runtime_error("cannot create DDS writer for " + topic_name(ns_, t));
+  apply(qos_of(t), qos);
+  const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(max_blocking).count();
+  qos.reliability().max_blocking_time = eprosima::fastrtps::Duration_t(
+      static_cast<std::int32_t>(ns / 1'000'000'000), static_cast<std::uint32_t>(ns % 1'000'000'000));
+  auto* w = publisher_->create_datawriter(&topic(t), qos, listener, mask);
+  if (w == nullptr) throw std::runtime_error(refusal(t, "writer"));
   return *w;
 }
 
 dds::DataReader& DdsNode::reader(TopicId t, dds::DataReaderListener* listener, dds::StatusMask mask) {
-  const TopicQos q = qos_of(t);
   dds::DataReaderQos qos = dds::DATAREADER_QOS_DEFAULT;
-  qos.reliability().kind = q.reliability;
-  qos.durability().kind = q.durability;
-  qos.history().kind = dds::KEEP_LAST_HISTORY_QOS;
-  qos.history().depth = q.depth;
+  apply(qos_of(t), qos);
   auto* r = subscriber_->create_datareader(&topic(t), qos, listener, mask);
-  if (r == nullptr) throw std::runtime_error("cannot create DDS reader for " + topic_name(ns_, t));
+  if (r == nullptr) throw std::runtime_error(refusal(t, "reader"));
   return *r;
 }
 

@@ -114,7 +114,7 @@ void CanopenE2e::connect_client() {
   client_.reset();
   events_.clear();
   event_cursor_ = 0;
-  client_ = std::make_unique<client::Client>(client::ClientOptions{dds_.domain, dds_.ns, "e2e-client"});
+  client_ = std::make_unique<client::Client>(client::options_for(dds_.domain, dds_.ns, "e2e-client"));
 }
 
 void CanopenE2e::TearDown() {

@@ -46,7 +46,7 @@ TEST(DaemonIntegration, DemoAxesEndToEnd) {
   Gateway gw("itest", dds);
   ASSERT_TRUE(gw.notify.wait_for("READY=1", kDiscovery)) << gw.process.log();
 
-  client::Client c({dds.domain, dds.ns, "itest-client"});
+  client::Client c(client::options_for(dds.domain, dds.ns, "itest-client"));
   ASSERT_TRUE(c.wait_until([&] { return c.state("x") && c.state("spindle") && c.state("turntable"); }, kDiscovery))
       << gw.process.log();
   std::uint64_t cursor = 0;
@@ -120,7 +120,7 @@ TEST(DaemonIntegration, TwoGatewaysShareADomain) {
   ASSERT_TRUE(a.notify.wait_for("READY=1", kDiscovery)) << a.process.log();
   ASSERT_TRUE(b.notify.wait_for("READY=1", kDiscovery)) << b.process.log();
 
-  client::Client c({dds.domain, dds.ns, "pair-client"});
+  client::Client c(client::options_for(dds.domain, dds.ns, "pair-client"));
   ASSERT_TRUE(c.wait_until([&] { return c.gateways().size() == 2; }, kDiscovery));
   for (const auto& g : c.gateways()) EXPECT_FALSE(g.axes.empty()) << g.name;
   ASSERT_TRUE(c.wait_until([&] { return c.state("x", "cell_a") && c.state("x", "cell_b"); }, kDiscovery));

@@ -32,11 +32,13 @@ DdsIsolation unique_dds(const std::string& tag) {
   return {20 + static_cast<std::uint32_t>(getpid()) % 80, "t" + std::to_string(getpid()) + "_" + tag};
 }
 
-std::string write_demo_config(const std::string& gateway, const DdsIsolation& dds) {
+std::string write_demo_config(const std::string& gateway, const DdsIsolation& dds,
+                              const std::function<void(YAML::Node&)>& edit) {
   YAML::Node root = YAML::LoadFile(DRIVEGATE_DEMO_CONFIG);
   root["gateway"]["name"] = gateway;
   root["gateway"]["dds"]["domain"] = dds.domain;
   root["gateway"]["dds"]["namespace"] = dds.ns;
+  if (edit) edit(root);
   const std::string path = temp_path(gateway + ".yaml");
   std::ofstream out(path);
   out << root << "\n";
@@ -127,6 +129,11 @@ DaemonProcess::~DaemonProcess() {
 std::optional<int> DaemonProcess::terminate(int signal, std::chrono::milliseconds timeout) {
   if (pid_ <= 0) return std::nullopt;
   kill(pid_, signal);
+  return wait_exit(timeout);
+}
+
+std::optional<int> DaemonProcess::wait_exit(std::chrono::milliseconds timeout) {
+  if (pid_ <= 0) return std::nullopt;
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   int status = 0;
   while (std::chrono::steady_clock::now() < deadline) {

@@ -4,9 +4,11 @@
 // listens on, and the daemon's log in a file. The process is killed when the object goes, and
 // when the test process dies first (PR_SET_PDEATHSIG), so a crashed test leaves no daemon behind.
 #include <sys/types.h>
+#include <yaml-cpp/yaml.h>
 
 #include <chrono>
 #include <condition_variable>
+#include <functional>
 #include <mutex>
 #include <optional>
 #include <thread>
@@ -22,8 +24,10 @@ struct DdsIsolation {
 };
 DdsIsolation unique_dds(const std::string& tag);
 
-// The demo configuration with gateway name, domain and namespace replaced; returns the file path.
-std::string write_demo_config(const std::string& gateway, const DdsIsolation& dds);
+// The demo configuration with gateway name, domain and namespace replaced, then `edit`ed; returns
+// the file path.
+std::string write_demo_config(const std::string& gateway, const DdsIsolation& dds,
+                              const std::function<void(YAML::Node&)>& edit = {});
 
 // A configuration given as text, in a file of this test process; returns the file path.
 std::string write_config_text(const std::string& stem, const std::string& yaml);
@@ -58,6 +62,8 @@ class DaemonProcess {
   std::optional<int> terminate(int signal, std::chrono::milliseconds timeout);
   // Whether the daemon is still running (a daemon that ended is reaped here).
   bool running();
+  // Waits for the daemon to exit by itself; its exit status (or nullopt on timeout).
+  std::optional<int> wait_exit(std::chrono::milliseconds timeout);
   [[nodiscard]] std::string log() const;
   // Resident set size in KiB from /proc, 0 if unknown.
   [[nodiscard]] long rss_kib() const;

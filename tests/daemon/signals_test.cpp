@@ -33,7 +33,7 @@ class Signals : public ::testing::Test {
     config_ = test::write_demo_config("sig_" + tag, dds_);
     process_ = std::make_unique<test::DaemonProcess>(config_, notify_.path());
     ASSERT_TRUE(notify_.wait_for("READY=1", kDiscovery)) << process_->log();
-    client_ = std::make_unique<client::Client>(client::ClientOptions{dds_.domain, dds_.ns, "sig-client"});
+    client_ = std::make_unique<client::Client>(client::options_for(dds_.domain, dds_.ns, "sig-client"));
     ASSERT_TRUE(client_->wait_until([&] {
       const auto akd = client_->state("akd");
       return client_->state("x") && akd && akd->link == "operational";

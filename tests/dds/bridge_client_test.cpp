@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <optional>
+#include <set>
 #include <string>
 
 #include <fastdds/dds/core/status/PublicationMatchedStatus.hpp>
@@ -44,7 +45,11 @@ std::string test_namespace() {
 }
 
 daemon::DdsBridgeOptions bridge_options(double rate = 20) {
-  return {test_domain(), test_namespace(), rate};
+  daemon::DdsBridgeOptions o;
+  o.domain = test_domain();
+  o.ns = test_namespace();
+  o.status_rate_hz = rate;
+  return o;
 }
 
 client::ClientOptions client_options() {
@@ -54,11 +59,19 @@ client::ClientOptions client_options() {
   return o;
 }
 
+msg::DdsOptions raw_options() {
+  msg::DdsOptions o;
+  o.domain = test_domain();
+  o.ns = test_namespace();
+  o.participant_name = "raw-peer";
+  return o;
+}
+
 // Talks to the bridge on the raw topics, so tests can send what the Client library would refuse.
 class RawPeer {
  public:
   RawPeer()
-      : node_(test_domain(), test_namespace(), "raw-peer"),
+      : node_(raw_options()),
         cmd_w_(node_.writer(msg::TopicId::AxisCommand)),
         reply_r_(node_.reader(msg::TopicId::CommandReply)) {}
 
@@ -214,7 +227,7 @@ TEST(DdsBridge, UnknownKindModeAndBusyAreRejected) {
   r = peer.reply(3);
   ASSERT_TRUE(r.has_value());
   EXPECT_EQ(r->status(), "rejected");
-  EXPECT_NE(r->reason().find("gateway busy"), std::string::npos) << r->reason();
+  EXPECT_NE(r->reason().find("busy: the gateway's command queue for axis 'x' stayed full"), std::string::npos) << r->reason();
   EXPECT_TRUE(rt.commands().empty());
 }
 
@@ -275,6 +288,32 @@ TEST(DdsBridge, TwoGatewaysAreListedAndCommandsReachOnlyTheOwner) {
   EXPECT_EQ(w->gateway, "gwB");
   EXPECT_DOUBLE_EQ(w->position, 11.5);
   EXPECT_EQ(w->state, "switch_on_disabled");
+}
+
+// The shared axis is neither gateway's first: every axis of the other gateway is looked at.
+TEST(DdsBridge, DuplicateAxisWarningWhenTheSharedAxisIsNotFirstInEitherList) {
+  FakeRuntime rt_a("gwA", {"y", "x"});
+  FakeRuntime rt_b("gwB", {"z", "w", "x"});
+  daemon::DdsBridge a(rt_a, bridge_options());
+  daemon::DdsBridge b(rt_b, bridge_options());
+  a.start();
+  b.start();
+  Client c(client_options());
+  std::uint64_t cursor = 0;
+  std::vector<client::AxisEvent> warnings;
+  ASSERT_TRUE(c.wait_until(
+      [&] {
+        for (auto& e : c.events_since(cursor))
+          if (e.kind == "warning") warnings.push_back(e);
+        return warnings.size() >= 2;
+      },
+      kTimeout)) << warnings.size();
+  std::set<std::string> from;
+  for (const auto& e : warnings) {
+    EXPECT_EQ(e.axis, "x") << e.text;
+    from.insert(e.gateway);
+  }
+  EXPECT_EQ(from, (std::set<std::string>{"gwA", "gwB"}));
 }
 
 TEST(DdsBridge, DuplicateAxisNameAcrossGatewaysRaisesAWarningEvent) {

@@ -40,13 +40,21 @@ CtlRun run_tool(const char* tool, const std::string& args) {
   return r;
 }
 
+daemon::DdsBridgeOptions bridge_options() {
+  daemon::DdsBridgeOptions o;
+  o.domain = test_domain();
+  o.ns = test_namespace();
+  o.status_rate_hz = 20;
+  return o;
+}
+
 CtlRun ctl(const std::string& args) { return run_tool(DRIVEGATECTL_PATH, args); }
 
 class Drivegatectl : public ::testing::Test {
  protected:
   void SetUp() override { bridge_.start(); }
   FakeRuntime rt_{"gw1", {"x", "y"}};
-  daemon::DdsBridge bridge_{rt_, {test_domain(), test_namespace(), 20}};
+  daemon::DdsBridge bridge_{rt_, bridge_options()};
 };
 
 TEST_F(Drivegatectl, MoveCompletesWithJsonResult) {
@@ -70,7 +78,7 @@ TEST_F(Drivegatectl, RejectedCommandExitsNonZeroWithTheReason) {
   rt_.set_busy(true);
   const CtlRun r = ctl("reset y");
   EXPECT_EQ(r.status, 1) << r.output;
-  EXPECT_NE(r.output.find("gateway busy"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("busy: the gateway's command queue"), std::string::npos) << r.output;
 }
 
 TEST_F(Drivegatectl, ListStatusAndParam) {
@@ -123,7 +131,7 @@ TEST_F(Drivegatectl, VelocityStreamsKeepAliveThenStops) {
 
 TEST(DrivegateDemo, RunsTheWholeSequenceAndLeavesAxesDisabled) {
   FakeRuntime rt("demo", {"x", "y", "spindle", "turntable"});
-  daemon::DdsBridge bridge(rt, {test_domain(), test_namespace(), 20});
+  daemon::DdsBridge bridge(rt, bridge_options());
   bridge.start();
   const CtlRun r = run_tool(DRIVEGATE_DEMO_PATH, "--plain --jog-seconds 0.3");
   EXPECT_EQ(r.status, 0) << r.output;
