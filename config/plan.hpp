@@ -36,7 +36,7 @@ struct GatewayPlan {
   std::vector<std::string> dds_interfaces;  // UDPv4 on these only (names or IPv4 addresses)
   std::optional<SecurityPlan> security;
   // At start-up, how long to listen for another instance of this gateway before any bus opens.
-  core::Duration duplicate_check = std::chrono::seconds(1);
+  core::Duration duplicate_check = std::chrono::seconds(2);
   std::string log_level = "info";
   double status_rate_hz = 50;
   std::vector<std::string> device_dirs;  // from the file, made absolute

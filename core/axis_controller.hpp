@@ -24,9 +24,10 @@ class ControllerSink {
 
 struct Admission {
   bool accepted = true;
-  Text reason;  // why not, in words a person can act on
+  Text reason;        // why not, in words a person can act on
+  bool busy = false;  // refused only for now (no free slot): the caller may offer it again later
   static Admission accept() noexcept { return {}; }
-  static Admission reject(std::string_view why) noexcept { return {false, Text(why)}; }
+  static Admission reject(std::string_view why) noexcept { return {false, Text(why), false}; }
 };
 
 class AxisController {

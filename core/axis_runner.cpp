@@ -152,10 +152,11 @@ void AxisRunner::setpoint(const Setpoint& sp, TimePoint now, RunnerOutput& out) 
   last_activity_ = now;
 }
 
-void AxisRunner::parameter(const ParamRequest& req, TimePoint now, RunnerOutput& out) noexcept {
+bool AxisRunner::parameter(const ParamRequest& req, TimePoint now, RunnerOutput& out) noexcept {
   out_ = &out;
   now_ = now;
   const Admission adm = controller_.parameter(req, now);
+  if (!adm.accepted && adm.busy) return false;
   if (!adm.accepted) {
     ParamReply r;
     r.id = req.id;
@@ -164,6 +165,7 @@ void AxisRunner::parameter(const ParamRequest& req, TimePoint now, RunnerOutput&
     r.error = adm.reason;
     out.parameter_reply(r);
   }
+  return true;
 }
 
 void AxisRunner::observe_link(TimePoint now, LinkState link, std::string_view detail, RunnerOutput& out) noexcept {

@@ -28,7 +28,8 @@ class AxisRunner final : private ControllerSink {
 
   void command(const Command& cmd, TimePoint now, RunnerOutput& out) noexcept;
   void setpoint(const Setpoint& sp, TimePoint now, RunnerOutput& out) noexcept;
-  void parameter(const ParamRequest& req, TimePoint now, RunnerOutput& out) noexcept;
+  // False when the controller has no room for it now (nothing was replied): offer it again later.
+  bool parameter(const ParamRequest& req, TimePoint now, RunnerOutput& out) noexcept;
 
   // Start of a cycle, right after the bus delivered inputs: takes note of the link state, so
   // commands handled in this cycle see it.

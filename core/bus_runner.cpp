@@ -8,6 +8,16 @@ BusRunner::BusRunner(Bus& bus, const std::vector<AxisSpec>& specs)
   axes_.reserve(specs.size());
   for (std::size_t i = 0; i < specs.size(); ++i)
     axes_.emplace_back(static_cast<AxisIndex>(i), specs[i], bus.controller(i));
+  reply_headroom_ = 4 * axes_.size() + 16;
+  if (reply_headroom_ >= replies_.capacity() / 2) throw BusError("bus runner: too many axes on one bus for its reply queue");
+}
+
+bool BusRunner::room_for_command() const noexcept {
+  return replies_.capacity() - replies_.size_approx() >= reply_headroom_;
+}
+
+bool BusRunner::room_for_parameter() const noexcept {
+  return params_in_flight_ + param_replies_.size_approx() < param_replies_.capacity();
 }
 
 void BusRunner::cycle(TimePoint now) noexcept {
@@ -15,14 +25,23 @@ void BusRunner::cycle(TimePoint now) noexcept {
   for (std::size_t i = 0; i < axes_.size(); ++i) axes_[i].observe_link(now, bus_.link_state(i), bus_.link_detail(i), *this);
 
   Command cmd;
-  for (std::size_t n = 0; n < kMaxCommandsPerCycle && commands_.pop(cmd); ++n)
+  for (std::size_t n = 0; n < kMaxCommandsPerCycle && room_for_command() && commands_.pop(cmd); ++n)
     if (cmd.axis < axes_.size()) axes_[cmd.axis].command(cmd, now, *this);
   Setpoint sp;
   for (std::size_t n = 0; n < kMaxSetpointsPerCycle && setpoints_.pop(sp); ++n)
     if (sp.axis < axes_.size()) axes_[sp.axis].setpoint(sp, now, *this);
-  ParamRequest pr;
-  for (std::size_t n = 0; n < kMaxParamsPerCycle && params_.pop(pr); ++n)
-    if (pr.axis < axes_.size()) axes_[pr.axis].parameter(pr, now, *this);
+  for (std::size_t n = 0; n < kMaxParamsPerCycle && room_for_parameter(); ++n) {
+    if (!param_held_ && !params_.pop(held_param_)) break;
+    param_held_ = false;
+    if (held_param_.axis >= axes_.size()) continue;
+    ++params_in_flight_;
+    if (!axes_[held_param_.axis].parameter(held_param_, now, *this)) {
+      // Its axis has every request slot in use: it goes first again next cycle, in order.
+      --params_in_flight_;
+      param_held_ = true;
+      break;
+    }
+  }
 
   for (std::size_t i = 0; i < axes_.size(); ++i) {
     axes_[i].update(now, *this);
@@ -38,6 +57,7 @@ void BusRunner::event(const Event& e) noexcept {
   if (!events_.push(e)) dropped_.fetch_add(1, std::memory_order_relaxed);
 }
 void BusRunner::parameter_reply(const ParamReply& r) noexcept {
+  if (params_in_flight_ > 0) --params_in_flight_;
   if (!param_replies_.push(r)) dropped_.fetch_add(1, std::memory_order_relaxed);
 }
 

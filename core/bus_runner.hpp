@@ -49,6 +49,13 @@ class BusRunner final : private RunnerOutput {
   static constexpr std::size_t kMaxCommandsPerCycle = 16;
   static constexpr std::size_t kMaxSetpointsPerCycle = 256;
   static constexpr std::size_t kMaxParamsPerCycle = 8;
+  // Flow control towards the control plane: a command is taken only while the reply queue has room
+  // for this many more replies (a command, the one it supersedes and every axis' completions of
+  // one cycle); a parameter request only while every request in flight has room for its reply.
+  // What is not taken waits in the inbound queue, and the control plane in front of it waits too:
+  // no reply is ever dropped for want of room.
+  [[nodiscard]] bool room_for_command() const noexcept;
+  [[nodiscard]] bool room_for_parameter() const noexcept;
 
   Bus& bus_;
   std::vector<AxisRunner> axes_;
@@ -57,10 +64,14 @@ class BusRunner final : private RunnerOutput {
   SpscQueue<Command, 64> commands_;
   SpscQueue<Setpoint, 256> setpoints_;
   SpscQueue<ParamRequest, 32> params_;
-  SpscQueue<Reply, 256> replies_;
+  SpscQueue<Reply, 1024> replies_;
   SpscQueue<Event, 256> events_;
-  SpscQueue<ParamReply, 32> param_replies_;
+  SpscQueue<ParamReply, 256> param_replies_;
   std::atomic<std::uint64_t> dropped_{0};
+  std::size_t reply_headroom_ = 0;
+  std::size_t params_in_flight_ = 0;  // taken, reply not yet queued
+  ParamRequest held_param_{};         // refused for now by its axis (no free slot): offered again first
+  bool param_held_ = false;
 };
 
 }  // namespace drivegate::core

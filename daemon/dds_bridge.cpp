@@ -53,9 +53,9 @@ constexpr auto kReplyHold = 1500ms;
 // written make the bridge stop taking requests until they are out.
 constexpr std::size_t kTakePerPass = 256;
 constexpr std::size_t kMaxReplyBacklog = 2048;
-// How long a reply write may block while every matched reader's history is full (keep-all flow
-// control); after that the reply waits in the bridge and is retried.
-constexpr std::chrono::milliseconds kWriteBlock{20};
+// A client with this many requests still unanswered gets "busy" for more: its replies then always
+// fit the reply topics' history per client (idl/dds_node.cpp), read or not.
+constexpr int kClientLimit = 256;
 // A summary of the traffic instead of a log line per command.
 constexpr auto kSummaryPeriod = 10s;
 
@@ -187,6 +187,11 @@ class DdsBridge::Impl : private dds::DataWriterListener {
   void publish_gateway_info();
   void publish_gateway_event(core::EventKind kind, const std::string& text);
   void log_summary(Clock::time_point now);
+  // A request of `client` was answered for good (bookkeeping of kClientLimit).
+  void answered(const std::string& client);
+  // Instances of clients whose reply readers went away are unregistered (the history per client
+  // would otherwise grow with every client that ever connected).
+  void forget_gone_clients();
   [[nodiscard]] bool busy() const noexcept {
     return !deferred_commands_.empty() || !deferred_params_.empty() ||
            replies_.size() + param_replies_.size() >= kMaxReplyBacklog;
@@ -252,6 +257,11 @@ class DdsBridge::Impl : private dds::DataWriterListener {
   mutable std::mutex match_mutex_;
   std::map<Prefix, int> reply_readers_;
   std::map<Prefix, int> param_reply_readers_;
+  std::vector<std::pair<Prefix, bool>> gone_;  // (participant, param writer) whose last reader left
+
+  // Bridge thread: requests per client without a final reply, and the clients of each participant.
+  std::map<std::string, int> unanswered_;
+  std::map<Prefix, std::set<std::string>> clients_of_;
 
   mutable std::mutex dup_mutex_;
   mutable std::condition_variable dup_cv_;
@@ -276,10 +286,10 @@ void DdsBridge::Impl::start() {
   o.security = opt_.security;
   node_ = std::make_unique<msg::DdsNode>(o);
   state_w_ = &node_->writer(msg::TopicId::AxisState);
-  reply_w_ = &node_->writer(msg::TopicId::CommandReply, this, dds::StatusMask::publication_matched(), kWriteBlock);
+  reply_w_ = &node_->writer(msg::TopicId::CommandReply, this, dds::StatusMask::publication_matched());
   event_w_ = &node_->writer(msg::TopicId::AxisEvent);
   bus_w_ = &node_->writer(msg::TopicId::BusStatus);
-  param_w_ = &node_->writer(msg::TopicId::ParamReply, this, dds::StatusMask::publication_matched(), kWriteBlock);
+  param_w_ = &node_->writer(msg::TopicId::ParamReply, this, dds::StatusMask::publication_matched());
   info_w_ = &node_->writer(msg::TopicId::GatewayInfo);
   cmd_r_ = &node_->reader(msg::TopicId::AxisCommand);
   sp_r_ = &node_->reader(msg::TopicId::Setpoint);
@@ -319,7 +329,10 @@ void DdsBridge::Impl::on_publication_matched(dds::DataWriter* writer, const dds:
     ++readers[p];
   } else if (info.current_count_change < 0) {
     const auto it = readers.find(p);
-    if (it != readers.end() && --it->second <= 0) readers.erase(it);
+    if (it != readers.end() && --it->second <= 0) {
+      readers.erase(it);
+      gone_.emplace_back(p, writer == param_w_);
+    }
   }
 }
 
@@ -354,6 +367,7 @@ void DdsBridge::Impl::run() {
     take_gateway_infos();
     collect_outbox(t);
     write_replies(t);
+    forget_gone_clients();
     if (t >= next_state) {
       publish_states();
       next_state += state_period;
@@ -452,6 +466,13 @@ void DdsBridge::Impl::handle_command(const msg::AxisCommand& in, const Prefix& f
   cmd.homing_search_velocity = in.homing_search_velocity();
   cmd.homing_zero_velocity = in.homing_zero_velocity();
   cmd.block = in.block();
+  if (unanswered_[in.client()] >= kClientLimit)
+    return reject(in, from,
+                  "busy: client '" + in.client() + "' has " + std::to_string(kClientLimit) +
+                      " requests without a final reply; wait for replies before sending more",
+                  now);
+  ++unanswered_[in.client()];
+  clients_of_[from].insert(in.client());
   Pending p{in.client(), in.id(), in.axis(), from, 0, 0};
   spdlog::debug("dds: {} for axis '{}' from '{}' id {} -> command {}", in.kind(), in.axis(), in.client(), in.id(),
                 cmd.id);
@@ -480,6 +501,7 @@ void DdsBridge::Impl::retry_deferred(Clock::time_point now) {
                  std::to_string(std::chrono::duration_cast<std::chrono::milliseconds>(kBusyAfter).count()) +
                  " ms; send it again");
       replies_.push_back({std::move(out), d.pending.prefix, now});
+      answered(d.pending.client);
       ++summary_rejected_;
       count([](Stats& s) { ++s.commands_busy; });
     } else {
@@ -503,6 +525,7 @@ void DdsBridge::Impl::retry_deferred(Clock::time_point now) {
       out.index(d.pending.index);
       out.subindex(d.pending.sub);
       param_replies_.push_back({std::move(out), d.pending.prefix, now});
+      answered(d.pending.client);
       count([](Stats& s) { ++s.commands_busy; });
     } else {
       break;
@@ -585,6 +608,13 @@ void DdsBridge::Impl::handle_param(const msg::ParamRequest& in, const Prefix& fr
   }
   if (req.size != 1 && req.size != 2 && req.size != 4)
     return fail_param(in, from, "parameter size must be 1, 2 or 4 bytes, got " + std::to_string(req.size), now);
+  if (unanswered_[in.client()] >= kClientLimit)
+    return fail_param(in, from,
+                      "busy: client '" + in.client() + "' has " + std::to_string(kClientLimit) +
+                          " requests without a final reply; wait for replies before sending more",
+                      now);
+  ++unanswered_[in.client()];
+  clients_of_[from].insert(in.client());
   Pending p{in.client(), in.id(), in.axis(), from, req.index, req.sub};
   spdlog::debug("dds: parameter {} {:04X}:{} for axis '{}' from '{}' id {} -> request {}",
                 in.write() ? "write" : "read", req.index, req.sub, in.axis(), in.client(), in.id(), req.id);
@@ -666,7 +696,10 @@ void DdsBridge::Impl::collect_outbox(Clock::time_point now) {
     spdlog::debug("dds: command {} ('{}' id {} on '{}'): {}{}{}", r.reply.id, out.client(), out.id(), out.axis(),
                   out.status(), out.reason().empty() ? "" : ": ", out.reason());
     replies_.push_back({std::move(out), it->second.prefix, now});
-    if (r.reply.status != core::ReplyStatus::Accepted) pending_commands_.erase(it);
+    if (r.reply.status != core::ReplyStatus::Accepted) {
+      answered(it->second.client);
+      pending_commands_.erase(it);
+    }
   }
 
   for (const auto& e : outbox_.events) {
@@ -703,13 +736,13 @@ void DdsBridge::Impl::collect_outbox(Clock::time_point now) {
     spdlog::debug("dds: parameter request {} ('{}' id {}): {}", p.reply.id, out.client(), out.id(),
                   out.ok() ? "ok" : "error: " + out.error());
     param_replies_.push_back({std::move(out), it->second.prefix, now});
+    answered(it->second.client);
     pending_params_.erase(it);
   }
 }
 
 // Replies go out in order per client once that client's reply reader is matched (or after the hold
-// time). A write that cannot go out because the readers' histories are full (flow control) is
-// retried on the next pass, with everything after it.
+// time).
 void DdsBridge::Impl::write_replies(Clock::time_point now) {
   const auto flush = [&](auto& queue, dds::DataWriter* writer, bool param) {
     std::set<Prefix> blocked;  // clients whose earlier reply is still waiting: keep their order
@@ -724,9 +757,7 @@ void DdsBridge::Impl::write_replies(Clock::time_point now) {
         ++it;
         continue;
       }
-      const ReturnCode_t rc = writer->write(&it->sample, dds::HANDLE_NIL);
-      if (rc == ReturnCode_t::RETCODE_TIMEOUT) return;  // every history full: try again next pass
-      if (rc != ReturnCode_t::RETCODE_OK) spdlog::error("dds: a reply could not be written (error {})", rc());
+      if (!writer->write(&it->sample)) spdlog::error("dds: a reply to '{}' could not be written", it->sample.client());
       count([&](Stats& s) {
         ++s.replies_written;
         if (!matched) ++s.replies_unmatched;
@@ -736,6 +767,39 @@ void DdsBridge::Impl::write_replies(Clock::time_point now) {
   };
   flush(replies_, reply_w_, false);
   flush(param_replies_, param_w_, true);
+}
+
+void DdsBridge::Impl::answered(const std::string& client) {
+  const auto it = unanswered_.find(client);
+  if (it != unanswered_.end() && --it->second <= 0) unanswered_.erase(it);
+}
+
+void DdsBridge::Impl::forget_gone_clients() {
+  std::vector<std::pair<Prefix, bool>> gone;
+  {
+    std::lock_guard lock(match_mutex_);
+    gone.swap(gone_);
+  }
+  for (const auto& [prefix, param] : gone) {
+    const auto it = clients_of_.find(prefix);
+    if (it == clients_of_.end()) continue;
+    for (const auto& name : it->second) {
+      if (param) {
+        msg::ParamReply key;
+        key.gateway(gateway_);
+        key.client(name);
+        param_w_->unregister_instance(&key, dds::HANDLE_NIL);
+      } else {
+        msg::CommandReply key;
+        key.gateway(gateway_);
+        key.client(name);
+        reply_w_->unregister_instance(&key, dds::HANDLE_NIL);
+      }
+    }
+    // Both reply readers gone: the participant is done with this gateway.
+    std::lock_guard lock(match_mutex_);
+    if (reply_readers_.count(prefix) == 0 && param_reply_readers_.count(prefix) == 0) clients_of_.erase(it);
+  }
 }
 
 void DdsBridge::Impl::log_summary(Clock::time_point now) {

@@ -28,24 +28,30 @@ namespace dds = eprosima::fastdds::dds;
 
 namespace {
 
-// Per DESIGN.md §6. Commands and parameter requests, and their replies, are reliable, volatile and
-// keep-all: nothing is overwritten before it was acknowledged, a burst is flow-controlled instead
-// of dropped, and a gateway that starts late never acts on old commands. A reply written before the
-// gateway's writer knew a client's reader would be lost to volatile durability, so the gateway
-// holds a client's replies until its reader is matched (daemon/dds_bridge.cpp). State and
+// Per DESIGN.md §6. Commands and parameter requests are reliable, volatile and keep-all: nothing
+// is overwritten before the gateway acknowledged it, a burst is flow-controlled instead of
+// dropped, and a gateway that starts late never acts on old commands. Their replies are reliable
+// and volatile, keyed by client with a deep history per client: one client that stops reading
+// cannot hold up the replies to every other (which a shared keep-all history would), and the
+// gateway keeps each client's unanswered requests well below that depth (daemon/dds_bridge.cpp).
+// A reply written before the gateway's writer knew a client's reader would be lost to volatile
+// durability, so the gateway holds a client's replies until its reader is matched. State and
 // set-points are best effort, newest only; events transient-local so a late joiner sees recent
 // faults; gateway_info and bus_status transient-local so a CLI started now sees them at once.
 constexpr std::array<TopicQos, kTopicCount> kQos{{
     {TopicId::AxisState, false, false, false, 1, "gateway, axis"},
     {TopicId::AxisCommand, true, false, true, 1024, ""},
-    {TopicId::CommandReply, true, false, true, 4096, ""},
+    {TopicId::CommandReply, true, false, false, 1024, "gateway, client"},
     {TopicId::Setpoint, false, false, false, 1, "gateway, axis"},
     {TopicId::AxisEvent, true, true, false, 100, ""},
     {TopicId::BusStatus, true, true, false, 1, "gateway, bus"},
     {TopicId::ParamRequest, true, false, true, 1024, ""},
-    {TopicId::ParamReply, true, false, true, 4096, ""},
+    {TopicId::ParamReply, true, false, false, 1024, "gateway, client"},
     {TopicId::GatewayInfo, true, true, false, 1, "gateway"},
 }};
+
+// Clients (reply instances) a gateway keeps apart at once; memory grows with use, not up front.
+constexpr std::int32_t kMaxInstances = 1000;
 
 template <typename Qos>
 void apply(const TopicQos& q, Qos& qos) {
@@ -61,6 +67,14 @@ void apply(const TopicQos& q, Qos& qos) {
   } else {
     qos.history().kind = dds::KEEP_LAST_HISTORY_QOS;
     qos.history().depth = q.depth;
+    if (q.depth > 1) {
+      // Instances come and go with clients (the gateway unregisters a client's when it leaves);
+      // Fast DDS's default limits (10 instances, 400 samples each) would refuse the eleventh.
+      qos.resource_limits().max_instances = kMaxInstances;
+      qos.resource_limits().max_samples_per_instance = q.depth;
+      qos.resource_limits().max_samples = kMaxInstances * q.depth;
+      qos.resource_limits().allocated_samples = std::min<std::int32_t>(q.depth, 64);
+    }
   }
 }
 
@@ -176,6 +190,12 @@ DdsNode::DdsNode(const DdsOptions& options) : ns_(options.ns) {
     throw std::runtime_error("no participant profile named '" + options.profile + "'" +
                              (options.profiles_file.empty() ? std::string{} : " in " + options.profiles_file));
   if (!options.participant_name.empty()) pqos.name(options.participant_name);
+  // Participant announcements every second instead of every 3 s (unless a profile chose): a
+  // participant that joins learns of the others sooner, which a CLI call and the gateway's
+  // start-up check for another instance of itself both wait for.
+  auto& discovery = pqos.wire_protocol().builtin.discovery_config;
+  if (discovery.leaseDuration_announcementperiod == eprosima::fastrtps::Duration_t(3, 0))
+    discovery.leaseDuration_announcementperiod = eprosima::fastrtps::Duration_t(1, 0);
   if (!options.interfaces.empty()) {
     auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
     udp->interfaceWhiteList = resolve_interfaces(options.interfaces);
@@ -234,6 +254,10 @@ dds::DataWriter& DdsNode::writer(TopicId t, dds::DataWriterListener* listener, d
   const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(max_blocking).count();
   qos.reliability().max_blocking_time = eprosima::fastrtps::Duration_t(
       static_cast<std::int32_t>(ns / 1'000'000'000), static_cast<std::uint32_t>(ns % 1'000'000'000));
+  // Heartbeats every 100 ms instead of Fast DDS's 3 s: readers acknowledge (and ask for what got
+  // lost in a burst) while the samples are still in the history, which for the keep-last reply
+  // topics is what makes a burst lossless (RTPS heartbeat period; not visible to other vendors).
+  qos.reliable_writer_qos().times.heartbeatPeriod = eprosima::fastrtps::Duration_t(0, 100'000'000);
   auto* w = publisher_->create_datawriter(&topic(t), qos, listener, mask);
   if (w == nullptr) throw std::runtime_error(refusal(t, "writer"));
   return *w;

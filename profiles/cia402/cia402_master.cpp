@@ -323,6 +323,7 @@ Admission Cia402Master::parameter(const core::ParamRequest& req, core::TimePoint
     return Admission::accept();
   }
   no.reason.format("%zu parameter requests already in flight for this axis: try again later", params_.size());
+  no.busy = true;
   return no;
 }
 

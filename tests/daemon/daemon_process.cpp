@@ -99,7 +99,7 @@ bool NotifySocket::wait_for(const std::string& what, std::chrono::milliseconds t
   });
 }
 
-DaemonProcess::DaemonProcess(const std::string& config, const std::string& notify_socket)
+DaemonProcess::DaemonProcess(const std::string& config, const std::string& notify_socket, const std::string& log_level)
     : log_path_(config + ".log") {
   const pid_t parent = getpid();
   pid_ = fork();
@@ -113,7 +113,7 @@ DaemonProcess::DaemonProcess(const std::string& config, const std::string& notif
     dup2(fd, STDOUT_FILENO);
     dup2(fd, STDERR_FILENO);
     setenv("NOTIFY_SOCKET", notify_socket.c_str(), 1);
-    execl(DRIVEGATED_PATH, DRIVEGATED_PATH, "--config", config.c_str(), "--log-level", "debug",
+    execl(DRIVEGATED_PATH, DRIVEGATED_PATH, "--config", config.c_str(), "--log-level", log_level.c_str(),
           static_cast<char*>(nullptr));
     _exit(127);
   }

@@ -55,7 +55,7 @@ class NotifySocket {
 
 class DaemonProcess {
  public:
-  DaemonProcess(const std::string& config, const std::string& notify_socket);
+  DaemonProcess(const std::string& config, const std::string& notify_socket, const std::string& log_level = "debug");
   ~DaemonProcess();
   [[nodiscard]] pid_t pid() const { return pid_; }
   // Sends a signal and waits for the exit; returns the exit status (or nullopt on timeout).
