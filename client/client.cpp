@@ -89,11 +89,6 @@ class Client::Impl : public dds::DataReaderListener {
     const std::string identity = opt_.identity.empty() ? env("DRIVEGATE_IDENTITY") : opt_.identity;
     if (!identity.empty()) o.security = msg::security_files_in(identity);
     node_ = std::make_unique<msg::DdsNode>(o);
-    // Under DDS Security an identity may lack the right to publish commands or parameter requests
-    // (role observer, operator): those endpoints are refused and the client says so when used.
-    cmd_w_ = optional_writer(msg::TopicId::AxisCommand, command_refusal_);
-    sp_w_ = optional_writer(msg::TopicId::Setpoint, command_refusal_);
-    param_w_ = optional_writer(msg::TopicId::ParamRequest, parameter_refusal_);
     // Transient-local history can be delivered while create_datareader() is still running, before
     // the reader pointers below are known to on_data_available(). So: create all readers without a
     // listener, then attach it and take whatever already arrived.
@@ -101,21 +96,48 @@ class Client::Impl : public dds::DataReaderListener {
     state_r_ = &node_->reader(msg::TopicId::AxisState, nullptr, dds::StatusMask::none());
     event_r_ = &node_->reader(msg::TopicId::AxisEvent, nullptr, dds::StatusMask::none());
     bus_r_ = &node_->reader(msg::TopicId::BusStatus, nullptr, dds::StatusMask::none());
-    if (cmd_w_ != nullptr) reply_r_ = optional_reader(msg::TopicId::CommandReply, command_refusal_);
-    if (param_w_ != nullptr) param_r_ = optional_reader(msg::TopicId::ParamReply, parameter_refusal_);
-    for (dds::DataReader* r : {info_r_, state_r_, reply_r_, event_r_, bus_r_, param_r_}) {
-      if (r == nullptr) continue;
+    for (dds::DataReader* r : {info_r_, state_r_, event_r_, bus_r_}) {
       r->set_listener(this, dds::StatusMask::data_available());
       on_data_available(r);
     }
+  }
+
+  // The endpoints for commands (and set-points) or parameter requests, made on first use: a client
+  // that only watches never asks for them, and under DDS Security an identity may lack the right to
+  // them (roles observer, operator), which is then reported when they are used.
+  void ensure_command_endpoints() {
+    std::lock_guard lock(endpoints_mutex_);
+    if (command_endpoints_tried_) return;
+    command_endpoints_tried_ = true;
+    cmd_w_ = optional_writer(msg::TopicId::AxisCommand, command_refusal_);
+    if (cmd_w_ != nullptr) sp_w_ = optional_writer(msg::TopicId::Setpoint, command_refusal_);
+    if (sp_w_ != nullptr) reply_r_ = listened_reader(msg::TopicId::CommandReply, command_refusal_);
+  }
+  void ensure_param_endpoints() {
+    std::lock_guard lock(endpoints_mutex_);
+    if (param_endpoints_tried_) return;
+    param_endpoints_tried_ = true;
+    param_w_ = optional_writer(msg::TopicId::ParamRequest, parameter_refusal_);
+    if (param_w_ != nullptr) param_r_ = listened_reader(msg::TopicId::ParamReply, parameter_refusal_);
+  }
+  dds::DataReader* listened_reader(msg::TopicId t, std::string& refusal) {
+    dds::DataReader* r = optional_reader(t, refusal);
+    if (r != nullptr) r->set_listener(this, dds::StatusMask::data_available());
+    return r;
   }
   // The readers call back into this object: delete them before anything else goes.
   ~Impl() override { node_.reset(); }
   Impl(const Impl&) = delete;
   Impl& operator=(const Impl&) = delete;
 
-  std::string command_refusal() const { return command_refusal_; }
-  std::string parameter_refusal() const { return parameter_refusal_; }
+  std::string command_refusal() {
+    ensure_command_endpoints();
+    return command_refusal_;
+  }
+  std::string parameter_refusal() {
+    ensure_param_endpoints();
+    return parameter_refusal_;
+  }
 
   void on_data_available(dds::DataReader* reader) override {
     if (reader == nullptr) return;
@@ -173,6 +195,7 @@ class Client::Impl : public dds::DataReaderListener {
     const auto deadline = SteadyClock::now() + timeout;
     CommandResult result;
     result.axis = req.axis;
+    ensure_command_endpoints();
     if (cmd_w_ == nullptr || reply_r_ == nullptr) {
       result.outcome = Outcome::Denied;
       result.reason = command_refusal_;
@@ -185,7 +208,7 @@ class Client::Impl : public dds::DataReaderListener {
       return result;
     }
     result.gateway = r.gateway;
-    ensure_matched(deadline);
+    ensure_matched(deadline, *cmd_w_, *reply_r_);
 
     msg::AxisCommand out;
     out.gateway(r.gateway);
@@ -261,6 +284,7 @@ class Client::Impl : public dds::DataReaderListener {
 
   std::string stream_setpoint(std::string_view axis, std::string_view gateway, double position, double velocity,
                               double torque) {
+    ensure_command_endpoints();
     if (sp_w_ == nullptr) return command_refusal_;
     const Route r = route(axis, gateway);
     if (!r.error.empty()) return r.error;
@@ -279,6 +303,7 @@ class Client::Impl : public dds::DataReaderListener {
   ParamResult param(const ParamRequest& req, Millis timeout) {
     const auto deadline = SteadyClock::now() + timeout;
     ParamResult result;
+    ensure_param_endpoints();
     if (param_w_ == nullptr || param_r_ == nullptr) {
       result.error = parameter_refusal_;
       return result;
@@ -289,7 +314,7 @@ class Client::Impl : public dds::DataReaderListener {
       return result;
     }
     result.gateway = r.gateway;
-    ensure_matched(deadline);
+    ensure_matched(deadline, *param_w_, *param_r_);
     msg::ParamRequest out;
     out.gateway(r.gateway);
     out.axis(req.axis);
@@ -443,7 +468,7 @@ class Client::Impl : public dds::DataReaderListener {
   // A reliable volatile sample written before the gateway's reader matched us would be lost, and so
   // would a reply written before our reply reader matched. Wait (bounded) until every known gateway
   // can be reached both ways.
-  void ensure_matched(SteadyClock::time_point deadline) const {
+  void ensure_matched(SteadyClock::time_point deadline, dds::DataWriter& writer, dds::DataReader& reader) const {
     wait_until(
         [&] {
           std::size_t gateways = 0;
@@ -451,18 +476,12 @@ class Client::Impl : public dds::DataReaderListener {
             std::lock_guard lock(mutex_);
             gateways = gateways_.size();
           }
-          dds::PublicationMatchedStatus cmd{};
-          dds::PublicationMatchedStatus par{};
-          dds::SubscriptionMatchedStatus rep{};
-          dds::SubscriptionMatchedStatus prep{};
+          dds::PublicationMatchedStatus w{};
+          dds::SubscriptionMatchedStatus r{};
+          writer.get_publication_matched_status(w);
+          reader.get_subscription_matched_status(r);
           const auto n = static_cast<std::int32_t>(gateways);
-          // Endpoints this identity may not have (observer, operator) do not count.
-          if (cmd_w_ != nullptr) cmd_w_->get_publication_matched_status(cmd); else cmd.current_count = n;
-          if (param_w_ != nullptr) param_w_->get_publication_matched_status(par); else par.current_count = n;
-          if (reply_r_ != nullptr) reply_r_->get_subscription_matched_status(rep); else rep.current_count = n;
-          if (param_r_ != nullptr) param_r_->get_subscription_matched_status(prep); else prep.current_count = n;
-          return cmd.current_count >= n && par.current_count >= n && rep.current_count >= n &&
-                 prep.current_count >= n;
+          return w.current_count >= n && r.current_count >= n;
         },
         std::chrono::duration_cast<Millis>(deadline - SteadyClock::now()));
   }
@@ -591,6 +610,9 @@ class Client::Impl : public dds::DataReaderListener {
   dds::DataReader* bus_r_ = nullptr;
   dds::DataReader* param_r_ = nullptr;
 
+  std::mutex endpoints_mutex_;
+  bool command_endpoints_tried_ = false;
+  bool param_endpoints_tried_ = false;
   std::string command_refusal_;    // why this identity may not command (empty: it may)
   std::string parameter_refusal_;  // likewise for parameter requests
   std::size_t in_flight_ = 0;      // requests written and waiting for their first reply (mutex_)
@@ -615,8 +637,8 @@ class Client::Impl : public dds::DataReaderListener {
 Client::Client(ClientOptions options) : impl_(std::make_unique<Impl>(std::move(options))) {}
 Client::~Client() = default;
 const std::string& Client::name() const noexcept { return impl_->name(); }
-std::string Client::command_refusal() const { return impl_->command_refusal(); }
-std::string Client::parameter_refusal() const { return impl_->parameter_refusal(); }
+std::string Client::command_refusal() { return impl_->command_refusal(); }
+std::string Client::parameter_refusal() { return impl_->parameter_refusal(); }
 std::vector<GatewayInfo> Client::gateways() const { return impl_->gateways(); }
 std::vector<AxisState> Client::states() const { return impl_->states(); }
 std::optional<AxisState> Client::state(std::string_view axis, std::string_view gateway) const {

@@ -193,9 +193,9 @@ class Client {
 
   [[nodiscard]] const std::string& name() const noexcept;
   // Why this client may not send commands, set-points or parameter requests (its DDS identity's
-  // permissions refused the writer); empty when it may.
-  [[nodiscard]] std::string command_refusal() const;
-  [[nodiscard]] std::string parameter_refusal() const;
+  // permissions refused the writer); empty when it may. The endpoints are made on first use.
+  [[nodiscard]] std::string command_refusal();
+  [[nodiscard]] std::string parameter_refusal();
 
   // Discovery and latest data (copies, sorted by gateway then axis).
   [[nodiscard]] std::vector<GatewayInfo> gateways() const;

@@ -26,7 +26,7 @@ using namespace drivegate::client;
 using SteadyClock = std::chrono::steady_clock;
 
 constexpr const char* kUsage =
-    "usage: drivegate-demo [--domain N] [--namespace NS] [--gateway G] [--timeout S]\n"
+    "usage: drivegate-demo [--domain N] [--namespace NS] [--gateway G] [--identity DIR] [--timeout S]\n"
     "                      [--x AXIS] [--y AXIS] [--spindle AXIS] [--turntable AXIS]\n"
     "                      [--spindle-speed V] [--jog-seconds S] [--plain]\n"
     "Enables the demo axes, homes the turntable, moves x and y, moves the CANopen drives akd, nord\n"
@@ -180,12 +180,13 @@ int run(int argc, char** argv) {
     std::cout << kUsage;
     return 0;
   }
-  args.reject_unknown({"domain", "namespace", "gateway", "timeout", "x", "y", "spindle", "turntable", "spindle-speed",
+  args.reject_unknown({"domain", "namespace", "gateway", "identity", "timeout", "x", "y", "spindle", "turntable", "spindle-speed",
                        "jog-seconds", "help", "plain"});
   if (!args.positional().empty()) throw UsageError("unexpected argument '" + args.positional().front() + "'");
   ClientOptions opts;
   opts.domain = static_cast<std::uint32_t>(parse_integer("--domain", args.option_or("domain", "0"), 0, 232));
   opts.ns = args.option_or("namespace", "drivegate");
+  opts.identity = args.option_or("identity", "");
   const double timeout_s = args.number("timeout").value_or(15.0);
   const double speed = args.number("spindle-speed").value_or(10.0);
   const double jog_seconds = args.number("jog-seconds").value_or(3.0);

@@ -58,11 +58,16 @@ constexpr CommandHelp kCommands[] = {
 };
 
 void print_usage(std::ostream& os) {
-  os << "usage: drivegatectl [--domain N] [--namespace NS] [--gateway G] [--json] [--timeout S] <command> ...\n\n"
+  os << "usage: drivegatectl [--domain N] [--namespace NS] [--gateway G] [--identity DIR] [--interfaces LIST] "
+        "[--json] [--timeout S] <command> ...\n\n"
         "commands:\n";
   for (const auto& c : kCommands) os << "  " << c.usage << "\n      " << c.text << "\n";
   os << "\n--domain N      DDS domain id (default 0)\n"
         "--namespace NS  topic namespace (default drivegate)\n"
+        "--identity DIR  DDS Security identity (scripts/make-pki.sh makes one per role); default: the\n"
+        "                DRIVEGATE_IDENTITY environment variable, else no security\n"
+        "--interfaces L  DDS over these interfaces only (comma-separated names or IPv4 addresses);\n"
+        "                default: DRIVEGATE_INTERFACES, else every interface\n"
         "--gateway G     address gateway G (needed when several gateways claim an axis)\n"
         "--json          one JSON object per result on stdout\n"
         "--timeout S     seconds to wait for discovery and replies (default 5)\n"
@@ -94,6 +99,18 @@ const std::string& word(const Context& ctx, std::size_t i, const char* what) {
 
 void expect_words(const Context& ctx, std::size_t n) {
   if (ctx.words.size() > n) throw UsageError("unexpected argument '" + ctx.words[n] + "'");
+}
+
+std::vector<std::string> split_commas(const std::string& text) {
+  std::vector<std::string> out;
+  std::size_t at = 0;
+  while (at < text.size()) {
+    const auto comma = text.find(',', at);
+    const auto end = comma == std::string::npos ? text.size() : comma;
+    if (end > at) out.push_back(text.substr(at, end - at));
+    at = end + 1;
+  }
+  return out;
 }
 
 int fail(const std::string& message) {
@@ -482,7 +499,7 @@ int cmd_buses(Context& ctx) {
   return 0;
 }
 
-const StringSet kGlobal{"domain", "namespace", "gateway", "json", "timeout", "help"};
+const StringSet kGlobal{"domain", "namespace", "gateway", "identity", "interfaces", "json", "timeout", "help"};
 
 StringSet options_of(std::string_view command) {
   StringSet s = kGlobal;
@@ -523,6 +540,8 @@ int run(int argc, char** argv) {
   ClientOptions opts;
   opts.domain = static_cast<std::uint32_t>(parse_integer("--domain", args.option_or("domain", "0"), 0, 232));
   opts.ns = args.option_or("namespace", "drivegate");
+  opts.identity = args.option_or("identity", "");
+  opts.interfaces = split_commas(args.option_or("interfaces", ""));
   const double timeout_s = args.number("timeout").value_or(5.0);
   if (timeout_s <= 0) throw UsageError("--timeout must be positive");
 

@@ -42,7 +42,7 @@ namespace {
 
 // The Runtime has no wake-up signal, so its outbox is drained at least this often.
 constexpr auto kMaxPoll = 5ms;
-// While requests wait for the Runtime, the bridge comes back sooner.
+// While requests are in flight or wait for the Runtime, the bridge comes back sooner.
 constexpr auto kBusyPoll = 1ms;
 // A request that found no place in the Runtime's queue for this long is answered "busy".
 constexpr auto kBusyAfter = 2s;
@@ -352,7 +352,9 @@ void DdsBridge::Impl::run() {
   dds::ConditionSeq active;
   while (running_) {
     const auto now = Clock::now();
-    const bool waiting = busy() || !replies_.empty() || !param_replies_.empty();
+    // Requests in flight: their replies are picked up from the Runtime sooner.
+    const bool waiting = busy() || !replies_.empty() || !param_replies_.empty() || !pending_commands_.empty() ||
+                         !pending_params_.empty();
     const auto wait = std::clamp<Clock::duration>(next_state - now, Clock::duration::zero(),
                                                   waiting ? Clock::duration(kBusyPoll) : Clock::duration(kMaxPoll));
     const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(wait).count();
