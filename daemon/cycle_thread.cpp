@@ -1,5 +1,7 @@
 #include "daemon/cycle_thread.hpp"
 
+#include <pthread.h>
+
 #include <time.h>
 
 #include <algorithm>
@@ -74,6 +76,12 @@ std::string CycleThread::scheduling_note() const { return note_; }
 
 void CycleThread::run() noexcept {
   // Set-up may allocate and fault; the loop below must not.
+  if (!schedule_.name.empty()) {
+    // The kernel keeps 15 characters; ps -L, top -H and /proc/PID/task/TID/comm show them.
+    char name[16] = {};
+    schedule_.name.copy(name, sizeof name - 1);
+    ::pthread_setname_np(::pthread_self(), name);
+  }
   try {
     note_ = apply_thread_scheduling(schedule_.priority, schedule_.cpu);
   } catch (...) {

@@ -40,6 +40,7 @@ class CycleThread {
     int priority = 0;  // SCHED_FIFO 1..99 when > 0
     int cpu = -1;      // pinned to this CPU when >= 0
     core::Duration status_window = std::chrono::seconds(1);  // how often percentiles are rolled
+    std::string name = {};  // thread name shown by ps/top (at most 15 characters are kept)
   };
   // now: the CLOCK_MONOTONIC wake-up time of this cycle; cycle: 0, 1, 2, ...
   using Body = std::function<void(core::TimePoint now, std::uint64_t cycle)>;

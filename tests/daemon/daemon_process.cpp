@@ -90,6 +90,13 @@ void NotifySocket::read_loop() {
   }
 }
 
+std::size_t NotifySocket::count(const std::string& what) {
+  std::lock_guard lock(mutex_);
+  std::size_t n = 0;
+  for (const auto& m : received_) n += m.find(what) != std::string::npos ? 1U : 0U;
+  return n;
+}
+
 bool NotifySocket::wait_for(const std::string& what, std::chrono::milliseconds timeout) {
   std::unique_lock lock(mutex_);
   return arrived_.wait_for(lock, timeout, [&] {
@@ -99,7 +106,8 @@ bool NotifySocket::wait_for(const std::string& what, std::chrono::milliseconds t
   });
 }
 
-DaemonProcess::DaemonProcess(const std::string& config, const std::string& notify_socket, const std::string& log_level)
+DaemonProcess::DaemonProcess(const std::string& config, const std::string& notify_socket, const std::string& log_level,
+                             const std::vector<std::string>& environment)
     : log_path_(config + ".log") {
   const pid_t parent = getpid();
   pid_ = fork();
@@ -113,6 +121,10 @@ DaemonProcess::DaemonProcess(const std::string& config, const std::string& notif
     dup2(fd, STDOUT_FILENO);
     dup2(fd, STDERR_FILENO);
     setenv("NOTIFY_SOCKET", notify_socket.c_str(), 1);
+    for (const auto& e : environment) {
+      const auto eq = e.find('=');
+      if (eq != std::string::npos) setenv(e.substr(0, eq).c_str(), e.substr(eq + 1).c_str(), 1);
+    }
     execl(DRIVEGATED_PATH, DRIVEGATED_PATH, "--config", config.c_str(), "--log-level", log_level.c_str(),
           static_cast<char*>(nullptr));
     _exit(127);

@@ -41,6 +41,8 @@ class NotifySocket {
   [[nodiscard]] const std::string& path() const { return path_; }
   // Waits until a datagram containing `what` (e.g. "READY=1") has arrived.
   bool wait_for(const std::string& what, std::chrono::milliseconds timeout);
+  // How many datagrams containing `what` have arrived so far.
+  std::size_t count(const std::string& what);
 
  private:
   void read_loop();
@@ -55,7 +57,9 @@ class NotifySocket {
 
 class DaemonProcess {
  public:
-  DaemonProcess(const std::string& config, const std::string& notify_socket, const std::string& log_level = "debug");
+  // `environment`: extra NAME=VALUE settings for the daemon (e.g. WATCHDOG_USEC).
+  DaemonProcess(const std::string& config, const std::string& notify_socket, const std::string& log_level = "debug",
+                const std::vector<std::string>& environment = {});
   ~DaemonProcess();
   [[nodiscard]] pid_t pid() const { return pid_; }
   // Sends a signal and waits for the exit; returns the exit status (or nullopt on timeout).
