@@ -442,5 +442,25 @@ axes:
   EXPECT_REPORTED(e, (dir_ / "bad.eds").string() + ":3:1: [6040].DataType: must be a CiA 301 data type");
 }
 
+// Drives that watch the gateway fault when its cycle stalls: --check-config says so for a real bus
+// without real-time priority, not for one with it, nor for simulated drives.
+TEST(CanopenPlans, WatchedBusWithoutRealtimePriorityIsWarnedAbout) {
+  const auto plan_with = [](const std::string& priority, const std::string& transport) {
+    return load_plan_from_string("gateway: { name: g }\nbuses:\n  - { name: can0, type: canopen, cycle_time: 4ms, " +
+                                     priority + "options: { transport: " + transport +
+                                     ", interface: can0 } }\naxes:\n  - { name: akd, bus: can0, address: 1, "
+                                     "device: kollmorgen-akd, unit: mm, mechanics: { feed: 5 } }\n",
+                                 kLabel, test_options());
+  };
+  const auto warned = [](const Plan& p) {
+    for (const auto& w : p.warnings)
+      if (w.find("runs without real-time priority, but its drives watch the gateway") != std::string::npos) return true;
+    return false;
+  };
+  EXPECT_TRUE(warned(plan_with("", "socketcan")));
+  EXPECT_FALSE(warned(plan_with("priority: 60, ", "socketcan")));
+  EXPECT_FALSE(warned(plan_with("", "sim")));
+}
+
 }  // namespace
 }  // namespace drivegate::config

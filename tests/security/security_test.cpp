@@ -10,6 +10,8 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <string>
 #include <thread>
 
@@ -173,6 +175,30 @@ TEST_F(Security, StrangersSeeNothingAndCommandNothing) {
   }
   const std::string out = ctl("old", "status");
   EXPECT_EQ(out.rfind("1:", 0), 0u) << out;
+}
+
+// Security is off in the demo and on in the production example (and so in the systemd deployment,
+// which starts from it): with certificates where it expects them, it passes --check-config.
+TEST(SecurityConfig, OnInTheProductionExampleOffInTheDemo) {
+  const auto pki = std::filesystem::temp_directory_path() / ("drivegate-pki-prod-" + std::to_string(::getpid()));
+  const ShellRun made = run(std::string(DRIVEGATE_MAKE_PKI) + " " + pki.string());
+  ASSERT_EQ(made.status, 0) << made.output;
+  std::ifstream in(DRIVEGATE_PRODUCTION_CONFIG);
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string yaml = text.str();
+  const std::string installed = "/etc/drivegate/pki/gateway";
+  ASSERT_NE(yaml.find("dir: " + installed), std::string::npos);
+  yaml.replace(yaml.find(installed), installed.size(), (pki / "gateway").string());
+  const std::string file = test::write_config_text("production", yaml);
+  ShellRun r = run(std::string(DRIVEGATED_PATH) + " --check-config " + file);
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("dds security:    on: certificate " + (pki / "gateway" / "cert.pem").string()), std::string::npos)
+      << r.output;
+  r = run(std::string(DRIVEGATED_PATH) + " --check-config " + DRIVEGATE_DEMO_CONFIG);
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("dds security:    off"), std::string::npos) << r.output;
+  std::filesystem::remove_all(pki);
 }
 
 }  // namespace
