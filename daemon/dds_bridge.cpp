@@ -486,54 +486,60 @@ void DdsBridge::Impl::handle_command(const msg::AxisCommand& in, const Prefix& f
   count([](Stats& s) { ++s.commands_routed; });
 }
 
+// Offers the requests that found no room in the Runtime again, in order; one that has waited
+// kBusyAfter is answered "busy".
 void DdsBridge::Impl::retry_deferred(Clock::time_point now) {
-  while (!deferred_commands_.empty()) {
-    auto& d = deferred_commands_.front();
-    if (rt_.submit_command(d.axis_id, d.request)) {
-      pending_commands_.emplace(d.request.id, std::move(d.pending));
-      count([](Stats& s) { ++s.commands_routed; });
-    } else if (now - d.since >= kBusyAfter) {
-      msg::CommandReply out;
-      out.gateway(gateway_);
-      out.axis(d.pending.axis);
-      out.client(d.pending.client);
-      out.id(d.pending.client_id);
-      out.status(std::string(core::to_string(core::ReplyStatus::Rejected)));
-      out.reason("busy: the gateway's command queue for axis '" + d.pending.axis + "' stayed full for " +
-                 std::to_string(std::chrono::duration_cast<std::chrono::milliseconds>(kBusyAfter).count()) +
-                 " ms; send it again");
-      replies_.push_back({std::move(out), d.pending.prefix, now});
-      answered(d.pending.client);
-      ++summary_rejected_;
-      count([](Stats& s) { ++s.commands_busy; });
-    } else {
-      break;
+  const auto retry = [&](auto& queue, auto& pending, auto& replies, auto submit, auto busy_reply, bool param) {
+    while (!queue.empty()) {
+      auto& d = queue.front();
+      if (submit(d)) {
+        pending.emplace(d.request.id, std::move(d.pending));
+        count([&](Stats& s) { ++(param ? s.params_routed : s.commands_routed); });
+      } else if (now - d.since >= kBusyAfter) {
+        replies.push_back({busy_reply(d.pending), d.pending.prefix, now});
+        answered(d.pending.client);
+        summary_rejected_ += param ? 0 : 1;
+        count([](Stats& s) { ++s.commands_busy; });
+      } else {
+        break;
+      }
+      queue.pop_front();
     }
-    deferred_commands_.pop_front();
-  }
-  while (!deferred_params_.empty()) {
-    auto& d = deferred_params_.front();
-    if (rt_.submit_parameter(d.axis_id, d.request)) {
-      pending_params_.emplace(d.request.id, std::move(d.pending));
-      count([](Stats& s) { ++s.params_routed; });
-    } else if (now - d.since >= kBusyAfter) {
-      msg::ParamReply out;
-      out.gateway(gateway_);
-      out.axis(d.pending.axis);
-      out.client(d.pending.client);
-      out.id(d.pending.client_id);
-      out.ok(false);
-      out.error("busy: the gateway's parameter queue for axis '" + d.pending.axis + "' stayed full; send it again");
-      out.index(d.pending.index);
-      out.subindex(d.pending.sub);
-      param_replies_.push_back({std::move(out), d.pending.prefix, now});
-      answered(d.pending.client);
-      count([](Stats& s) { ++s.commands_busy; });
-    } else {
-      break;
-    }
-    deferred_params_.pop_front();
-  }
+  };
+  const std::string waited =
+      std::to_string(std::chrono::duration_cast<std::chrono::milliseconds>(kBusyAfter).count()) + " ms";
+  retry(
+      deferred_commands_, pending_commands_, replies_,
+      [&](const Deferred<core::Command>& d) { return rt_.submit_command(d.axis_id, d.request); },
+      [&](const Pending& p) {
+        msg::CommandReply out;
+        out.gateway(gateway_);
+        out.axis(p.axis);
+        out.client(p.client);
+        out.id(p.client_id);
+        out.status(std::string(core::to_string(core::ReplyStatus::Rejected)));
+        out.reason("busy: the gateway's command queue for axis '" + p.axis + "' stayed full for " + waited +
+                   "; send it again");
+        return out;
+      },
+      false);
+  retry(
+      deferred_params_, pending_params_, param_replies_,
+      [&](const Deferred<core::ParamRequest>& d) { return rt_.submit_parameter(d.axis_id, d.request); },
+      [&](const Pending& p) {
+        msg::ParamReply out;
+        out.gateway(gateway_);
+        out.axis(p.axis);
+        out.client(p.client);
+        out.id(p.client_id);
+        out.ok(false);
+        out.error("busy: the gateway's parameter queue for axis '" + p.axis + "' stayed full for " + waited +
+                  "; send it again");
+        out.index(p.index);
+        out.subindex(p.sub);
+        return out;
+      },
+      true);
 }
 
 void DdsBridge::Impl::take_setpoints() {

@@ -11,6 +11,7 @@ PACKAGES=(
   googletest libgtest-dev                # unit and integration tests
   libsystemd-dev systemd                 # sd_notify; systemd-analyze verifies the unit in tests
   iproute2                               # network namespaces for tests that need them
+  openssl                                # scripts/make-pki.sh (DDS Security certificates)
   python3-can                            # reference peer for the UDP multicast CAN bus (tests)
   cyclonedds-dev cyclonedds-tools        # a second DDS implementation: the interoperability test
 )

@@ -107,6 +107,22 @@ struct BusHarness {
     }, budget);
     return status;
   }
+  // A parameter request through the runner, cycled until its reply arrives (2 s of virtual time).
+  core::ParamReply param(const std::string& name, bool write, std::uint16_t index, std::uint8_t sub,
+                         std::uint8_t size, std::int64_t value = 0) {
+    core::ParamRequest r;
+    r.id = next_id++;
+    r.axis = axis(name);
+    r.write = write;
+    r.index = index;
+    r.sub = sub;
+    r.size = size;
+    r.value = value;
+    EXPECT_TRUE(runner->push_parameter(r));
+    core::ParamReply reply;
+    EXPECT_TRUE(run_until([&] { return runner->pop_parameter_reply(reply); }, 2s)) << name << " " << index;
+    return reply;
+  }
   std::string reason(core::CommandId id) const {
     for (const auto& r : replies)
       if (r.id == id && r.status != core::ReplyStatus::Accepted) return std::string(r.reason.view());

@@ -366,20 +366,7 @@ TEST(CanopenBusParameters, ReadsWritesAndAbortsOverSdo) {
   ASSERT_TRUE(h.run_until([&] { return h.all_up(); }, 5s)) << h.events_text();
   std::vector<core::ParamReply> got;
   auto ask = [&](const std::string& axis, bool write, std::uint16_t index, std::uint8_t sub, std::uint8_t size,
-                 std::int64_t value = 0) {
-    core::ParamRequest r;
-    r.id = h.next_id++;
-    r.axis = h.axis(axis);
-    r.write = write;
-    r.index = index;
-    r.sub = sub;
-    r.size = size;
-    r.value = value;
-    EXPECT_TRUE(h.runner->push_parameter(r));
-    core::ParamReply reply;
-    h.run_until([&] { return h.runner->pop_parameter_reply(reply); }, 2s);
-    return reply;
-  };
+                 std::int64_t value = 0) { return h.param(axis, write, index, sub, size, value); };
   auto r = ask("akd", false, 0x1018, 1, 4);
   ASSERT_TRUE(r.ok) << r.error.view();
   EXPECT_EQ(r.value, 0x6A);  // Kollmorgen (AKD part 1 §14 vector 11)

@@ -17,18 +17,7 @@ using core::ReplyStatus;
 
 core::ParamReply ask(BusHarness& h, const std::string& axis, bool write, std::uint16_t index, std::uint8_t sub,
                      std::uint8_t size, std::int64_t value = 0) {
-  core::ParamRequest r;
-  r.id = h.next_id++;
-  r.axis = h.axis(axis);
-  r.write = write;
-  r.index = index;
-  r.sub = sub;
-  r.size = size;
-  r.value = value;
-  EXPECT_TRUE(h.runner->push_parameter(r));
-  core::ParamReply reply;
-  EXPECT_TRUE(h.run_until([&] { return h.runner->pop_parameter_reply(reply); }, 2s));
-  return reply;
+  return h.param(axis, write, index, sub, size, value);
 }
 
 bool has_event(const BusHarness& h, core::EventKind kind, const std::string& text) {
