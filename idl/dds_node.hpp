@@ -67,7 +67,7 @@ struct TopicQos {
 };
 const std::array<TopicQos, kTopicCount>& qos_table() noexcept;
 const TopicQos& qos_of(TopicId t) noexcept;
-// "reliable" / "best effort", "transient local" / "volatile", "keep all (up to 4096)" /
+// "reliable" / "best effort", "transient local" / "volatile", "keep all (up to 1024)" /
 // "keep last 1 per instance": the words of the README's table.
 std::string reliability_text(const TopicQos& q);
 std::string durability_text(const TopicQos& q);

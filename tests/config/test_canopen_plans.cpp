@@ -21,6 +21,7 @@ buses:
   - name: can0
     type: canopen
     cycle_time: 4ms
+    priority: 50
     options:
       transport: udp-multicast
       interface: 127.0.0.1
@@ -307,10 +308,12 @@ buses:
 TEST(CanopenPlanErrors, UdpOptionsOnOtherTransportsAreWarnings) {
   const Plan plan = load_plan_from_string(one_axis("group: 239.1.1.1, port: 5000", "kollmorgen-akd", 1), "t.yaml",
                                           test_options());
-  ASSERT_EQ(plan.warnings.size(), 2U);
+  ASSERT_EQ(plan.warnings.size(), 3U);
   EXPECT_EQ(plan.warnings[0], "t.yaml:3:69: buses[0].options.group: is only used with transport udp-multicast; "
                               "transport is socketcan");
   EXPECT_NE(plan.warnings[1].find("buses[0].options.port: is only used"), std::string::npos) << plan.warnings[1];
+  // And, as for any watched bus without real-time priority:
+  EXPECT_NE(plan.warnings[2].find("runs without real-time priority"), std::string::npos) << plan.warnings[2];
 }
 
 TEST(CanopenPlanErrors, SdoChannels) {
