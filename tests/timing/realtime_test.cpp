@@ -102,6 +102,12 @@ TEST(Realtime, FifoAppliesOrSaysWhatIsMissing) {
 TEST(Realtime, LockMemoryLocksOrSaysWhatIsMissing) {
   const std::string note = lock_memory();
   if (note.empty()) {
+#if defined(__SANITIZE_ADDRESS__)
+    // AddressSanitizer turns mlockall into a no-op (locking its shadow memory would take the
+    // machine's RAM): nothing to read back in that build.
+    munlockall();
+    return;
+#endif
     EXPECT_GT(locked_kib(), 0);
     munlockall();
     EXPECT_EQ(locked_kib(), 0);
