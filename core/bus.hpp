@@ -10,6 +10,7 @@
 #include <string_view>
 
 #include "core/axis_controller.hpp"
+#include "core/command.hpp"
 #include "core/clock.hpp"
 
 namespace drivegate::core {
@@ -50,6 +51,9 @@ class Bus {
   // Cyclic path.
   virtual void receive(TimePoint now) noexcept = 0;
   virtual void transmit(TimePoint now) noexcept = 0;
+  // Events about the bus itself (another master on the wire, ...), taken after receive(); false
+  // when there is none. The runner publishes them with no axis.
+  virtual bool next_event(Event& /*out*/) noexcept { return false; }
 
   // May be called from any thread while the bus runs (implementations keep relaxed atomics).
   [[nodiscard]] virtual BusCounters counters() const noexcept = 0;

@@ -22,6 +22,12 @@ bool BusRunner::room_for_parameter() const noexcept {
 
 void BusRunner::cycle(TimePoint now) noexcept {
   bus_.receive(now);
+  Event bus_event;
+  while (bus_.next_event(bus_event)) {
+    bus_event.axis = kNoAxis;
+    bus_event.stamp_ns = to_ns(now);
+    event(bus_event);
+  }
   for (std::size_t i = 0; i < axes_.size(); ++i) axes_[i].observe_link(now, bus_.link_state(i), bus_.link_detail(i), *this);
 
   Command cmd;

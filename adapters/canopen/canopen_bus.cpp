@@ -257,9 +257,33 @@ void CanopenBus::dispatch(const CanFrame& f, core::TimePoint now) noexcept {
     case Function::Tpdo:
       if (Node* n = node_by_id(c.node)) used = n->pdos.on_frame(f, now);
       break;
-    default: break;  // NMT, SYNC, RPDOs, SDO requests of another master: not for us
+    case Function::Sync:
+    case Function::Nmt: note_foreign_master(f, now); break;  // the gateway never hears its own
+    default: break;  // RPDOs, SDO requests of another master: not for us
   }
   if (!used) ++unexpected_;
+}
+
+// Two masters on one bus fight over the drives (each SYNCs, starts and stops nodes, writes
+// their controlwords): say so, as a bus event, at most every 10 s.
+void CanopenBus::note_foreign_master(const CanFrame& f, core::TimePoint now) noexcept {
+  ++foreign_master_;
+  if (foreign_pending_ || (foreign_master_ > 1 && now - foreign_reported_ < std::chrono::seconds(10))) return;
+  foreign_reported_ = now;
+  foreign_pending_ = true;
+  foreign_event_ = core::Event{};
+  foreign_event_.kind = core::EventKind::Warning;
+  foreign_event_.text.format("another CANopen master is on bus %s: it sends %s frames (COB-ID %03Xh) that this gateway "
+                             "did not; two masters fight over the drives (%llu such frames so far)",
+                             name_.c_str(), f.id == cob::kNmt ? "NMT" : "SYNC", static_cast<unsigned>(f.id),
+                             static_cast<unsigned long long>(foreign_master_));
+}
+
+bool CanopenBus::next_event(core::Event& out) noexcept {
+  if (!foreign_pending_) return false;
+  foreign_pending_ = false;
+  out = foreign_event_;
+  return true;
 }
 
 void CanopenBus::handle_controller_state(core::TimePoint now) noexcept {

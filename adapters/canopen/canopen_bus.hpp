@@ -68,6 +68,7 @@ class CanopenBus final : public core::Bus {
   std::string_view link_detail(std::size_t axis) const noexcept override;
   void receive(core::TimePoint now) noexcept override;
   void transmit(core::TimePoint now) noexcept override;
+  bool next_event(core::Event& out) noexcept override;
   core::BusCounters counters() const noexcept override;
 
   // Diagnostics (bus thread only, or while the bus is not cycling).
@@ -77,6 +78,12 @@ class CanopenBus final : public core::Bus {
   [[nodiscard]] const EmcyConsumer& emcy() const noexcept { return emcy_; }
   [[nodiscard]] const NodePdos& pdos(std::size_t axis) const noexcept { return nodes_[axis]->pdos; }
   [[nodiscard]] std::uint64_t unexpected_frames() const noexcept { return unexpected_; }
+  std::uint64_t foreign_master_ = 0;
+  core::TimePoint foreign_reported_{};  // last foreign-master warning (at most one per 10 s)
+  bool foreign_pending_ = false;         // a warning waits for next_event()
+  core::Event foreign_event_{};
+  // SYNC and NMT commands on the wire that this gateway did not send: another master.
+  [[nodiscard]] std::uint64_t foreign_master_frames() const noexcept { return foreign_master_; }
   [[nodiscard]] std::uint64_t boots(std::size_t axis) const noexcept { return nodes_[axis]->boots; }
   [[nodiscard]] Transport& transport() noexcept { return *transport_; }
 
@@ -114,6 +121,7 @@ class CanopenBus final : public core::Bus {
   void flush(core::TimePoint now) noexcept;
   void release_watchdogs() noexcept;
   void publish_counters() noexcept;
+  void note_foreign_master(const CanFrame& f, core::TimePoint now) noexcept;
 
   std::string name_;
   config::CanopenBusOptions options_;

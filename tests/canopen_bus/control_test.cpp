@@ -100,5 +100,30 @@ TEST(CanopenControl, ADriveThatStopsFollowingIsStoppedOverSdoAndReconfigured) {
   EXPECT_EQ(h.drive("akd").drive().state(), AxisState::SwitchOnDisabled);
 }
 
+// Another master on the wire (its SYNC and NMT frames, which this gateway did not send) is a bus
+// warning, not silence; the gateway's own traffic never counts as such.
+TEST(CanopenControl, AnotherMasterOnTheBusIsReported) {
+  BusHarness h;
+  ASSERT_TRUE(h.run_until([&] { return h.all_up(); }, 5s)) << h.events_text();
+  h.run_until([] { return false; }, 500ms);
+  EXPECT_EQ(h.bus->foreign_master_frames(), 0u);
+  EXPECT_FALSE(has_event(h, core::EventKind::Warning, "another CANopen master"));
+
+  auto rogue = h.peer->bus().connect();
+  rogue->open();
+  for (int i = 0; i < 5; ++i) {
+    ASSERT_EQ(rogue->send(make_frame(cob::kSync, {}), h.now), SendResult::Sent);
+    ASSERT_EQ(rogue->send(make_frame(cob::kNmt, {0x01, 0x00}), h.now), SendResult::Sent);
+    h.cycle();
+  }
+  EXPECT_EQ(h.bus->foreign_master_frames(), 10u);
+  std::size_t warnings = 0;
+  for (const auto& e : h.events)
+    if (e.kind == core::EventKind::Warning && e.axis == core::kNoAxis &&
+        std::string(e.text.view()).find("another CANopen master is on bus can0") != std::string::npos)
+      ++warnings;
+  EXPECT_EQ(warnings, 1u) << h.events_text();  // once, not per frame
+}
+
 }  // namespace
 }  // namespace drivegate::canopen::test
