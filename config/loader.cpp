@@ -81,9 +81,11 @@ void read_gateway(const MapReader& g, const fs::path& base_dir, GatewayPlan& out
   out.domain = static_cast<int>(dds.integer("domain", Need::Optional, 0, 232).value_or(0));
   out.ns = dds.name("namespace", Need::Optional, false).value_or(out.ns);
   if (dds.has("profiles_file")) out.dds_profiles_file = read_file_path(dds, "profiles_file", base_dir, Need::Required);
-  out.dds_profile = dds.string("profile", Need::Optional).value_or("");
+  // Fast DDS 2.9 applies the default profile of the file in FASTRTPS_DEFAULT_PROFILES_FILE by
+  // itself, but not that of a file loaded later: the participant profile is named here.
+  out.dds_profile = dds.name("profile", out.dds_profiles_file.empty() ? Need::Optional : Need::Required).value_or("");
   if (!out.dds_profile.empty() && out.dds_profiles_file.empty())
-    dds.error("profile", "names a profile in profiles_file: give profiles_file too");
+    dds.error("profile", "names a participant profile of profiles_file: give profiles_file too");
   if (const auto list = dds.list("interfaces", Need::Optional)) {
     if (list->size() == 0) dds.error("interfaces", "must name at least one interface (or leave it out for all)");
     for (std::size_t i = 0; i < list->size(); ++i) {

@@ -177,9 +177,9 @@ DdsNode::DdsNode(const DdsOptions& options) : ns_(options.ns) {
   if (options.domain > 232)
     throw std::runtime_error("DDS domain id " + std::to_string(options.domain) + " is out of range 0..232");
   auto* factory = dds::DomainParticipantFactory::get_instance();
-  // The XML defaults (FASTDDS_DEFAULT_PROFILES_FILE, DEFAULT_FASTRTPS_PROFILES.xml) first, then the
-  // file given here; the participant starts from the resulting default QoS, never from the
-  // compiled-in PARTICIPANT_QOS_DEFAULT that would bypass them.
+  // The XML defaults (FASTRTPS_DEFAULT_PROFILES_FILE, DEFAULT_FASTRTPS_PROFILES.xml) first, then the
+  // file given here; the participant starts from the resulting default QoS (or the named profile),
+  // never from the compiled-in PARTICIPANT_QOS_DEFAULT that would bypass them.
   factory->load_profiles();
   if (!options.profiles_file.empty() &&
       factory->load_XML_profiles_file(options.profiles_file) != ReturnCode_t::RETCODE_OK)

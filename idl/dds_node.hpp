@@ -6,8 +6,10 @@
 // against it.
 //
 // The participant starts from Fast DDS's default participant QoS, so a standard XML profile
-// (FASTDDS_DEFAULT_PROFILES_FILE, or DdsOptions::profiles_file) applies: interfaces, transports,
-// discovery servers, security properties. DdsOptions then narrows what drivegate is told to.
+// (FASTRTPS_DEFAULT_PROFILES_FILE, which Fast DDS 2.9 reads; DEFAULT_FASTRTPS_PROFILES.xml in the
+// working directory; or DdsOptions::profiles_file with the profile named) applies: interfaces,
+// transports, discovery servers, security properties. DdsOptions then narrows what drivegate is
+// told to.
 #include <array>
 #include <chrono>
 #include <cstddef>
@@ -77,8 +79,9 @@ struct DdsOptions {
   std::uint32_t domain = 0;
   std::string ns = "drivegate";
   std::string participant_name;
-  // A Fast DDS XML profiles file loaded before the participant is made; its default participant
-  // profile (or `profile`, when named) is the starting point instead of the built-in defaults.
+  // A Fast DDS XML profiles file loaded before the participant is made, and the participant
+  // profile in it that is the starting point (Fast DDS 2.9 does not make a later file's default
+  // profile the default).
   std::string profiles_file;
   std::string profile;
   // UDPv4 on these interfaces only (names such as "lo" or IPv4 addresses), no shared memory: the

@@ -354,6 +354,17 @@ TEST_F(FileErrors, FilesAboveTheLimitAreRefusedBeforeParsing) {
   EXPECT_EQ(file_errors(write("limit.yaml", big).string()), "(loaded without error)");
 }
 
+// A Fast DDS profiles file comes with the participant profile to use; a profile needs its file.
+TEST_F(FileErrors, DdsProfilesFileNeedsItsProfile) {
+  const auto xml = write("fastdds.xml", "<profiles/>\n");
+  std::string yaml = kHead + kCounts;
+  yaml.replace(yaml.find("  name: cell-1\n"), 15, "  name: cell-1\n  dds: { profiles_file: \"" + xml.string() + "\" }\n");
+  EXPECT_REPORTED(errors_of(yaml), "gateway.dds.profile: missing required field");
+  yaml = kHead + kCounts;
+  yaml.replace(yaml.find("  name: cell-1\n"), 15, "  name: cell-1\n  dds: { profile: cell }\n");
+  EXPECT_REPORTED(errors_of(yaml), "gateway.dds.profile: names a participant profile of profiles_file");
+}
+
 TEST(LoadErrors, ASecondDocumentIsAnError) {
   const std::string e = errors_of(kHead + kCounts + "---\ngateway: { name: other }\n");
   EXPECT_REPORTED(e, "t.yaml:14:1: a second YAML document starts here");

@@ -4,6 +4,8 @@
 #include <signal.h>
 
 #include <atomic>
+#include <cstdio>
+#include <fstream>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -49,27 +51,48 @@ class Announcements final : public fdds::DomainParticipantListener {
   std::vector<Seen> seen_;
 };
 
-TEST(DdsNetwork, ADaemonOnLoopbackAnnouncesLoopbackOnlyAndALoopbackClientWorks) {
-  const auto dds = test::unique_dds("lo");
-  const auto config = test::write_demo_config("loop", dds, [](YAML::Node& root) {
-    root["gateway"]["dds"]["interfaces"].push_back("lo");
-  });
-  // An observer on loopback alone, listening to participant announcements.
-  Announcements listener;
-  auto* factory = fdds::DomainParticipantFactory::get_instance();
-  fdds::DomainParticipantQos q;
-  factory->get_default_participant_qos(q);
-  auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
-  udp->interfaceWhiteList.push_back("127.0.0.1");
-  q.transport().use_builtin_transports = false;
-  q.transport().user_transports.push_back(udp);
-  auto* observer = factory->create_participant(dds.domain, q, &listener);
-  ASSERT_NE(observer, nullptr);
+// A participant on loopback alone that records what the others announce.
+class LoopbackObserver {
+ public:
+  explicit LoopbackObserver(std::uint32_t domain) {
+    auto* factory = fdds::DomainParticipantFactory::get_instance();
+    fdds::DomainParticipantQos q;
+    factory->get_default_participant_qos(q);
+    auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
+    udp->interfaceWhiteList.push_back("127.0.0.1");
+    q.transport().use_builtin_transports = false;
+    q.transport().user_transports.push_back(udp);
+    participant_ = factory->create_participant(domain, q, &listener_);
+  }
+  ~LoopbackObserver() {
+    if (participant_ != nullptr) fdds::DomainParticipantFactory::get_instance()->delete_participant(participant_);
+  }
+  LoopbackObserver(const LoopbackObserver&) = delete;
+  LoopbackObserver& operator=(const LoopbackObserver&) = delete;
+  [[nodiscard]] bool ok() const { return participant_ != nullptr; }
 
-  test::NotifySocket notify;
-  test::DaemonProcess daemon(config, notify.path());
-  ASSERT_TRUE(notify.wait_for("READY=1", 15s)) << daemon.log();
+  // The daemon `name` was seen and announced loopback UDPv4 locators only.
+  void expect_loopback_only(const std::string& name) {
+    bool found = false;
+    for (const auto& s : listener_.seen()) {
+      if (s.name != name) continue;
+      found = true;
+      ASSERT_FALSE(s.locators.empty());
+      for (const auto& l : s.locators) {
+        EXPECT_EQ(l.kind, LOCATOR_KIND_UDPv4) << l;  // no shared memory, no other transport
+        EXPECT_TRUE(rtps::IPLocator::isLocal(l)) << name << " announced " << l;
+      }
+    }
+    EXPECT_TRUE(found) << "the loopback observer never discovered " << name;
+  }
 
+ private:
+  Announcements listener_;
+  fdds::DomainParticipant* participant_ = nullptr;
+};
+
+// A client on loopback alone commands axis x.
+void command_over_loopback(const test::DdsIsolation& dds, test::DaemonProcess& daemon) {
   auto opts = client::options_for(dds.domain, dds.ns, "loop-client");
   opts.interfaces = {"lo"};
   client::Client c(opts);
@@ -83,21 +106,78 @@ TEST(DdsNetwork, ADaemonOnLoopbackAnnouncesLoopbackOnlyAndALoopbackClientWorks) 
   mv.kind = "move";
   mv.position = 3;
   EXPECT_EQ(c.send(mv, true, 20s).outcome, client::Outcome::Completed);
+}
 
-  bool found = false;
-  for (const auto& s : listener.seen()) {
-    if (s.name != "drivegated/loop") continue;
-    found = true;
-    ASSERT_FALSE(s.locators.empty());
-    for (const auto& l : s.locators) {
-      EXPECT_EQ(l.kind, LOCATOR_KIND_UDPv4) << l;  // no shared memory, no other transport
-      EXPECT_TRUE(rtps::IPLocator::isLocal(l)) << "the daemon announced " << l;
-    }
-  }
-  EXPECT_TRUE(found) << "the loopback observer never discovered the daemon";
-  factory->delete_participant(observer);
+TEST(DdsNetwork, ADaemonOnLoopbackAnnouncesLoopbackOnlyAndALoopbackClientWorks) {
+  const auto dds = test::unique_dds("lo");
+  const auto config = test::write_demo_config("loop", dds, [](YAML::Node& root) {
+    root["gateway"]["dds"]["interfaces"].push_back("lo");
+  });
+  LoopbackObserver observer(dds.domain);
+  ASSERT_TRUE(observer.ok());
+  test::NotifySocket notify;
+  test::DaemonProcess daemon(config, notify.path());
+  ASSERT_TRUE(notify.wait_for("READY=1", 15s)) << daemon.log();
+  command_over_loopback(dds, daemon);
+  observer.expect_loopback_only("drivegated/loop");
   EXPECT_EQ(daemon.terminate(SIGTERM, 20s), 0);
 }
+
+// A standard Fast DDS XML profile applies: as FASTRTPS_DEFAULT_PROFILES_FILE (the variable Fast DDS
+// 2.9 reads; the daemon starts from the factory's default participant QoS, not from compiled-in
+// defaults) and as the config's gateway.dds.profiles_file with its profile. Here the profile keeps
+// the participant on loopback.
+constexpr const char* kLoopbackProfile = R"(<?xml version="1.0" encoding="UTF-8" ?>
+<profiles xmlns="http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles">
+  <transport_descriptors>
+    <transport_descriptor>
+      <transport_id>loopback_only</transport_id>
+      <type>UDPv4</type>
+      <interfaceWhiteList><address>127.0.0.1</address></interfaceWhiteList>
+    </transport_descriptor>
+  </transport_descriptors>
+  <participant profile_name="loopback_participant" is_default_profile="true">
+    <rtps>
+      <userTransports><transport_id>loopback_only</transport_id></userTransports>
+      <useBuiltinTransports>false</useBuiltinTransports>
+    </rtps>
+  </participant>
+</profiles>
+)";
+
+class DdsProfiles : public ::testing::TestWithParam<bool> {};
+
+TEST_P(DdsProfiles, AFastDdsXmlProfileApplies) {
+  const bool from_environment = GetParam();
+  const auto dds = test::unique_dds(from_environment ? "xmlenv" : "xmlcfg");
+  const std::string xml = test::write_config_text("profile", "") + ".xml";
+  {
+    std::ofstream out(xml);
+    out << kLoopbackProfile;
+  }
+  const std::string name = from_environment ? "xmlenv" : "xmlcfg";
+  const auto config = test::write_demo_config(name, dds, [&](YAML::Node& root) {
+    if (from_environment) return;
+    root["gateway"]["dds"]["profiles_file"] = xml;
+    root["gateway"]["dds"]["profile"] = "loopback_participant";
+  });
+  LoopbackObserver observer(dds.domain);
+  ASSERT_TRUE(observer.ok());
+  test::NotifySocket notify;
+  std::vector<std::string> env;
+  if (from_environment) env.push_back("FASTRTPS_DEFAULT_PROFILES_FILE=" + xml);
+  test::DaemonProcess daemon(config, notify.path(), "debug", env);
+  ASSERT_TRUE(notify.wait_for("READY=1", 15s)) << daemon.log();
+  command_over_loopback(dds, daemon);
+  observer.expect_loopback_only("drivegated/" + name);
+  EXPECT_EQ(daemon.terminate(SIGTERM, 20s), 0);
+  std::remove(xml.c_str());
+}
+
+INSTANTIATE_TEST_SUITE_P(Daemon, DdsProfiles, ::testing::Values(true, false),
+                         [](const ::testing::TestParamInfo<bool>& p) {
+                           return p.param ? std::string("Environment") : std::string("ConfigFile");
+                         });
 
 // An interface that does not exist is a clear start-up error, not a participant on every network.
 TEST(DdsNetwork, AnUnknownInterfaceStopsTheStartWithItsName) {
