@@ -74,7 +74,7 @@ void AxisRunner::command(const Command& cmd, TimePoint now, RunnerOutput& out) n
   // has ended as the client asked. Halt, resume, enable and fault reset leave it running.
   if (live_command_ != 0 && live_command_ != cmd.id && ends_live_run(cmd.kind)) {
     if (is_internal(cmd.id))
-      end_live_command(ReplyStatus::Failed, ending_.empty() ? std::string_view("stopped by the gateway") : ending_.view());
+      end_live_command(ReplyStatus::Failed, gateway_stop_reason());
     else
       end_live_command(ReplyStatus::Completed, {});
   }
@@ -357,10 +357,14 @@ void AxisRunner::failed(CommandId id, std::string_view reason) noexcept {
     if (submitting_ != 0 && id != submitting_ && ends_live_run(submitting_kind_)) {
       if (!is_internal(submitting_)) return send_reply(id, ReplyStatus::Completed, {});
       return send_reply(id, ReplyStatus::Failed,
-                        ending_.empty() ? std::string_view("stopped by the gateway") : ending_.view());
+                        gateway_stop_reason());
     }
   }
   send_reply(id, ReplyStatus::Failed, reason);
+}
+
+std::string_view AxisRunner::gateway_stop_reason() const noexcept {
+  return ending_.empty() ? std::string_view("stopped by the gateway") : ending_.view();
 }
 
 void AxisRunner::end_live_command(ReplyStatus status, std::string_view reason) noexcept {

@@ -59,6 +59,8 @@ class AxisRunner final : private ControllerSink {
   void check_soft_limits(TimePoint now) noexcept;
   void internal_stop(CommandKind kind, TimePoint now, std::string_view why) noexcept;
   void end_live_command(ReplyStatus status, std::string_view reason) noexcept;
+  // Why the gateway itself ended a client's command: the reason of the stop under way, if any.
+  [[nodiscard]] std::string_view gateway_stop_reason() const noexcept;
   void watch_live_command() noexcept;
   void select_default_mode(TimePoint now) noexcept;
   void build_snapshot(TimePoint now) noexcept;

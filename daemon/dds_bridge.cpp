@@ -104,6 +104,26 @@ struct Pending {
   std::uint8_t sub = 0;
 };
 
+// A reply (CommandReply or ParamReply) addressed to the client and request of `p`.
+template <typename Reply>
+Reply reply_to(const std::string& gateway, const Pending& p) {
+  Reply out;
+  out.gateway(gateway);
+  out.axis(p.axis);
+  out.client(p.client);
+  out.id(p.client_id);
+  return out;
+}
+
+// The key of a client's reply instance (gateway, client).
+template <typename Reply>
+Reply instance_key(const std::string& gateway, const std::string& client) {
+  Reply key;
+  key.gateway(gateway);
+  key.client(client);
+  return key;
+}
+
 // A request taken from DDS that the Runtime had no room for yet.
 template <typename Request>
 struct Deferred {
@@ -185,7 +205,8 @@ class DdsBridge::Impl : private dds::DataWriterListener {
   void publish_states();
   void publish_bus_status();
   void publish_gateway_info();
-  void publish_gateway_event(core::EventKind kind, const std::string& text);
+  // An event of this gateway (not of a bus); `axis` when it is about one of its axes.
+  void publish_gateway_event(core::EventKind kind, const std::string& text, const std::string& axis = {});
   void log_summary(Clock::time_point now);
   // A request of `client` was answered for good (bookkeeping of kClientLimit).
   void answered(const std::string& client);
@@ -421,11 +442,7 @@ void DdsBridge::Impl::reject(const msg::AxisCommand& in, const Prefix& from, con
   if (warn_limit_.allow(now))
     spdlog::warn("dds: rejected {} for axis '{}' from '{}' id {}: {}", in.kind(), in.axis(), in.client(), in.id(),
                  reason);
-  msg::CommandReply out;
-  out.gateway(gateway_);
-  out.axis(in.axis());
-  out.client(in.client());
-  out.id(in.id());
+  auto out = reply_to<msg::CommandReply>(gateway_, Pending{in.client(), in.id(), in.axis(), from, 0, 0});
   out.status(std::string(core::to_string(core::ReplyStatus::Rejected)));
   out.reason(reason);
   replies_.push_back({std::move(out), from, now});
@@ -512,11 +529,7 @@ void DdsBridge::Impl::retry_deferred(Clock::time_point now) {
       deferred_commands_, pending_commands_, replies_,
       [&](const Deferred<core::Command>& d) { return rt_.submit_command(d.axis_id, d.request); },
       [&](const Pending& p) {
-        msg::CommandReply out;
-        out.gateway(gateway_);
-        out.axis(p.axis);
-        out.client(p.client);
-        out.id(p.client_id);
+        auto out = reply_to<msg::CommandReply>(gateway_, p);
         out.status(std::string(core::to_string(core::ReplyStatus::Rejected)));
         out.reason("busy: the gateway's command queue for axis '" + p.axis + "' stayed full for " + waited +
                    "; send it again");
@@ -527,11 +540,7 @@ void DdsBridge::Impl::retry_deferred(Clock::time_point now) {
       deferred_params_, pending_params_, param_replies_,
       [&](const Deferred<core::ParamRequest>& d) { return rt_.submit_parameter(d.axis_id, d.request); },
       [&](const Pending& p) {
-        msg::ParamReply out;
-        out.gateway(gateway_);
-        out.axis(p.axis);
-        out.client(p.client);
-        out.id(p.client_id);
+        auto out = reply_to<msg::ParamReply>(gateway_, p);
         out.ok(false);
         out.error("busy: the gateway's parameter queue for axis '" + p.axis + "' stayed full for " + waited +
                   "; send it again");
@@ -577,11 +586,7 @@ void DdsBridge::Impl::fail_param(const msg::ParamRequest& in, const Prefix& from
   if (warn_limit_.allow(now))
     spdlog::warn("dds: parameter request {:04X}:{} for axis '{}' from '{}' failed: {}", in.index(), in.subindex(),
                  in.axis(), in.client(), error);
-  msg::ParamReply out;
-  out.gateway(gateway_);
-  out.axis(in.axis());
-  out.client(in.client());
-  out.id(in.id());
+  auto out = reply_to<msg::ParamReply>(gateway_, Pending{in.client(), in.id(), in.axis(), from, 0, 0});
   out.ok(false);
   out.error(error);
   out.index(in.index());
@@ -660,21 +665,15 @@ void DdsBridge::Impl::take_gateway_infos() {
       const std::string text = "axis '" + other.name() + "' is claimed by gateway '" + gateway_ + "' and by gateway '" +
                                in.gateway() + "'; clients must name the gateway for this axis";
       spdlog::warn("dds: {}", text);
-      msg::AxisEvent ev;
-      ev.gateway(gateway_);
-      ev.axis(other.name());
-      ev.kind(std::string(core::to_string(core::EventKind::Warning)));
-      ev.state(std::string(core::to_string(core::AxisState::Unknown)));
-      ev.text(text);
-      ev.stamp(std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch()).count());
-      event_w_->write(&ev);
+      publish_gateway_event(core::EventKind::Warning, text, other.name());
     }
   });
 }
 
-void DdsBridge::Impl::publish_gateway_event(core::EventKind kind, const std::string& text) {
+void DdsBridge::Impl::publish_gateway_event(core::EventKind kind, const std::string& text, const std::string& axis) {
   msg::AxisEvent ev;
   ev.gateway(gateway_);
+  ev.axis(axis);
   ev.kind(std::string(core::to_string(kind)));
   ev.state(std::string(core::to_string(core::AxisState::Unknown)));
   ev.text(text);
@@ -694,11 +693,7 @@ void DdsBridge::Impl::collect_outbox(Clock::time_point now) {
       spdlog::debug("dds: reply {} for command {} of no DDS client", core::to_string(r.reply.status), r.reply.id);
       continue;
     }
-    msg::CommandReply out;
-    out.gateway(gateway_);
-    out.axis(it->second.axis);
-    out.client(it->second.client);
-    out.id(it->second.client_id);
+    auto out = reply_to<msg::CommandReply>(gateway_, it->second);
     out.status(std::string(core::to_string(r.reply.status)));
     out.reason(r.reply.reason.str());
     spdlog::debug("dds: command {} ('{}' id {} on '{}'): {}{}{}", r.reply.id, out.client(), out.id(), out.axis(),
@@ -730,11 +725,7 @@ void DdsBridge::Impl::collect_outbox(Clock::time_point now) {
       spdlog::debug("dds: parameter reply {} of no DDS client", p.reply.id);
       continue;
     }
-    msg::ParamReply out;
-    out.gateway(gateway_);
-    out.axis(it->second.axis);
-    out.client(it->second.client);
-    out.id(it->second.client_id);
+    auto out = reply_to<msg::ParamReply>(gateway_, it->second);
     out.ok(p.reply.ok);
     out.value(p.reply.value);
     out.error_code(p.reply.error_code);
@@ -793,14 +784,10 @@ void DdsBridge::Impl::forget_gone_clients() {
     if (it == clients_of_.end()) continue;
     for (const auto& name : it->second) {
       if (param) {
-        msg::ParamReply key;
-        key.gateway(gateway_);
-        key.client(name);
+        auto key = instance_key<msg::ParamReply>(gateway_, name);
         param_w_->unregister_instance(&key, dds::HANDLE_NIL);
       } else {
-        msg::CommandReply key;
-        key.gateway(gateway_);
-        key.client(name);
+        auto key = instance_key<msg::CommandReply>(gateway_, name);
         reply_w_->unregister_instance(&key, dds::HANDLE_NIL);
       }
     }
