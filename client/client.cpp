@@ -315,7 +315,7 @@ class Client::Impl : public dds::DataReaderListener {
     }
     result.gateway = r.gateway;
     ensure_matched(deadline, *param_w_, *param_r_);
-    msg::ParamRequest out;
+    msg::ParameterRequest out;
     out.gateway(r.gateway);
     out.axis(req.axis);
     out.client(opt_.name);
@@ -325,8 +325,7 @@ class Client::Impl : public dds::DataReaderListener {
     out.index(req.index);
     out.subindex(req.subindex);
     out.name(req.name);
-    out.size(req.size);
-    out.is_signed(req.is_signed);
+    out.type(req.type);
     out.value(req.value);
     {
       std::lock_guard lock(mutex_);
@@ -588,13 +587,22 @@ class Client::Impl : public dds::DataReaderListener {
   }
 
   void take_param_replies() {
-    msg::take_valid<msg::ParamReply>(*param_r_, [&](const msg::ParamReply& in) {
+    msg::take_valid<msg::ParameterReply>(*param_r_, [&](const msg::ParameterReply& in) {
       if (in.client() != opt_.name) return;
       std::lock_guard lock(mutex_);
       const auto it = param_replies_.find(in.id());
-      if (it != param_replies_.end())
-        it->second = ParamResult{in.ok(),         in.gateway(), in.value(), in.error_code(),
-                                 in.error(),      in.index(),   in.subindex()};
+      if (it == param_replies_.end()) return;
+      ParamResult r;
+      r.ok = in.ok();
+      r.gateway = in.gateway();
+      r.error_code = in.error_code();
+      r.error = in.error();
+      r.index = in.index();
+      r.subindex = in.subindex();
+      // A type this client does not know (a newer gateway's) shows as raw bytes.
+      r.type = core::param_type_from_name(in.type()).value_or(core::ParamType::Unknown);
+      r.data = in.data();
+      it->second = std::move(r);
     });
   }
 

@@ -14,6 +14,8 @@
 #include <utility>
 #include <vector>
 
+#include "core/param_value.hpp"
+
 namespace drivegate::client {
 
 using Millis = std::chrono::milliseconds;
@@ -161,20 +163,26 @@ struct ParamRequest {
   bool write = false;
   std::uint16_t index = 0;
   std::uint8_t subindex = 0;
-  std::uint8_t size = 4;
-  bool is_signed = false;
-  std::int64_t value = 0;
-  std::string name;  // the object by name (EDS ParameterName, SD6 "A83"); replaces index/subindex
+  std::string name;   // the object by name (EDS ParameterName, SD6 "A83"); replaces index/subindex
+  std::string type;   // empty: the type the axis' EDS or the standards give; else u8..u64, i8..i64,
+                      // r32, r64, bool, string, unicode, octets, domain (core/param_value.hpp)
+  std::string value;  // write: the value as text ("1000", "-5", "0x1F", "2.5", "name", "01 02 0a")
 };
 
 struct ParamResult {
   bool ok = false;
   std::string gateway;
-  std::int64_t value = 0;
   std::uint32_t error_code = 0;
   std::string error;
   std::uint16_t index = 0;  // the object the gateway accessed
   std::uint8_t subindex = 0;
+  core::ParamType type = core::ParamType::Unknown;  // what `data` is (Unknown: raw bytes)
+  std::vector<std::uint8_t> data;                   // the object's bytes as on the bus (read or written)
+
+  // The value as text: decimal integers, reals, strings, else hex bytes (core::format_param).
+  [[nodiscard]] std::string text() const { return core::format_param(type, data); }
+  // An integer object's value; nullopt for other types.
+  [[nodiscard]] std::optional<std::int64_t> integer() const noexcept { return core::param_as_signed(type, data); }
 };
 
 // Which gateway a request goes to, or why none.

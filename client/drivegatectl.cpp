@@ -17,6 +17,7 @@
 namespace {
 
 using namespace drivegate::client;
+namespace core = drivegate::core;
 using SteadyClock = std::chrono::steady_clock;
 using StringSet = std::set<std::string, std::less<>>;
 
@@ -49,10 +50,12 @@ constexpr CommandHelp kCommands[] = {
     {"events", "events [--follow] [AXIS]", "recent events (faults, warnings, state changes); --follow keeps printing",
      0, 1},
     {"param",
-     "param get AXIS OBJECT [--size 1|2|4] [--signed]\n"
-     "  param set AXIS OBJECT VALUE [--size 1|2|4] [--signed]\n"
+     "param get AXIS OBJECT [--type TYPE]\n"
+     "  param set AXIS OBJECT VALUE [--type TYPE]\n"
      "  OBJECT is INDEX[:SUB] in hex (6060, 0x6099:1, 6060h) or a name: an EDS ParameterName or a\n"
-     "  vendor parameter such as A83 (a name gives size and sign when the axis has an EDS)",
+     "  vendor parameter such as A83. The type comes from the axis' EDS, the device profile or CiA\n"
+     "  301/402; --type names it otherwise: u8 u16 u24 u32 u40 u48 u56 u64, i8 .. i64, r32 r64, bool,\n"
+     "  string, unicode, octets, domain (VALUE: decimal or 0x hex, a real, text, hex bytes \"01 02 0a\")",
      "read/write a drive object; INDEX is hex (0x optional), SUB decimal or 0x-hex", 3, 4},
     {"buses", "buses", "bus status: cycle timing, lateness, frame counters", 0, 0},
 };
@@ -396,6 +399,53 @@ bool is_object_name(std::string_view text) {
   return !(index.back() == 'h' || index.back() == 'H');
 }
 
+// How a parameter value reads: "0x00020192 (131474)" for objects read in hex, quoted text for
+// strings, a hex dump for long byte strings, and the type named.
+std::string describe_value(const ParamResult& r) {
+  const std::string cia(core::param_type_cia_name(r.type));
+  const std::string size = std::to_string(r.data.size()) + (r.data.size() == 1 ? " byte" : " bytes");
+  if (r.type == core::ParamType::Unknown)
+    return core::hex_bytes(r.data) + " (" + size + "; type not known: give --type to decode)";
+  if (const auto error = core::param_size_error(r.type, r.data.size()); !error.empty())
+    return core::hex_bytes(r.data) + " (" + error + ")";
+  const std::string text = r.text();
+  if (r.type == core::ParamType::VisibleString || r.type == core::ParamType::UnicodeString)
+    return "\"" + text + "\" (" + cia + ", " + size + ")";
+  if (const auto hex = core::format_param_hex(r.type, r.data)) {
+    if (core::param_reads_as_hex(r.index, r.subindex)) return *hex + " (" + text + ", " + cia + ")";
+    return text + " (" + *hex + ", " + cia + ")";
+  }
+  if (r.data.size() <= 16) return text + " (" + cia + ")";
+  std::string dump = "(" + cia + ", " + size + ")";
+  for (std::size_t at = 0; at < r.data.size(); at += 16) {
+    char offset[32];
+    std::snprintf(offset, sizeof offset, "\n  %04zx: ", at);
+    dump += offset;
+    dump += core::hex_bytes(std::span<const std::uint8_t>(r.data).subspan(at, std::min<std::size_t>(16, r.data.size() - at)));
+  }
+  return dump;
+}
+
+void json_value(JsonWriter& w, const ParamResult& r) {
+  const bool fits = core::param_size_error(r.type, r.data.size()).empty();
+  w.field("type", core::param_type_name(r.type));
+  w.field("size", static_cast<std::uint64_t>(r.data.size()));
+  w.field("bytes", std::string_view(core::hex_bytes(r.data)));
+  if (!fits || r.type == core::ParamType::Unknown) return;
+  if (r.type == core::ParamType::Bool && r.data[0] <= 1) {
+    w.field("value", r.data[0] != 0);
+  } else if (core::param_type_is_signed(r.type)) {
+    w.field("value", *core::param_as_signed(r.type, r.data));
+  } else if (core::param_type_is_integer(r.type)) {
+    w.field("value", *core::param_as_unsigned(r.type, r.data));
+  } else if (core::param_type_is_real(r.type)) {
+    w.field("value", *core::param_as_real(r.type, r.data));
+  } else {
+    w.field("value", std::string_view(r.text()));
+  }
+  if (const auto hex = core::format_param_hex(r.type, r.data)) w.field("hex", std::string_view(*hex));
+}
+
 int cmd_param(Context& ctx) {
   const std::string& op = word(ctx, 0, "get|set");
   if (op != "get" && op != "set") throw UsageError("param: expected 'get' or 'set', got '" + op + "'");
@@ -413,21 +463,19 @@ int cmd_param(Context& ctx) {
     req.subindex = addr.sub;
   }
   req.write = write;
-  req.is_signed = ctx.args.flag("signed");
-  req.size = static_cast<std::uint8_t>(parse_integer("--size", ctx.args.option_or("size", "4"), 1, 4));
-  if (req.size == 3) throw UsageError("--size must be 1, 2 or 4");
-  if (write) {
-    const unsigned bits = 8U * req.size;
-    const std::int64_t min = req.is_signed ? -(std::int64_t{1} << (bits - 1)) : 0;
-    const std::int64_t max = req.is_signed ? (std::int64_t{1} << (bits - 1)) - 1 : (std::int64_t{1} << bits) - 1;
-    req.value = parse_integer("VALUE", word(ctx, 3, "VALUE"), min, max);
-  }
+  req.type = ctx.args.option_or("type", "");
+  if (!req.type.empty() && !core::param_type_from_name(req.type))
+    throw UsageError("--type: unknown type '" + req.type +
+                     "'; use u8, u16, u24, u32, u40, u48, u56, u64, i8 .. i64, r32, r64, bool, string, unicode, "
+                     "octets, domain, time_of_day or time_difference");
+  if (write) req.value = word(ctx, 3, "VALUE");
   const ParamResult r = ctx.client.param(req, ctx.timeout);
   char where[96];
   if (req.name.empty())
-    std::snprintf(where, sizeof where, "%04X:%u", req.index, static_cast<unsigned>(req.subindex));
+    std::snprintf(where, sizeof where, "%04Xh:%02X", req.index, static_cast<unsigned>(req.subindex));
   else if (r.ok)
-    std::snprintf(where, sizeof where, "%.60s (%04X:%u)", req.name.c_str(), r.index, static_cast<unsigned>(r.subindex));
+    std::snprintf(where, sizeof where, "%.60s (%04Xh:%02X)", req.name.c_str(), r.index,
+                  static_cast<unsigned>(r.subindex));
   else
     std::snprintf(where, sizeof where, "%.60s", req.name.c_str());
   if (ctx.json) {
@@ -436,19 +484,15 @@ int cmd_param(Context& ctx) {
         .field("axis", std::string_view(req.axis))
         .field("gateway", std::string_view(r.gateway))
         .field("object", std::string_view(where))
+        .field("index", static_cast<std::uint64_t>(r.index))
+        .field("subindex", static_cast<std::uint64_t>(r.subindex))
         .field("write", write)
-        .field("ok", r.ok)
-        .field("value", r.ok && !write ? r.value : req.value)
-        .field("error_code", static_cast<std::uint64_t>(r.error_code))
-        .field("error", std::string_view(r.error))
-        .end_object();
+        .field("ok", r.ok);
+    if (r.ok) json_value(w, r);
+    w.field("error_code", static_cast<std::uint64_t>(r.error_code)).field("error", std::string_view(r.error)).end_object();
     std::cout << w.str() << std::endl;
   } else if (r.ok) {
-    if (write) {
-      std::cout << req.axis << " " << where << " = " << req.value << " written\n";
-    } else {
-      std::cout << req.axis << " " << where << " = " << r.value << "\n";
-    }
+    std::cout << req.axis << " " << where << " = " << describe_value(r) << (write ? " written" : "") << "\n";
   }
   if (r.ok) return 0;
   char code[24] = "";
@@ -510,7 +554,7 @@ StringSet options_of(std::string_view command) {
   if (command == "torque") add({"for"});
   if (command == "home") add({"method", "offset"});
   if (command == "events") add({"follow"});
-  if (command == "param") add({"size", "signed"});
+  if (command == "param") add({"type"});
   return s;
 }
 

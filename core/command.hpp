@@ -6,11 +6,14 @@
 // Two unit worlds meet here (DESIGN.md §4): `Command`, `Setpoint` and `AxisSnapshot` are in user
 // units (configured per axis); `DriveCommand`, `DriveSetpoint` and `DriveFeedback` are in the
 // drive's native units. AxisRunner (core/axis_runner.hpp) is the one place that converts.
+#include <array>
 #include <cstdint>
+#include <span>
 #include <type_traits>
 
 #include "core/axis_types.hpp"
 #include "core/fixed_string.hpp"
+#include "core/param_value.hpp"
 
 namespace drivegate::core {
 
@@ -140,25 +143,31 @@ struct Event {
   std::int64_t stamp_ns = 0;
 };
 
-// Parameter access by object index/sub-index (CiA 402 drives) for the DDS parameter topic.
+// Parameter access by object index/sub-index (CiA 402 drives) for the DDS parameter topic: the
+// object's bytes as they travel on the bus (little-endian), typed by core/param_value.hpp. The
+// daemon resolved the type (request, EDS, device profile) and encoded a write's value already.
 struct ParamRequest {
   CommandId id = 0;
   AxisIndex axis = kNoAxis;
   bool write = false;
   std::uint16_t index = 0;
   std::uint8_t sub = 0;
-  std::uint8_t size = 4;  // bytes: 1, 2 or 4
-  bool is_signed = false;
-  std::int64_t value = 0;  // write value
+  ParamType type = ParamType::Unknown;  // Unknown: reads take whatever size the drive sends
+  std::uint16_t size = 0;               // write: bytes in data
+  std::array<std::uint8_t, kMaxParamBytes> data{};
+  [[nodiscard]] std::span<const std::uint8_t> bytes() const noexcept { return {data.data(), size}; }
 };
 
 struct ParamReply {
   CommandId id = 0;
   AxisIndex axis = kNoAxis;
   bool ok = false;
-  std::int64_t value = 0;        // read result
   std::uint32_t error_code = 0;  // e.g. CiA 301 SDO abort code
   Text error;                    // in words
+  ParamType type = ParamType::Unknown;
+  std::uint16_t size = 0;  // bytes in data: what was read, or what was written
+  std::array<std::uint8_t, kMaxParamBytes> data{};
+  [[nodiscard]] std::span<const std::uint8_t> bytes() const noexcept { return {data.data(), size}; }
 };
 
 static_assert(std::is_trivially_copyable_v<Command>);

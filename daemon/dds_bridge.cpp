@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
+#include <cstdio>
 #include <deque>
 #include <map>
 #include <mutex>
@@ -28,6 +29,7 @@
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <spdlog/spdlog.h>
 
+#include "core/param_value.hpp"
 #include "daemon/log_limiter.hpp"
 #include "drivegate.h"
 #include "idl/dds_node.hpp"
@@ -95,6 +97,13 @@ Prefix prefix_of(const dds::InstanceHandle_t& h) {
   return p;
 }
 
+// "1008h:00", as the gateway names objects in its messages.
+std::string hex_object(std::uint16_t index, std::uint8_t sub) {
+  std::array<char, 16> buf{};
+  std::snprintf(buf.data(), buf.size(), "%04Xh:%02X", static_cast<unsigned>(index), static_cast<unsigned>(sub));
+  return buf.data();
+}
+
 struct Pending {
   std::string client;
   std::uint64_t client_id = 0;
@@ -104,7 +113,7 @@ struct Pending {
   std::uint8_t sub = 0;
 };
 
-// A reply (CommandReply or ParamReply) addressed to the client and request of `p`.
+// A reply (CommandReply or ParameterReply) addressed to the client and request of `p`.
 template <typename Reply>
 Reply reply_to(const std::string& gateway, const Pending& p) {
   Reply out;
@@ -196,8 +205,8 @@ class DdsBridge::Impl : private dds::DataWriterListener {
   void reject(const msg::AxisCommand& in, const Prefix& from, const std::string& reason, Clock::time_point now);
   void take_setpoints();
   void take_params(Clock::time_point now);
-  void handle_param(const msg::ParamRequest& in, const Prefix& from, Clock::time_point now);
-  void fail_param(const msg::ParamRequest& in, const Prefix& from, const std::string& error, Clock::time_point now);
+  void handle_param(const msg::ParameterRequest& in, const Prefix& from, Clock::time_point now);
+  void fail_param(const msg::ParameterRequest& in, const Prefix& from, const std::string& error, Clock::time_point now);
   void retry_deferred(Clock::time_point now);
   void take_gateway_infos();
   void collect_outbox(Clock::time_point now);
@@ -259,7 +268,7 @@ class DdsBridge::Impl : private dds::DataWriterListener {
   std::deque<Deferred<core::Command>> deferred_commands_;
   std::deque<Deferred<core::ParamRequest>> deferred_params_;
   std::deque<OutReply<msg::CommandReply>> replies_;
-  std::deque<OutReply<msg::ParamReply>> param_replies_;
+  std::deque<OutReply<msg::ParameterReply>> param_replies_;
   std::set<std::pair<std::string, std::string>> warned_duplicates_;  // (other gateway, axis)
   std::set<std::pair<std::string, std::string>> warned_setpoints_;   // (client, axis)
   std::set<std::uint64_t> warned_instances_;                         // other instances of this gateway
@@ -540,7 +549,7 @@ void DdsBridge::Impl::retry_deferred(Clock::time_point now) {
       deferred_params_, pending_params_, param_replies_,
       [&](const Deferred<core::ParamRequest>& d) { return rt_.submit_parameter(d.axis_id, d.request); },
       [&](const Pending& p) {
-        auto out = reply_to<msg::ParamReply>(gateway_, p);
+        auto out = reply_to<msg::ParameterReply>(gateway_, p);
         out.ok(false);
         out.error("busy: the gateway's parameter queue for axis '" + p.axis + "' stayed full for " + waited +
                   "; send it again");
@@ -572,7 +581,7 @@ void DdsBridge::Impl::take_setpoints() {
 }
 
 void DdsBridge::Impl::take_params(Clock::time_point now) {
-  msg::ParamRequest in;
+  msg::ParameterRequest in;
   dds::SampleInfo info;
   for (std::size_t n = 0; n < kTakePerPass && !busy(); ++n) {
     if (param_r_->take_next_sample(&in, &info) != ReturnCode_t::RETCODE_OK) break;
@@ -581,12 +590,12 @@ void DdsBridge::Impl::take_params(Clock::time_point now) {
   }
 }
 
-void DdsBridge::Impl::fail_param(const msg::ParamRequest& in, const Prefix& from, const std::string& error,
+void DdsBridge::Impl::fail_param(const msg::ParameterRequest& in, const Prefix& from, const std::string& error,
                                  Clock::time_point now) {
   if (warn_limit_.allow(now))
     spdlog::warn("dds: parameter request {:04X}:{} for axis '{}' from '{}' failed: {}", in.index(), in.subindex(),
                  in.axis(), in.client(), error);
-  auto out = reply_to<msg::ParamReply>(gateway_, Pending{in.client(), in.id(), in.axis(), from, 0, 0});
+  auto out = reply_to<msg::ParameterReply>(gateway_, Pending{in.client(), in.id(), in.axis(), from, 0, 0});
   out.ok(false);
   out.error(error);
   out.index(in.index());
@@ -594,33 +603,55 @@ void DdsBridge::Impl::fail_param(const msg::ParamRequest& in, const Prefix& from
   param_replies_.push_back({std::move(out), from, now});
 }
 
-void DdsBridge::Impl::handle_param(const msg::ParamRequest& in, const Prefix& from, Clock::time_point now) {
+void DdsBridge::Impl::handle_param(const msg::ParameterRequest& in, const Prefix& from, Clock::time_point now) {
   ++summary_params_;
   summary_clients_.insert(in.client());
   const auto axis = find_axis(in.axis());
   if (!axis)
     return fail_param(in, from,
                       "unknown axis '" + in.axis() + "' on gateway '" + gateway_ + "'; axes here: " + axis_list(), now);
+  const ParameterLookup p = rt_.lookup_parameter(*axis, in.name(), in.index(), in.subindex());
+  if (!p.ok) return fail_param(in, from, p.error, now);
+  const std::string where = hex_object(p.index, p.sub);
+  core::ParamType type = p.type;
+  if (!in.type().empty()) {
+    const auto asked = core::param_type_from_name(in.type());
+    if (!asked)
+      return fail_param(in, from,
+                        "unknown type '" + in.type() +
+                            "': use u8, u16, u24, u32, u40, u48, u56, u64, i8 .. i64, r32, r64, bool, string, "
+                            "unicode, octets, domain, time_of_day or time_difference",
+                        now);
+    const auto size_text = [](core::ParamType t) {
+      const std::size_t n = core::param_type_size(t);
+      return n == 0 ? std::string("any length") : std::to_string(n) + (n == 1 ? " byte" : " bytes");
+    };
+    if (p.type != core::ParamType::Unknown && *asked != p.type)
+      return fail_param(in, from,
+                        where + " is a " + std::string(core::param_type_cia_name(p.type)) + " (" + size_text(p.type) +
+                            ", per " + p.type_source + "), not a " + std::string(core::param_type_cia_name(*asked)) +
+                            " (" + size_text(*asked) + ")",
+                        now);
+    type = *asked;
+  }
   core::ParamRequest req;
   req.id = next_id_++;
   req.write = in.write();
-  req.index = in.index();
-  req.sub = in.subindex();
-  req.size = in.size();
-  req.is_signed = in.is_signed();
-  req.value = in.value();
-  if (!in.name().empty()) {
-    const ParameterLookup p = rt_.lookup_parameter(*axis, in.name());
-    if (!p.ok) return fail_param(in, from, p.error, now);
-    req.index = p.index;
-    req.sub = p.sub;
-    if (p.size != 0) {
-      req.size = p.size;
-      req.is_signed = p.is_signed;
-    }
+  req.index = p.index;
+  req.sub = p.sub;
+  req.type = type;
+  if (in.write()) {
+    if (type == core::ParamType::Unknown)
+      return fail_param(in, from,
+                        "the type of " + where +
+                            " is not known (not in the axis' EDS nor in CiA 301/402): give it (--type u16, string, "
+                            "domain, ...)",
+                        now);
+    const core::EncodedParam value = core::encode_param(type, in.value());
+    if (!value.error.empty()) return fail_param(in, from, where + ": " + value.error, now);
+    req.size = static_cast<std::uint16_t>(value.bytes.size());
+    std::copy(value.bytes.begin(), value.bytes.end(), req.data.begin());
   }
-  if (req.size != 1 && req.size != 2 && req.size != 4)
-    return fail_param(in, from, "parameter size must be 1, 2 or 4 bytes, got " + std::to_string(req.size), now);
   if (unanswered_[in.client()] >= kClientLimit)
     return fail_param(in, from,
                       "busy: client '" + in.client() + "' has " + std::to_string(kClientLimit) +
@@ -628,14 +659,14 @@ void DdsBridge::Impl::handle_param(const msg::ParamRequest& in, const Prefix& fr
                       now);
   ++unanswered_[in.client()];
   clients_of_[from].insert(in.client());
-  Pending p{in.client(), in.id(), in.axis(), from, req.index, req.sub};
+  Pending pending{in.client(), in.id(), in.axis(), from, req.index, req.sub};
   spdlog::debug("dds: parameter {} {:04X}:{} for axis '{}' from '{}' id {} -> request {}",
                 in.write() ? "write" : "read", req.index, req.sub, in.axis(), in.client(), in.id(), req.id);
   if (!rt_.submit_parameter(*axis, req)) {
-    deferred_params_.push_back({*axis, req, std::move(p), now});
+    deferred_params_.push_back({*axis, req, std::move(pending), now});
     return;
   }
-  pending_params_.emplace(req.id, std::move(p));
+  pending_params_.emplace(req.id, std::move(pending));
   count([](Stats& s) { ++s.params_routed; });
 }
 
@@ -725,9 +756,11 @@ void DdsBridge::Impl::collect_outbox(Clock::time_point now) {
       spdlog::debug("dds: parameter reply {} of no DDS client", p.reply.id);
       continue;
     }
-    auto out = reply_to<msg::ParamReply>(gateway_, it->second);
+    auto out = reply_to<msg::ParameterReply>(gateway_, it->second);
     out.ok(p.reply.ok);
-    out.value(p.reply.value);
+    out.type(std::string(core::param_type_name(p.reply.type)));
+    const auto bytes = p.reply.bytes();
+    out.data(std::vector<std::uint8_t>(bytes.begin(), bytes.end()));
     out.error_code(p.reply.error_code);
     out.error(p.reply.error.str());
     out.index(it->second.index);
@@ -784,7 +817,7 @@ void DdsBridge::Impl::forget_gone_clients() {
     if (it == clients_of_.end()) continue;
     for (const auto& name : it->second) {
       if (param) {
-        auto key = instance_key<msg::ParamReply>(gateway_, name);
+        auto key = instance_key<msg::ParameterReply>(gateway_, name);
         param_w_->unregister_instance(&key, dds::HANDLE_NIL);
       } else {
         auto key = instance_key<msg::CommandReply>(gateway_, name);

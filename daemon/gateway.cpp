@@ -9,6 +9,7 @@
 #include "config/eds.hpp"
 #include "config/parameter_names.hpp"
 #include "daemon/bus_factory.hpp"
+#include "profiles/cia402/standard_types.hpp"
 
 namespace drivegate::daemon {
 
@@ -314,9 +315,27 @@ std::vector<std::string> Gateway::scheduling_notes() const {
   return notes;
 }
 
-// EDS names first (they carry size and signedness), then the device's parameter naming (SD6
-// "A83"), so an EDS can also name vendor parameters.
-ParameterLookup Gateway::lookup_parameter(std::size_t axis_id, std::string_view name) const {
+namespace {
+
+// The type the device profile gives an object: its PDO maps and start-up writes name types.
+std::optional<core::ParamType> device_profile_type(const config::AxisPlan& axis, cia402::ObjectId id) {
+  const auto& dev = axis.device.canopen;
+  for (const auto* pdos : {&dev.rpdos, &dev.tpdos})
+    for (const auto& pdo : *pdos)
+      for (const auto& e : pdo.entries)
+        if (e.object == id) return cia402::to_param_type(e.type);
+  for (const auto* writes : {&dev.startup_writes, &axis.canopen.startup_writes})
+    for (const auto& w : *writes)
+      if (w.def.id == id) return cia402::to_param_type(w.def.type);
+  return std::nullopt;
+}
+
+}  // namespace
+
+// A name is an EDS ParameterName first, then the device's parameter naming (SD6 "A83"), so an
+// EDS can also name vendor parameters. The type comes from the EDS, else from the standards.
+ParameterLookup Gateway::lookup_parameter(std::size_t axis_id, std::string_view name, std::uint16_t index,
+                                          std::uint8_t sub) const {
   ParameterLookup out;
   if (axis_id >= refs_.size()) {
     out.error = "unknown axis";
@@ -324,33 +343,43 @@ ParameterLookup Gateway::lookup_parameter(std::size_t axis_id, std::string_view 
   }
   const AxisRef ref = refs_[axis_id];
   const config::AxisPlan& axis = buses_[ref.bus].plan->axes[ref.axis];
-  if (const config::EdsObject* o = config::find_eds_object(axis.canopen.eds_objects, name)) {
-    const auto type = config::eds_integer_type(o->data_type);
-    if (!type) {
-      out.error = "object '" + o->name + "' is of type " + config::eds_type_name(o->data_type) +
-                  "; parameters of 1, 2 or 4 bytes only";
+  const auto& eds = axis.canopen.eds_objects;
+  const config::EdsObject* entry = nullptr;
+  if (name.empty()) {
+    out.ok = true;
+    out.index = index;
+    out.sub = sub;
+    entry = config::find_eds_object(eds, cia402::ObjectId{index, sub});
+  } else if ((entry = config::find_eds_object(eds, name)) != nullptr) {
+    out.ok = true;
+    out.index = entry->id.index;
+    out.sub = entry->id.sub;
+  } else if (const auto& naming = axis.device.canopen.parameter_naming) {
+    const auto r = config::resolve_parameter_name(name, *naming);
+    if (!r.id) {
+      out.error = "'" + std::string(name) + "' is not a parameter of device " + axis.device.name + ": " + r.error;
       return out;
     }
     out.ok = true;
-    out.index = o->id.index;
-    out.sub = o->id.sub;
-    out.size = cia402::size_of(*type);
-    out.is_signed = cia402::is_signed(*type);
+    out.index = r.id->index;
+    out.sub = r.id->sub;
+    entry = config::find_eds_object(eds, *r.id);
+  } else {
+    out.error = "axis '" + axis.spec.name + "' has no object named '" + std::string(name) + "'" +
+                (axis.canopen.eds.empty() ? " (give the axis an EDS file to use names, or use INDEX:SUB)"
+                                          : " in its EDS");
     return out;
   }
-  if (const auto& naming = axis.device.canopen.parameter_naming) {
-    const auto r = config::resolve_parameter_name(name, *naming);
-    if (r.id) {
-      out.ok = true;
-      out.index = r.id->index;
-      out.sub = r.id->sub;
-      return out;
-    }
-    out.error = "'" + std::string(name) + "' is not a parameter of device " + axis.device.name + ": " + r.error;
-    return out;
+  if (entry != nullptr && core::param_type_from_cia(entry->data_type) != core::ParamType::Unknown) {
+    out.type = core::param_type_from_cia(entry->data_type);
+    out.type_source = "the EDS";
+  } else if (const auto from_profile = device_profile_type(axis, {out.index, out.sub})) {
+    out.type = *from_profile;
+    out.type_source = "device profile " + axis.device.name;
+  } else if (const auto t = cia402::standard_param_type({out.index, out.sub}); t != core::ParamType::Unknown) {
+    out.type = t;
+    out.type_source = out.index < 0x2000 ? "CiA 301" : "CiA 402";
   }
-  out.error = "axis '" + axis.spec.name + "' has no object named '" + std::string(name) + "'" +
-              (axis.canopen.eds.empty() ? " (give the axis an EDS file to use names, or use INDEX:SUB)" : " in its EDS");
   return out;
 }
 

@@ -52,7 +52,8 @@ class Gateway final : public Runtime {
   bool submit_command(std::size_t axis_id, const core::Command& cmd) override;
   bool submit_setpoint(std::size_t axis_id, const core::Setpoint& sp) override;
   bool submit_parameter(std::size_t axis_id, const core::ParamRequest& req) override;
-  ParameterLookup lookup_parameter(std::size_t axis_id, std::string_view name) const override;
+  ParameterLookup lookup_parameter(std::size_t axis_id, std::string_view name, std::uint16_t index,
+                                   std::uint8_t sub) const override;
   core::AxisSnapshot snapshot(std::size_t axis_id) const override;
   std::size_t bus_count() const noexcept override { return buses_.size(); }
   BusStatus bus_status(std::size_t bus) const override;

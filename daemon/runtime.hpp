@@ -65,15 +65,15 @@ struct Outbox {
   }
 };
 
-// An object named by a client (EDS ParameterName or a vendor parameter name), resolved for one
-// axis. size 0: the name does not say, the request's size applies.
+// The object a client asked for (by name, else by index/sub-index) on one axis, and its type as
+// the axis' EDS or the standards give it (Unknown when neither does).
 struct ParameterLookup {
   bool ok = false;
   std::uint16_t index = 0;
   std::uint8_t sub = 0;
-  std::uint8_t size = 0;
-  bool is_signed = false;
-  std::string error;  // why not ok, in words
+  core::ParamType type = core::ParamType::Unknown;
+  std::string type_source;  // "the EDS", "CiA 301", ... (for messages)
+  std::string error;        // why not ok, in words
 };
 
 class Runtime {
@@ -87,8 +87,10 @@ class Runtime {
   virtual bool submit_command(std::size_t axis_id, const core::Command& cmd) = 0;
   virtual bool submit_setpoint(std::size_t axis_id, const core::Setpoint& sp) = 0;
   virtual bool submit_parameter(std::size_t axis_id, const core::ParamRequest& req) = 0;
-  // The object `name` stands for on this axis (control plane only; may allocate).
-  [[nodiscard]] virtual ParameterLookup lookup_parameter(std::size_t axis_id, std::string_view name) const = 0;
+  // The object `name` stands for on this axis, or the object index:sub when `name` is empty, with
+  // its type (control plane only; may allocate).
+  [[nodiscard]] virtual ParameterLookup lookup_parameter(std::size_t axis_id, std::string_view name,
+                                                         std::uint16_t index, std::uint8_t sub) const = 0;
 
   [[nodiscard]] virtual core::AxisSnapshot snapshot(std::size_t axis_id) const = 0;
   [[nodiscard]] virtual std::size_t bus_count() const noexcept = 0;

@@ -97,8 +97,8 @@ dds::TopicDataType* make_type(TopicId t) {
     case TopicId::Setpoint: return new SetpointPubSubType();
     case TopicId::AxisEvent: return new AxisEventPubSubType();
     case TopicId::BusStatus: return new BusStatusPubSubType();
-    case TopicId::ParamRequest: return new ParamRequestPubSubType();
-    case TopicId::ParamReply: return new ParamReplyPubSubType();
+    case TopicId::ParamRequest: return new ParameterRequestPubSubType();
+    case TopicId::ParamReply: return new ParameterReplyPubSubType();
     case TopicId::GatewayInfo: return new GatewayInfoPubSubType();
   }
   return nullptr;

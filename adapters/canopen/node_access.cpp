@@ -30,27 +30,38 @@ cia402::RequestId NodeAccess::submit_write(cia402::ObjectDef def, std::int64_t v
                def.type);
 }
 
+cia402::RequestId NodeAccess::submit_upload(cia402::ObjectId id, std::span<std::uint8_t> into,
+                                            std::uint8_t expected_size) noexcept {
+  if (!operational_ || !slot_for(kNoSdoRequest)) return cia402::kNoRequest;
+  return track(sdo_.read_into(channel_, id, into, expected_size), cia402::DataType::U32);
+}
+
+cia402::RequestId NodeAccess::submit_download(cia402::ObjectId id, std::span<const std::uint8_t> data) noexcept {
+  if (!operational_ || !slot_for(kNoSdoRequest)) return cia402::kNoRequest;
+  return track(sdo_.write_from(channel_, id, data), cia402::DataType::U32);
+}
+
 cia402::RequestResult NodeAccess::poll(cia402::RequestId id) noexcept {
   Pending* p = id == cia402::kNoRequest ? nullptr : slot_for(id);
-  if (!p) return {cia402::RequestState::Unknown, 0, 0};
+  if (!p) return {};
   const SdoResult r = sdo_.result(id);
   switch (r.status) {
     case SdoStatus::Queued:
-    case SdoStatus::InFlight: return {cia402::RequestState::Pending, 0, 0};
+    case SdoStatus::InFlight: return {cia402::RequestState::Pending, 0, 0, 0, true};
     case SdoStatus::Done: {
       const auto type = p->type;
       sdo_.take(id);
       *p = {};
-      return {cia402::RequestState::Done, cia402::normalise(type, r.value), 0};
+      return {cia402::RequestState::Done, cia402::normalise(type, r.value), 0, r.size, r.size_indicated};
     }
     case SdoStatus::Failed:
       sdo_.take(id);
       *p = {};
-      return {cia402::RequestState::Failed, 0, r.abort_code};
+      return {cia402::RequestState::Failed, 0, r.abort_code, 0, true};
     case SdoStatus::Unknown: break;
   }
   *p = {};
-  return {cia402::RequestState::Unknown, 0, 0};
+  return {};
 }
 
 void NodeAccess::cancel(cia402::RequestId id) noexcept {

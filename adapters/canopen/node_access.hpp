@@ -6,6 +6,7 @@
 // profile never competes with the boot sequence for the SDO channel.
 #include <array>
 #include <cstdint>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -46,6 +47,9 @@ class NodeAccess final : public cia402::ObjectAccess {
 
   cia402::RequestId submit_read(cia402::ObjectDef def) noexcept override;
   cia402::RequestId submit_write(cia402::ObjectDef def, std::int64_t value) noexcept override;
+  cia402::RequestId submit_upload(cia402::ObjectId id, std::span<std::uint8_t> into,
+                                  std::uint8_t expected_size) noexcept override;
+  cia402::RequestId submit_download(cia402::ObjectId id, std::span<const std::uint8_t> data) noexcept override;
   cia402::RequestResult poll(cia402::RequestId id) noexcept override;
   void cancel(cia402::RequestId id) noexcept override;
   [[nodiscard]] cia402::DriveFaultReport fault_report() const noexcept override;

@@ -15,27 +15,6 @@ using core::AxisState;
 using core::CommandKind;
 using core::Mode;
 
-namespace {
-
-DataType param_type(std::uint8_t size, bool is_signed) noexcept {
-  switch (size) {
-    case 1: return is_signed ? DataType::I8 : DataType::U8;
-    case 2: return is_signed ? DataType::I16 : DataType::U16;
-    default: return is_signed ? DataType::I32 : DataType::U32;
-  }
-}
-
-bool fits(std::int64_t value, std::uint8_t size, bool is_signed) noexcept {
-  const unsigned bits = 8U * size;
-  if (is_signed) {
-    const std::int64_t max = (std::int64_t{1} << (bits - 1)) - 1;
-    return value >= -max - 1 && value <= max;
-  }
-  return value >= 0 && value <= (std::int64_t{1} << bits) - 1;
-}
-
-}  // namespace
-
 Cia402Master::Cia402Master(ObjectAccess& io, const MasterSettings& settings) noexcept
     : io_(io), settings_(settings), device_(settings.enable_step_timeout) {}
 
@@ -297,29 +276,38 @@ void Cia402Master::setpoint(const core::DriveSetpoint& sp, core::TimePoint /*now
 Admission Cia402Master::parameter(const core::ParamRequest& req, core::TimePoint /*now*/) noexcept {
   Admission no;
   no.accepted = false;
-  if (req.size != 1 && req.size != 2 && req.size != 4) {
-    no.reason.format("object size %u is not supported: use 1, 2 or 4 bytes", static_cast<unsigned>(req.size));
-    return no;
-  }
-  if (req.write && !fits(req.value, req.size, req.is_signed)) {
-    no.reason.format("value %lld does not fit in a %u-byte %s object", static_cast<long long>(req.value),
-                     static_cast<unsigned>(req.size), req.is_signed ? "signed" : "unsigned");
-    return no;
-  }
-  if (req.write && profile_owns(ObjectId{req.index, req.sub})) {
-    no.reason.format("%04Xh is driven by the CiA 402 profile; use the axis commands", static_cast<unsigned>(req.index));
-    return no;
-  }
-  if (const auto owner = req.write ? io_.owner_of(ObjectId{req.index, req.sub}) : std::string_view{}; !owner.empty()) {
-    no.reason.format("%04Xh:%02X is %.*s: a write would take the drive out of the gateway's control; change the "
-                     "configuration instead",
-                     static_cast<unsigned>(req.index), static_cast<unsigned>(req.sub), static_cast<int>(owner.size()),
-                     owner.data());
-    return no;
+  const ObjectId id{req.index, req.sub};
+  if (req.write) {
+    // The daemon encoded the value for its type; a request that disagrees with itself is refused
+    // rather than sent cut short.
+    const std::size_t fixed = core::param_type_size(req.type);
+    if (req.size == 0 || req.size > req.data.size()) {
+      no.reason.format("a parameter write carries 1 to %zu bytes, not %u", req.data.size(), static_cast<unsigned>(req.size));
+      return no;
+    }
+    if (fixed != 0 && fixed != req.size) {
+      no.reason.format("%u bytes do not fit a %.*s, which has %zu", static_cast<unsigned>(req.size),
+                       static_cast<int>(core::param_type_cia_name(req.type).size()),
+                       core::param_type_cia_name(req.type).data(), fixed);
+      return no;
+    }
+    if (profile_owns(id)) {
+      no.reason.format("%04Xh is driven by the CiA 402 profile; use the axis commands", static_cast<unsigned>(req.index));
+      return no;
+    }
+    if (const auto owner = io_.owner_of(id); !owner.empty()) {
+      no.reason.format("%04Xh:%02X is %.*s: a write would take the drive out of the gateway's control; change the "
+                       "configuration instead",
+                       static_cast<unsigned>(req.index), static_cast<unsigned>(req.sub),
+                       static_cast<int>(owner.size()), owner.data());
+      return no;
+    }
   }
   for (auto& p : params_) {
     if (p.active) continue;
-    p = PendingParam{true, req, ObjectDef{{req.index, req.sub}, param_type(req.size, req.is_signed)}, kNoRequest};
+    p.active = true;
+    p.req = req;
+    p.request = kNoRequest;
     return Admission::accept();
   }
   no.reason.format("%zu parameter requests already in flight for this axis: try again later", params_.size());

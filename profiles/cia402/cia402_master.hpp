@@ -73,10 +73,10 @@ class Cia402Master final : public core::AxisController {
     RequestId write = kNoRequest;
     bool written = false;
   };
+  // A parameter request from admission to reply; an upload lands in req.data (unused by a read).
   struct PendingParam {
     bool active = false;
     core::ParamRequest req{};
-    ObjectDef def{};
     RequestId request = kNoRequest;
   };
 

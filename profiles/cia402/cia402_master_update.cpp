@@ -2,6 +2,9 @@
 // feedback.
 
 #include "profiles/cia402/cia402_master.hpp"
+
+#include <algorithm>
+
 #include "profiles/cia402/controlword.hpp"
 #include "profiles/cia402/master_helpers.hpp"
 #include "profiles/cia402/op_modes.hpp"
@@ -302,8 +305,11 @@ void Cia402Master::write_outputs() noexcept {
 void Cia402Master::run_parameters(core::ControllerSink& sink) noexcept {
   for (auto& p : params_) {
     if (!p.active) continue;
+    const ObjectId id{p.req.index, p.req.sub};
+    const std::size_t fixed = core::param_type_size(p.req.type);
     if (p.request == kNoRequest) {
-      p.request = p.req.write ? io_.submit_write(p.def, p.req.value) : io_.submit_read(p.def);
+      const auto expected = static_cast<std::uint8_t>(fixed <= 4 ? fixed : 0);
+      p.request = p.req.write ? io_.submit_download(id, p.req.bytes()) : io_.submit_upload(id, p.req.data, expected);
       continue;  // kNoRequest again: the adapter's queue is full, retry next cycle
     }
     const RequestResult r = io_.poll(p.request);
@@ -311,13 +317,30 @@ void Cia402Master::run_parameters(core::ControllerSink& sink) noexcept {
     core::ParamReply reply;
     reply.id = p.req.id;
     reply.axis = p.req.axis;
+    reply.type = p.req.type;
+    const auto type_name = core::param_type_cia_name(p.req.type);
     if (r.state == RequestState::Done) {
-      reply.ok = true;
-      reply.value = p.req.write ? p.req.value : r.value;
+      const std::size_t size = p.req.write ? p.req.size : std::min<std::size_t>(r.size, p.req.data.size());
+      if (!p.req.write && fixed != 0 && size != fixed) {
+        // Never a value cut to size or padded: the drive's object is not what the type says.
+        reply.error.format("%04Xh:%02X: the drive sent %zu bytes, a %.*s has %zu", static_cast<unsigned>(id.index),
+                           static_cast<unsigned>(id.sub), size, static_cast<int>(type_name.size()), type_name.data(),
+                           fixed);
+      } else if (!p.req.write && !r.size_known) {
+        // Four bytes came, but how many of them are the object only its type says
+        // (stoeber-sd6-canopen.md §6.4: expedited uploads without a size).
+        reply.error.format("%04Xh:%02X: the drive did not say how long the object is (expedited upload without a "
+                           "size) and its type is not known: name the type (--type u8, u16, ...)",
+                           static_cast<unsigned>(id.index), static_cast<unsigned>(id.sub));
+      } else {
+        reply.ok = true;
+        reply.size = static_cast<std::uint16_t>(size);
+        std::copy_n(p.req.data.begin(), size, reply.data.begin());
+      }
     } else if (r.state == RequestState::Failed) {
       reply.error_code = r.abort_code;
-      reply.error.format("%04Xh:%02X: %s (abort code 0x%08X)", static_cast<unsigned>(p.def.id.index),
-                         static_cast<unsigned>(p.def.id.sub), sdo_abort_text(r.abort_code).data(),
+      reply.error.format("%04Xh:%02X: %s (abort code 0x%08X)", static_cast<unsigned>(id.index),
+                         static_cast<unsigned>(id.sub), sdo_abort_text(r.abort_code).data(),
                          static_cast<unsigned>(r.abort_code));
     } else {
       reply.error.assign("request lost by the bus adapter");

@@ -5,6 +5,7 @@
 //
 // All calls happen on the bus' cycle thread and must not allocate or block.
 #include <cstdint>
+#include <span>
 #include <string_view>
 
 #include "profiles/cia402/objects.hpp"
@@ -28,6 +29,9 @@ struct RequestResult {
   RequestState state = RequestState::Unknown;
   std::int64_t value = 0;        // read result (sign-extended per the object's type)
   std::uint32_t abort_code = 0;  // CiA 301 SDO abort code or CoE equivalent when Failed
+  std::uint32_t size = 0;        // submit_upload(): bytes the drive sent into the caller's buffer
+  bool size_known = true;        // false: the drive did not say how many of them are the object's
+                                 // (CANopen expedited upload without size, and no expected size)
 };
 
 class ObjectAccess {
@@ -48,6 +52,14 @@ class ObjectAccess {
   // Returns kNoRequest when the adapter's request queue is full (try again next cycle).
   virtual RequestId submit_read(ObjectDef def) noexcept = 0;
   virtual RequestId submit_write(ObjectDef def, std::int64_t value) noexcept = 0;
+  // Objects of any size as bytes (parameters: strings, domains, 64-bit values). The upload puts
+  // the drive's bytes into `into` (a longer object fails: CiA 301 abort 05040005h, out of memory);
+  // `expected_size` (1..4, or 0) is the object's size when the caller knows it, for drives that
+  // answer an expedited upload without a size (stoeber-sd6-canopen.md §6.4). The download sends
+  // `data` as it is. The caller's buffer stays in use until poll() reports Done or Failed, or until
+  // cancel(); a cancelled transfer in the middle of a segmented exchange is aborted on the bus.
+  virtual RequestId submit_upload(ObjectId id, std::span<std::uint8_t> into, std::uint8_t expected_size) noexcept = 0;
+  virtual RequestId submit_download(ObjectId id, std::span<const std::uint8_t> data) noexcept = 0;
   // Done/Failed results are reported once and then forgotten (later polls say Unknown).
   virtual RequestResult poll(RequestId id) noexcept = 0;
   // The caller no longer wants the result of `id` (command superseded or failed, link lost): the

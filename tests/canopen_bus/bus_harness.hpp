@@ -12,6 +12,7 @@
 #include "adapters/canopen/sim/sim_network.hpp"
 #include "config/loader.hpp"
 #include "core/bus_runner.hpp"
+#include "tests/support/param_request.hpp"
 
 namespace drivegate::canopen::test {
 
@@ -109,15 +110,10 @@ struct BusHarness {
   }
   // A parameter request through the runner, cycled until its reply arrives (2 s of virtual time).
   core::ParamReply param(const std::string& name, bool write, std::uint16_t index, std::uint8_t sub,
-                         std::uint8_t size, std::int64_t value = 0) {
-    core::ParamRequest r;
-    r.id = next_id++;
+                         core::ParamType type, std::string_view value = {}) {
+    core::ParamRequest r = write ? drivegate::test::param_write(next_id++, index, sub, type, value)
+                                 : drivegate::test::param_read(next_id++, index, sub, type);
     r.axis = axis(name);
-    r.write = write;
-    r.index = index;
-    r.sub = sub;
-    r.size = size;
-    r.value = value;
     EXPECT_TRUE(runner->push_parameter(r));
     core::ParamReply reply;
     EXPECT_TRUE(run_until([&] { return runner->pop_parameter_reply(reply); }, 2s)) << name << " " << index;

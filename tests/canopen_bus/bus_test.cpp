@@ -138,11 +138,8 @@ TEST(CanopenBus, CyclesAllocateNothingWhileAxesMove) {
     h.push(name, CommandKind::Move, 50.0);
   }
   h.cycle();
-  core::ParamRequest read;
+  core::ParamRequest read = drivegate::test::param_read(0, 0x6064, 0, core::ParamType::I32);
   read.axis = h.axis("sd6");
-  read.index = 0x6064;
-  read.size = 4;
-  read.is_signed = true;
   std::size_t params = 0, replies = 0, faults = 0, links = 0;
   const auto drain = [&] {
     core::Reply r;
@@ -365,22 +362,23 @@ TEST(CanopenBusParameters, ReadsWritesAndAbortsOverSdo) {
   BusHarness h;
   ASSERT_TRUE(h.run_until([&] { return h.all_up(); }, 5s)) << h.events_text();
   std::vector<core::ParamReply> got;
-  auto ask = [&](const std::string& axis, bool write, std::uint16_t index, std::uint8_t sub, std::uint8_t size,
-                 std::int64_t value = 0) { return h.param(axis, write, index, sub, size, value); };
-  auto r = ask("akd", false, 0x1018, 1, 4);
+  using core::ParamType;
+  auto ask = [&](const std::string& axis, bool write, std::uint16_t index, std::uint8_t sub, ParamType type,
+                 std::string_view value = {}) { return h.param(axis, write, index, sub, type, value); };
+  auto r = ask("akd", false, 0x1018, 1, ParamType::U32);
   ASSERT_TRUE(r.ok) << r.error.view();
-  EXPECT_EQ(r.value, 0x6A);  // Kollmorgen (AKD part 1 §14 vector 11)
-  r = ask("sd6", false, 0x1018, 1, 4);
+  EXPECT_EQ(drivegate::test::reply_integer(r), 0x6A);  // Kollmorgen (AKD part 1 §14 vector 11)
+  r = ask("sd6", false, 0x1018, 1, ParamType::U32);
   ASSERT_TRUE(r.ok) << r.error.view();
-  EXPECT_EQ(r.value, 0xB9);  // STÖBER, answered with 42h (SD6 D-2)
-  r = ask("sd6", false, 0x2053, 0, 1);  // A83: the node-ID
+  EXPECT_EQ(drivegate::test::reply_integer(r), 0xB9);  // STÖBER, answered with 42h (SD6 D-2)
+  r = ask("sd6", false, 0x2053, 0, ParamType::U8);  // A83: the node-ID
   ASSERT_TRUE(r.ok) << r.error.view();
-  EXPECT_EQ(r.value, 3);
-  r = ask("nord", false, 0x603F, 0, 2);  // NORD has no 603Fh (NORD §9)
+  EXPECT_EQ(drivegate::test::reply_integer(r), 3);
+  r = ask("nord", false, 0x603F, 0, ParamType::U16);  // NORD has no 603Fh (NORD §9)
   EXPECT_FALSE(r.ok);
   EXPECT_EQ(r.error_code, 0x06020000U);
   EXPECT_NE(std::string(r.error.view()).find("does not exist"), std::string::npos) << r.error.view();
-  r = ask("akd", true, 0x6081, 0, 4, 12345);
+  r = ask("akd", true, 0x6081, 0, ParamType::U32, "12345");
   ASSERT_TRUE(r.ok) << r.error.view();
   EXPECT_EQ(h.drive("akd").drive().read_object({0x6081, 0}).value, 12345);
 }

@@ -17,7 +17,7 @@ using core::ReplyStatus;
 
 core::ParamReply ask(BusHarness& h, const std::string& axis, bool write, std::uint16_t index, std::uint8_t sub,
                      std::uint8_t size, std::int64_t value = 0) {
-  return h.param(axis, write, index, sub, size, value);
+  return h.param(axis, write, index, sub, *core::integer_param_type(size, false), std::to_string(value));
 }
 
 bool has_event(const BusHarness& h, core::EventKind kind, const std::string& text) {
@@ -54,7 +54,7 @@ TEST(CanopenControl, WritesToObjectsTheGatewayConfiguredAreRefused) {
   // Nothing reached the drive: its RPDO 1 is still valid, and reading it is allowed.
   const auto r = ask(h, "akd", false, 0x1400, 1, 4);
   ASSERT_TRUE(r.ok) << r.error.view();
-  EXPECT_EQ(r.value & 0x80000000, 0);
+  EXPECT_EQ(drivegate::test::reply_integer(r) & 0x80000000, 0);
   // Other objects stay writable.
   EXPECT_TRUE(ask(h, "akd", true, 0x6081, 0, 4, 1000).ok);
 }

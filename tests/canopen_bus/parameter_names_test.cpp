@@ -1,5 +1,5 @@
 // Objects named by clients, resolved by the gateway for an axis: EDS ParameterNames (with their
-// size and sign) and the SD6's parameter names.
+// type) and the SD6's parameter names; the types of objects named by index.
 #include <gtest/gtest.h>
 
 #include "config/loader.hpp"
@@ -20,30 +20,68 @@ axes:
   const config::Plan plan = config::load_plan_from_string(yaml, "names.yaml");
   daemon::Gateway gw(plan);
 
-  auto p = gw.lookup_parameter(0, "fbus.param05");  // case-insensitive
+  auto p = gw.lookup_parameter(0, "fbus.param05", 0, 0);  // case-insensitive
   ASSERT_TRUE(p.ok) << p.error;
   EXPECT_EQ(p.index, 0x36E9);
   EXPECT_EQ(p.sub, 0);
-  EXPECT_EQ(p.size, 4);
-  p = gw.lookup_parameter(0, "Target torque");
+  EXPECT_EQ(p.type, core::ParamType::U32);
+  p = gw.lookup_parameter(0, "Target torque", 0, 0);
   ASSERT_TRUE(p.ok) << p.error;
   EXPECT_EQ(p.index, 0x6071);
-  EXPECT_EQ(p.size, 2);
-  EXPECT_TRUE(p.is_signed);
-  p = gw.lookup_parameter(0, "A83");  // the AKD has no parameter naming
+  EXPECT_EQ(p.type, core::ParamType::I16);
+  EXPECT_EQ(p.type_source, "the EDS");
+  p = gw.lookup_parameter(0, "A83", 0, 0);  // the AKD has no parameter naming
   EXPECT_FALSE(p.ok);
   EXPECT_NE(p.error.find("in its EDS"), std::string::npos) << p.error;
 
-  p = gw.lookup_parameter(1, "A83");
+  p = gw.lookup_parameter(1, "A83", 0, 0);
   ASSERT_TRUE(p.ok) << p.error;
   EXPECT_EQ(p.index, 0x2053);
-  EXPECT_EQ(p.size, 0);  // no EDS: the request's size applies
-  p = gw.lookup_parameter(1, "E200[0]");  // SD6 TV-6
+  EXPECT_EQ(p.type, core::ParamType::Unknown);  // no EDS, not in the profile: the request names it
+  p = gw.lookup_parameter(1, "E200[0]", 0, 0);  // SD6 TV-6
   ASSERT_TRUE(p.ok) << p.error;
   EXPECT_EQ(p.index, 0x28C8);
-  p = gw.lookup_parameter(1, "A540");
+  p = gw.lookup_parameter(1, "A540", 0, 0);
   EXPECT_FALSE(p.ok);
   EXPECT_NE(p.error.find("A540"), std::string::npos) << p.error;
+}
+
+// Without a name the object is index:sub, typed by the EDS, then the device profile (its PDO maps
+// and start-up writes), then CiA 301/402; anything else stays unknown.
+TEST(ParameterNames, TypesFromEdsProfileAndStandards) {
+  const std::string yaml = std::string(R"(gateway: { name: types }
+buses:
+  - { name: can0, type: canopen, cycle_time: 4ms, options: { transport: sim, bitrate: 1000000 } }
+axes:
+  - { name: akd, bus: can0, address: 1, device: kollmorgen-akd, unit: mm, mechanics: { feed: 5 },
+      canopen: { eds: ")") + DRIVEGATE_TEST_EDS + R"(" } }
+  - { name: sd6, bus: can0, address: 3, device: stoeber-sd6, mechanics: { encoder_counts_per_rev: 10000 } }
+)";
+  const config::Plan plan = config::load_plan_from_string(yaml, "types.yaml");
+  daemon::Gateway gw(plan);
+  struct Case {
+    std::size_t axis;
+    std::uint16_t index;
+    std::uint8_t sub;
+    core::ParamType type;
+    const char* source;
+  } cases[] = {
+      {1, 0x1008, 0, core::ParamType::VisibleString, "CiA 301"},
+      {1, 0x1018, 2, core::ParamType::U32, "CiA 301"},
+      {1, 0x1400, 2, core::ParamType::U8, "CiA 301"},
+      {1, 0x1800, 3, core::ParamType::U16, "CiA 301"},
+      {1, 0x6064, 0, core::ParamType::I32, "device profile stoeber-sd6"},  // its TPDO 1 maps it
+      {1, 0x6098, 0, core::ParamType::I8, "CiA 402"},
+      {1, 0x2053, 0, core::ParamType::Unknown, ""},
+      {0, 0x6071, 0, core::ParamType::I16, "the EDS"},
+  };
+  for (const auto& c : cases) {
+    const auto p = gw.lookup_parameter(c.axis, "", c.index, c.sub);
+    ASSERT_TRUE(p.ok) << p.error;
+    EXPECT_EQ(p.index, c.index);
+    EXPECT_EQ(p.type, c.type) << std::hex << c.index << ":" << int(c.sub);
+    EXPECT_EQ(p.type_source, c.source) << std::hex << c.index << ":" << int(c.sub);
+  }
 }
 
 }  // namespace

@@ -173,8 +173,9 @@ TEST_F(CanopenE2eBadInput, MalformedAndUnexpectedFramesAreCountedAndDropped) {
   client::ParamRequest a83;
   a83.axis = "sd6";
   a83.name = "A83";
+  a83.type = "u8";
   const auto p = client_->param(a83, 5s);
-  EXPECT_TRUE(p.ok && p.value == 3) << p.error;
+  EXPECT_TRUE(p.ok && p.data == std::vector<std::uint8_t>{3}) << p.error;
   EXPECT_TRUE(client_->wait_until([&] { return bus_status()->frames_received > received + 100; }, 5s));
   std::string status;
   EXPECT_TRUE(sim_->wait_status([](const std::string& s) {

@@ -59,8 +59,7 @@ TEST_F(CanopenE2eControl, ADriveThatStopsFollowingIsStoppedAndReconfigured) {
   p.write = true;
   p.index = 0x1400;
   p.subindex = 1;
-  p.size = 4;
-  p.value = 0x80000201;
+  p.value = "0x80000201";
   const auto refused = client_->param(p, 5s);
   EXPECT_FALSE(refused.ok);
   EXPECT_NE(refused.error.find("owned by the CANopen bus (RPDO communication parameter)"), std::string::npos)

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <utility>
+#include <vector>
 
 #include "adapters/canopen/master/sdo_client.hpp"
 #include "adapters/canopen/sim/sdo_server.hpp"
@@ -228,6 +229,67 @@ TEST(SdoLoopback, SilentServerMakesTheClientRetryAndGiveUp) {
   const auto again = client.read(0, {0x1000, 0});
   bus.run(kT0 + 1s);
   EXPECT_EQ(client.result(again).value, 0x00020192U);
+}
+
+// Objects beyond the client's own slots travel through the caller's buffer: a 4 KiB upload and
+// download whole, an object longer than the buffer aborted with 05040005h, and a cancel in the
+// middle of a transfer aborts it on the bus at once so the buffer is free.
+TEST(SdoLoopback, CallerBuffersCarryFourKilobytes) {
+  TestBackend od;
+  Bytes blob(4096);
+  for (std::size_t i = 0; i < blob.size(); ++i) blob[i] = static_cast<std::uint8_t>(i * 7 + 1);
+  od.add(kObject, blob);
+  od.add({0x2101, 0}, {});
+  od.add({0x2102, 0}, {1, 2});
+  SdoServer server({0x605, 0x585, 1000ms, false}, od);
+  SdoServer* servers[] = {&server};
+  const SdoChannelConfig cfg{5, 1, 0, 0};
+  SdoClient client(std::span<const SdoChannelConfig>(&cfg, 1), SdoTiming{});
+  Loop bus(client, servers);
+
+  std::vector<std::uint8_t> into(4096);
+  auto id = client.read_into(0, kObject, into);
+  ASSERT_NE(id, kNoSdoRequest);
+  bus.run(kT0, 2000);
+  SdoResult r = client.take(id);
+  ASSERT_EQ(r.status, SdoStatus::Done) << std::hex << r.abort_code;
+  EXPECT_EQ(r.size, 4096);
+  EXPECT_EQ(into, blob);
+  EXPECT_EQ(bus.take_client_frames(), frames_for(4096));
+
+  id = client.write_from(0, {0x2101, 0}, blob);
+  bus.run(kT0, 2000);
+  EXPECT_EQ(client.take(id).status, SdoStatus::Done);
+  EXPECT_EQ(od.value({0x2101, 0}), blob);
+
+  std::vector<std::uint8_t> small(100);
+  id = client.read_into(0, kObject, small);
+  bus.run(kT0, 2000);
+  r = client.take(id);
+  EXPECT_EQ(r.status, SdoStatus::Failed);
+  EXPECT_EQ(r.abort_code, 0x05040005U);
+  bus.round(kT0);  // the abort goes out
+  EXPECT_FALSE(server.transfer_open());
+  EXPECT_EQ(server.counters().aborts_received, 1U);
+
+  // Cancelled after the first segment: the client aborts (08000000h), writes nothing more into
+  // the buffer, and the channel is free for the next request.
+  std::fill(into.begin(), into.end(), 0);
+  id = client.read_into(0, kObject, into);
+  bus.round(kT0);
+  bus.round(kT0);
+  ASSERT_EQ(client.result(id).status, SdoStatus::InFlight);
+  client.cancel(id);
+  EXPECT_EQ(client.pending(0), 0U);
+  const auto before = into;
+  bus.round(kT0);  // the abort goes out
+  EXPECT_FALSE(server.transfer_open());
+  EXPECT_EQ(server.counters().aborts_received, 2U);
+  EXPECT_EQ(into, before);
+  EXPECT_EQ(client.result(id).status, SdoStatus::Unknown);
+  id = client.read(0, {0x2102, 0});
+  bus.run(kT0, 2000);
+  EXPECT_EQ(client.take(id).status, SdoStatus::Done);
 }
 
 }  // namespace

@@ -196,12 +196,13 @@ TEST(SdoServerErrors, IdleTransferTimesOutWith05040000) {
 
 TEST(SdoServerErrors, SizeLimitsAndMismatches) {
   TestBackend od;
-  od.add({0x3000, 0}, Bytes(300, 0xAB));
+  static_assert(SdoServer::kBufferSize == 4096);
+  od.add({0x3000, 0}, Bytes(4140, 0xAB));
   od.add(kTvObject, {});
   SdoServer s(kNode5, od);
-  // More than the 256-byte buffer: out of memory, either direction.
+  // More than the 4 KiB buffer: out of memory, either direction.
   EXPECT_EQ(ask(s, {0x40, 0x00, 0x30, 0x00, 0, 0, 0, 0}), Frames{abort_frame({0x00, 0x30, 0x00}, 0x05040005)});
-  EXPECT_EQ(ask(s, {0x21, 0x00, 0x30, 0x00, 0x2C, 0x01, 0, 0}), Frames{abort_frame({0x00, 0x30, 0x00}, 0x05040005)});
+  EXPECT_EQ(ask(s, {0x21, 0x00, 0x30, 0x00, 0x2C, 0x10, 0, 0}), Frames{abort_frame({0x00, 0x30, 0x00}, 0x05040005)});
   // Announced 8 bytes, sent 14.
   ask(s, {0x21, 0x00, 0x20, 0x01, 0x08, 0, 0, 0});
   ask(s, {0x00, 1, 2, 3, 4, 5, 6, 7});

@@ -94,7 +94,7 @@ inline Conversation sd6_tv2() {
 // and writes then touch fixed storage only.
 class TestBackend final : public sim::SdoBackend {
  public:
-  static constexpr std::size_t kCapacity = 300;  // more than the server's buffer, to test its limit
+  static constexpr std::size_t kCapacity = 4140;  // more than the server's buffer, to test its limit
 
   TestBackend() { entries_.reserve(64); }
 

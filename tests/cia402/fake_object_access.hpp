@@ -2,9 +2,11 @@
 // A scripted stand-in for a bus adapter: a small object dictionary (some objects "mapped" into the
 // cyclic image), acyclic requests that finish after a set number of polls, and per-object aborts.
 // Fixed-size storage so that it allocates nothing while the master runs (alloc test).
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <string_view>
 
 #include "profiles/cia402/object_access.hpp"
@@ -71,17 +73,58 @@ class FakeObjectAccess final : public ObjectAccess {
     if (id != kNoRequest && log_count_ < log_.size()) log_[log_count_++] = Logged{def.id, v};
     return id;
   }
+  // Byte-level requests see an object as its bytes: those given by set_bytes(), else the value's
+  // four little-endian bytes.
+  void set_bytes(ObjectId id, std::span<const std::uint8_t> b) noexcept {
+    Object& o = slot(id);
+    o.size = std::min(b.size(), o.bytes.size());
+    std::copy_n(b.begin(), o.size, o.bytes.begin());
+  }
+  [[nodiscard]] std::span<const std::uint8_t> bytes(ObjectId id) noexcept {
+    Object& o = slot(id);
+    return {o.bytes.data(), o.size};
+  }
+  RequestId submit_upload(ObjectId id, std::span<std::uint8_t> into, std::uint8_t /*expected*/) noexcept override {
+    ++reads_;
+    const RequestId r = add_request(ObjectDef{id, DataType::U32}, false, 0);
+    if (Request* req = find(r)) req->into = into;
+    return r;
+  }
+  RequestId submit_download(ObjectId id, std::span<const std::uint8_t> data) noexcept override {
+    const RequestId r = add_request(ObjectDef{id, DataType::U32}, true, 0);
+    Request* req = find(r);
+    if (req == nullptr) return r;
+    req->bytes = true;
+    req->size = std::min(data.size(), req->data.size());
+    std::copy_n(data.begin(), req->size, req->data.begin());
+    if (log_count_ < log_.size()) log_[log_count_++] = Logged{id, static_cast<std::int64_t>(le(data))};
+    return r;
+  }
   RequestResult poll(RequestId id) noexcept override {
     for (auto& r : requests_) {
       if (!r.used || r.id != id) continue;
-      if (--r.polls_left > 0) return {RequestState::Pending, 0, 0};
+      if (--r.polls_left > 0) return {RequestState::Pending, 0, 0, 0, true};
       r.used = false;
       Object& o = slot(r.def.id);
-      if (o.abort != 0) return {RequestState::Failed, 0, o.abort};
+      if (o.abort != 0) return {RequestState::Failed, 0, o.abort, 0, true};
+      if (r.bytes) {
+        set_bytes(r.def.id, {r.data.data(), r.size});
+        o.value = static_cast<std::int64_t>(le({r.data.data(), r.size}));
+        return {RequestState::Done, 0, 0, 0, true};
+      }
       if (r.write) o.value = r.value;
-      return {RequestState::Done, o.value, 0};
+      if (!r.into.empty()) {
+        std::array<std::uint8_t, 4> four{};
+        for (std::size_t i = 0; i < four.size(); ++i) four[i] = static_cast<std::uint8_t>(o.value >> (8 * i));
+        const std::span<const std::uint8_t> from = o.size != 0 ? std::span<const std::uint8_t>(o.bytes.data(), o.size)
+                                                               : std::span<const std::uint8_t>(four);
+        if (from.size() > r.into.size()) return {RequestState::Failed, 0, 0x05040005, 0, true};
+        std::copy(from.begin(), from.end(), r.into.begin());
+        return {RequestState::Done, 0, 0, static_cast<std::uint32_t>(from.size()), true};
+      }
+      return {RequestState::Done, o.value, 0, 0, true};
     }
-    return {RequestState::Unknown, 0, 0};
+    return {};
   }
   void cancel(RequestId id) noexcept override {
     for (auto& r : requests_) {
@@ -102,6 +145,8 @@ class FakeObjectAccess final : public ObjectAccess {
     std::int64_t value = 0;
     bool mapped = false;
     std::uint32_t abort = 0;
+    std::array<std::uint8_t, 64> bytes{};
+    std::size_t size = 0;  // 0: the object is its value
   };
   struct Request {
     bool used = false;
@@ -110,7 +155,21 @@ class FakeObjectAccess final : public ObjectAccess {
     bool write = false;
     std::int64_t value = 0;
     int polls_left = 0;
+    std::span<std::uint8_t> into{};  // submit_upload()
+    bool bytes = false;              // submit_download(): data[0..size)
+    std::array<std::uint8_t, 64> data{};
+    std::size_t size = 0;
   };
+  static std::uint64_t le(std::span<const std::uint8_t> b) noexcept {
+    std::uint64_t v = 0;
+    for (std::size_t i = std::min<std::size_t>(b.size(), 8); i-- > 0;) v = (v << 8) | b[i];
+    return v;
+  }
+  Request* find(RequestId id) noexcept {
+    for (auto& r : requests_)
+      if (r.used && r.id == id) return &r;
+    return nullptr;
+  }
 
   Object& slot(ObjectId id) noexcept {
     for (auto& o : objects_) {
@@ -118,7 +177,9 @@ class FakeObjectAccess final : public ObjectAccess {
     }
     for (auto& o : objects_) {
       if (!o.used) {
-        o = Object{true, id, 0, false, 0};
+        o = Object{};
+        o.used = true;
+        o.id = id;
         return o;
       }
     }
@@ -128,7 +189,13 @@ class FakeObjectAccess final : public ObjectAccess {
     if (queue_full_) return kNoRequest;
     for (auto& r : requests_) {
       if (r.used) continue;
-      r = Request{true, ++next_id_, def, write, v, latency_};
+      r = Request{};
+      r.used = true;
+      r.id = ++next_id_;
+      r.def = def;
+      r.write = write;
+      r.value = v;
+      r.polls_left = latency_;
       return r.id;
     }
     return kNoRequest;

@@ -3,22 +3,19 @@
 
 #include "tests/cia402/master_harness.hpp"
 #include "tests/support/alloc_counter.hpp"
+#include "tests/support/param_request.hpp"
 
 namespace drivegate::cia402::test {
 namespace {
 
 using core::CommandKind;
 
+// A 1, 2 or 4-byte unsigned parameter request, the value encoded as the daemon encodes it.
 core::ParamRequest param(core::CommandId id, std::uint16_t index, std::uint8_t sub, std::uint8_t size, bool write,
                          std::int64_t value = 0) {
-  core::ParamRequest r;
-  r.id = id;
-  r.index = index;
-  r.sub = sub;
-  r.size = size;
-  r.write = write;
-  r.value = value;
-  return r;
+  const auto type = *core::integer_param_type(size, false);
+  return write ? drivegate::test::param_write(id, index, sub, type, std::to_string(value))
+               : drivegate::test::param_read(id, index, sub, type);
 }
 
 TEST(Parameters, ReadAndWriteThroughAcyclicRequests) {
@@ -34,7 +31,7 @@ TEST(Parameters, ReadAndWriteThroughAcyclicRequests) {
   ASSERT_EQ(h.sink.params.size(), 2U);
   EXPECT_TRUE(h.sink.params[0].ok);
   EXPECT_EQ(h.sink.params[0].id, 11U);
-  EXPECT_EQ(h.sink.params[0].value, 10000);
+  EXPECT_EQ(drivegate::test::reply_integer(h.sink.params[0]), 10000);
   EXPECT_TRUE(h.sink.params[1].ok);
   EXPECT_EQ(h.io.value(obj::kProfileAcceleration.id), 50);
 }
@@ -56,18 +53,60 @@ TEST(Parameters, AbortCodeAndTextAreReported) {
 
 TEST(Parameters, BadRequestsAreRejected) {
   Harness h;
-  EXPECT_FALSE(h.master.parameter(param(1, 0x6040, 0, 3, false), h.now).accepted);
-  const auto a = h.master.parameter(param(2, 0x6040, 0, 2, true, 70000), h.now);
+  // A write whose bytes disagree with its type never reaches the drive cut short.
+  auto wrong = param(2, 0x6081, 0, 4, true, 70000);
+  wrong.size = 3;
+  auto a = h.master.parameter(wrong, h.now);
   EXPECT_FALSE(a.accepted);
-  EXPECT_EQ(a.reason.view(), "value 70000 does not fit in a 2-byte unsigned object");
-  EXPECT_FALSE(h.master.parameter(param(3, 0x6040, 0, 1, true, -1), h.now).accepted);
-  auto s = param(4, 0x607C, 0, 1, true, -128);
-  s.is_signed = true;
-  EXPECT_TRUE(h.master.parameter(s, h.now).accepted);
-  for (core::CommandId id = 5; id < 5 + Cia402Master::kMaxParameterRequests - 1; ++id) {
+  EXPECT_EQ(a.reason.view(), "3 bytes do not fit a UNSIGNED32, which has 4");
+  auto empty = param(3, 0x6081, 0, 4, true, 1);
+  empty.size = 0;
+  EXPECT_FALSE(h.master.parameter(empty, h.now).accepted);
+  // Type unknown: a write of any length goes (the drive checks it).
+  auto raw = drivegate::test::param_write(4, 0x2000, 0, core::ParamType::Domain, "01 02 03");
+  raw.type = core::ParamType::Unknown;
+  EXPECT_TRUE(h.master.parameter(raw, h.now).accepted);
+  for (core::CommandId id = 5; id < 4 + Cia402Master::kMaxParameterRequests; ++id) {
     EXPECT_TRUE(h.master.parameter(param(id, 0x1000, 0, 4, false), h.now).accepted);
   }
-  EXPECT_FALSE(h.master.parameter(param(99, 0x1000, 0, 4, false), h.now).accepted);
+  a = h.master.parameter(param(99, 0x1000, 0, 4, false), h.now);
+  EXPECT_FALSE(a.accepted);
+  EXPECT_TRUE(a.busy);
+}
+
+// Objects of any size travel as bytes; an upload whose size disagrees with the type is an error
+// naming both sizes, never a value cut to size.
+TEST(Parameters, StringsAndSizeMismatches) {
+  Harness h;
+  h.io.set_latency(1);
+  const std::string name = "drivegate simulated servo drive";  // 31 bytes: segmented on CANopen
+  h.io.set_bytes(ObjectId{0x1008, 0}, std::span(reinterpret_cast<const std::uint8_t*>(name.data()), name.size()));
+  h.io.set_bytes(ObjectId{0x2001, 0}, std::array<std::uint8_t, 2>{0x34, 0x12});
+  h.cycle(kSwSwitchOnDisabled);
+  ASSERT_TRUE(h.master.parameter(drivegate::test::param_read(1, 0x1008, 0, core::ParamType::VisibleString), h.now).accepted);
+  ASSERT_TRUE(h.master.parameter(drivegate::test::param_read(2, 0x1008, 0, core::ParamType::U32), h.now).accepted);
+  ASSERT_TRUE(h.master.parameter(drivegate::test::param_read(3, 0x2001, 0, core::ParamType::U32), h.now).accepted);
+  ASSERT_TRUE(h.master.parameter(drivegate::test::param_read(4, 0x2001, 0), h.now).accepted);
+  ASSERT_TRUE(h.master.parameter(drivegate::test::param_write(5, 0x2002, 0, core::ParamType::U64, "0x1122334455667788"), h.now).accepted);
+  h.cycle(kSwSwitchOnDisabled);
+  h.cycle(kSwSwitchOnDisabled);
+  ASSERT_EQ(h.sink.params.size(), 5U);
+  const auto& str = h.sink.params[0];
+  ASSERT_TRUE(str.ok) << str.error.view();
+  EXPECT_EQ(str.type, core::ParamType::VisibleString);
+  EXPECT_EQ(std::string(reinterpret_cast<const char*>(str.data.data()), str.size), name);
+  EXPECT_FALSE(h.sink.params[1].ok);
+  EXPECT_EQ(h.sink.params[1].error.view(), "1008h:00: the drive sent 31 bytes, a UNSIGNED32 has 4");
+  EXPECT_FALSE(h.sink.params[2].ok);
+  EXPECT_EQ(h.sink.params[2].error.view(), "2001h:00: the drive sent 2 bytes, a UNSIGNED32 has 4");
+  ASSERT_TRUE(h.sink.params[3].ok);  // type unknown: the bytes as they came
+  EXPECT_EQ(h.sink.params[3].size, 2U);
+  EXPECT_EQ(h.sink.params[3].data[0], 0x34);
+  ASSERT_TRUE(h.sink.params[4].ok);
+  const auto written = h.io.bytes(ObjectId{0x2002, 0});
+  ASSERT_EQ(written.size(), 8U);
+  EXPECT_EQ(written[0], 0x88);
+  EXPECT_EQ(written[7], 0x11);
 }
 
 TEST(Parameters, QueueFullIsRetried) {

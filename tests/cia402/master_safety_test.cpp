@@ -5,6 +5,7 @@
 
 #include "profiles/cia402/controlword.hpp"
 #include "tests/cia402/master_harness.hpp"
+#include "tests/support/param_request.hpp"
 
 namespace drivegate::cia402::test {
 namespace {
@@ -13,14 +14,7 @@ using core::CommandKind;
 using core::Mode;
 
 core::ParamRequest write_param(core::CommandId id, std::uint16_t index, std::int64_t value) {
-  core::ParamRequest r;
-  r.id = id;
-  r.index = index;
-  r.size = 4;
-  r.is_signed = true;
-  r.write = true;
-  r.value = value;
-  return r;
+  return drivegate::test::param_write(id, index, 0, core::ParamType::I32, std::to_string(value));
 }
 
 // --- 1. Safe holds ---
@@ -373,13 +367,7 @@ TEST(ControlSupervision, WritesToObjectsTheBusOwnsAreRefusedWithTheOwner) {
   Harness h;
   h.io.own(0x1400);
   h.cycle(kSwSwitchOnDisabled);
-  core::ParamRequest w;
-  w.id = 9;
-  w.write = true;
-  w.index = 0x1400;
-  w.sub = 1;
-  w.size = 4;
-  w.value = 0x80000201;
+  core::ParamRequest w = drivegate::test::param_write(9, 0x1400, 1, core::ParamType::U32, "0x80000201");
   const auto r = h.master.parameter(w, h.now);
   ASSERT_FALSE(r.accepted);
   EXPECT_NE(std::string(r.reason.view()).find("1400h:01 is owned by the test bus"), std::string::npos)

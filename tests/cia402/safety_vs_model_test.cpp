@@ -8,6 +8,7 @@
 
 #include "profiles/cia402/controlword.hpp"
 #include "tests/cia402/model_bench.hpp"
+#include "tests/support/param_request.hpp"
 
 namespace drivegate::cia402::test {
 namespace {
@@ -176,7 +177,7 @@ TEST(SafetyVsModel, SupersededMovesDoNotLeakRequestSlots) {
   core::ParamRequest rq;
   rq.id = 99;
   rq.index = 0x6041;
-  rq.size = 2;
+  rq.type = core::ParamType::U16;
   ASSERT_TRUE(b.master.parameter(rq, b.now).accepted);
   b.cycles(10);
   ASSERT_EQ(b.sink.params.size(), 1U);
@@ -212,13 +213,7 @@ TEST(SafetyVsModel, ParameterWriteToTheVelocityTargetIsRefused) {
   b.enable();
   ASSERT_TRUE(b.submit(command(2, CommandKind::SetMode, Mode::ProfileVelocity)));
   ASSERT_TRUE(b.run(2, 100));
-  core::ParamRequest rq;
-  rq.id = 7;
-  rq.write = true;
-  rq.index = 0x60FF;
-  rq.size = 4;
-  rq.is_signed = true;
-  rq.value = 20000;
+  core::ParamRequest rq = drivegate::test::param_write(7, 0x60FF, 0, core::ParamType::I32, "20000");
   const auto a = b.master.parameter(rq, b.now);
   EXPECT_FALSE(a.accepted);
   EXPECT_EQ(a.reason.view(), "60FFh is driven by the CiA 402 profile; use the axis commands");

@@ -79,14 +79,12 @@ class RawClient {
       c.velocity(20);
       c.immediate(true);
       while (cmd_w_->write(&c, fdds::HANDLE_NIL) == ReturnCode_t::RETCODE_TIMEOUT) ++write_waits_;
-      msg::ParamRequest p;
+      msg::ParameterRequest p;
       p.gateway(gateway);
       p.axis(i % 2 == 0 ? "x" : "y");
       p.client(name_);
       p.id(static_cast<std::uint64_t>(i + 1));
       p.index(0x6064);
-      p.size(4);
-      p.is_signed(true);
       if (i < kParamsPerClient)
         while (param_w_->write(&p, fdds::HANDLE_NIL) == ReturnCode_t::RETCODE_TIMEOUT) ++write_waits_;
     }
@@ -106,7 +104,7 @@ class RawClient {
       ++by_status_[r.status()];
       if (r.reason().rfind("busy", 0) == 0) ++busy_;
     }
-    msg::ParamReply p;
+    msg::ParameterReply p;
     while (param_r_->take_next_sample(&p, &info) == ReturnCode_t::RETCODE_OK) {
       if (!info.valid_data || p.client() != name_) continue;
       ++param_finals_[p.id()];

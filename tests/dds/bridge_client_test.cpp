@@ -379,7 +379,8 @@ TEST(DdsBridge, StatesArriveAtAboutTheConfiguredRate) {
 
 TEST(DdsBridge, ParameterGetAndSetRoundTrip) {
   FakeRuntime rt("gw1", {"x", "y"});
-  rt.set_object(1, 0x6060, 0, 1);
+  rt.set_object(1, 0x6060, 0, core::ParamType::I8, "1");
+  rt.set_object(1, 0x6081, 0, core::ParamType::I32, "0");
   daemon::DdsBridge bridge(rt, bridge_options());
   bridge.start();
   Client c(client_options());
@@ -387,26 +388,24 @@ TEST(DdsBridge, ParameterGetAndSetRoundTrip) {
   client::ParamRequest get;
   get.axis = "y";
   get.index = 0x6060;
-  get.size = 1;
-  get.is_signed = true;
   auto r = c.param(get, kTimeout);
   ASSERT_TRUE(r.ok) << r.error << seen(c);
-  EXPECT_EQ(r.value, 1);
+  EXPECT_EQ(r.type, core::ParamType::I8);
+  EXPECT_EQ(r.integer(), 1);
   EXPECT_EQ(r.gateway, "gw1");
 
   client::ParamRequest set = get;
   set.write = true;
   set.index = 0x6081;
-  set.size = 4;
-  set.value = -1234;
+  set.value = "-1234";
   r = c.param(set, kTimeout);
   ASSERT_TRUE(r.ok) << r.error;
-  EXPECT_EQ(rt.object(1, 0x6081, 0), -1234);
+  EXPECT_EQ(rt.object(1, 0x6081, 0), (std::vector<std::uint8_t>{0x2E, 0xFB, 0xFF, 0xFF}));
 
   get.index = 0x6081;
   r = c.param(get, kTimeout);
   ASSERT_TRUE(r.ok) << r.error;
-  EXPECT_EQ(r.value, -1234);
+  EXPECT_EQ(r.integer(), -1234);
 
   get.index = 0x1234;
   r = c.param(get, kTimeout);
@@ -415,15 +414,92 @@ TEST(DdsBridge, ParameterGetAndSetRoundTrip) {
   EXPECT_NE(r.error.find("does not exist"), std::string::npos);
 }
 
+// Every basic type end to end: strings, 64-bit integers, reals and byte strings of up to 4 KiB
+// come back byte for byte; a value or type that does not fit is an error naming both, never a
+// value cut short.
+TEST(DdsBridge, ParametersOfEveryType) {
+  FakeRuntime rt("gw1", {"x"});
+  rt.set_object(0, 0x1008, 0, core::ParamType::VisibleString, "drivegate simulated servo drive");
+  rt.set_object(0, 0x2001, 0, core::ParamType::U64, "0xFFFFFFFFFFFFFFF6");
+  rt.set_object(0, 0x2002, 0, core::ParamType::R32, "4.5");
+  rt.set_object(0, 0x2004, 0, core::ParamType::Unknown, "01 02 03");
+  std::string blob;
+  for (int i = 0; i < 4096; ++i) blob += (i % 16 == 0 ? "" : " ") + std::string(1, "0123456789ABCDEF"[i % 16]) + "A";
+  rt.set_object(0, 0x2003, 0, core::ParamType::Domain, blob);
+  daemon::DdsBridge bridge(rt, bridge_options());
+  bridge.start();
+  Client c(client_options());
+  const auto get = [&](std::uint16_t index, std::string type = {}) {
+    client::ParamRequest q;
+    q.axis = "x";
+    q.index = index;
+    q.type = std::move(type);
+    return c.param(q, kTimeout);
+  };
+  const auto set = [&](std::uint16_t index, std::string value, std::string type = {}) {
+    client::ParamRequest q;
+    q.axis = "x";
+    q.index = index;
+    q.write = true;
+    q.value = std::move(value);
+    q.type = std::move(type);
+    return c.param(q, kTimeout);
+  };
+
+  auto r = get(0x1008);
+  ASSERT_TRUE(r.ok) << r.error << seen(c);
+  EXPECT_EQ(r.type, core::ParamType::VisibleString);
+  EXPECT_EQ(r.text(), "drivegate simulated servo drive");
+  EXPECT_EQ(r.data.size(), 31U);
+  r = get(0x2001);
+  ASSERT_TRUE(r.ok) << r.error;
+  EXPECT_EQ(core::param_as_unsigned(r.type, r.data), 0xFFFFFFFFFFFFFFF6ULL);
+  EXPECT_EQ(r.text(), "18446744073709551606");
+  r = get(0x2002);
+  ASSERT_TRUE(r.ok) << r.error;
+  EXPECT_EQ(r.text(), "4.5");
+  r = get(0x2003);
+  ASSERT_TRUE(r.ok) << r.error;
+  ASSERT_EQ(r.data.size(), 4096U);
+  EXPECT_EQ(r.data[4095], 0xFA);
+  r = get(0x2004);  // type not known: the bytes as they are
+  ASSERT_TRUE(r.ok) << r.error;
+  EXPECT_EQ(r.type, core::ParamType::Unknown);
+  EXPECT_EQ(r.text(), "01 02 03");
+
+  ASSERT_TRUE(set(0x1008, "new name").ok);
+  EXPECT_EQ(rt.object(0, 0x1008, 0).size(), 8U);
+  ASSERT_TRUE(set(0x2002, "-1e3").ok);
+  EXPECT_EQ(get(0x2002).text(), "-1000");
+  ASSERT_TRUE(set(0x2004, "0a0b", "octets").ok);  // unknown to the gateway: the request names it
+
+  // Errors name the sizes and types; nothing reaches the object.
+  r = get(0x1008, "u32");
+  EXPECT_FALSE(r.ok);
+  EXPECT_EQ(r.error, "1008h:00 is a VISIBLE_STRING (any length, per the test's dictionary), not a UNSIGNED32 (4 bytes)");
+  r = set(0x2001, "-1");
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.error.find("outside the range of UNSIGNED64 (0 to 18446744073709551615)"), std::string::npos) << r.error;
+  r = set(0x2002, "nan");
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.error.find("not a finite number"), std::string::npos) << r.error;
+  r = set(0x2005, "12");
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.error.find("is not known"), std::string::npos) << r.error;
+  r = get(0x2001, "float128");
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.error.find("unknown type 'float128'"), std::string::npos) << r.error;
+  EXPECT_EQ(core::param_as_unsigned(core::ParamType::U64, rt.object(0, 0x2001, 0)), 0xFFFFFFFFFFFFFFF6ULL);
+}
+
 // Objects by name (EDS ParameterName or a vendor name): the gateway resolves index, sub-index
-// and, when the name says, size and signedness; the reply names the object accessed.
+// and type; the reply names the object accessed.
 TEST(DdsBridge, ParametersByName) {
   FakeRuntime rt("gw1", {"x"});
   daemon::ParameterLookup a83;
   a83.index = 0x2053;
-  a83.size = 1;
   rt.add_name("A83", a83);
-  rt.set_object(0, 0x2053, 0, 7);
+  rt.set_object(0, 0x2053, 0, core::ParamType::U8, "7");
   daemon::DdsBridge bridge(rt, bridge_options());
   bridge.start();
   Client c(client_options());
@@ -431,10 +507,9 @@ TEST(DdsBridge, ParametersByName) {
   client::ParamRequest get;
   get.axis = "x";
   get.name = "A83";
-  get.size = 3;  // ignored: the name gives the size
   auto r = c.param(get, kTimeout);
   ASSERT_TRUE(r.ok) << r.error << seen(c);
-  EXPECT_EQ(r.value, 7);
+  EXPECT_EQ(r.integer(), 7);
   EXPECT_EQ(r.index, 0x2053);
   EXPECT_EQ(r.subindex, 0);
 

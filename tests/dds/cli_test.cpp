@@ -88,32 +88,74 @@ TEST_F(Drivegatectl, ListStatusAndParam) {
   r = ctl("status x");
   EXPECT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("switch_on_disabled"), std::string::npos) << r.output;
-  rt_.set_object(0, 0x6061, 0, -3);
-  r = ctl("param get x 6061h:0 --size 1 --signed");
+  rt_.set_object(0, 0x6061, 0, core::ParamType::I8, "-3");
+  r = ctl("param get x 6061h:0");
   EXPECT_EQ(r.status, 0) << r.output;
-  EXPECT_NE(r.output.find("6061:0 = -3"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("x 6061h:00 = -3 (0xFD, INTEGER8)"), std::string::npos) << r.output;
+  rt_.set_object(0, 0x6081, 0, core::ParamType::U32, "0");
   r = ctl("param set x 0x6081 70000");
   EXPECT_EQ(r.status, 0) << r.output;
-  EXPECT_EQ(rt_.object(0, 0x6081, 0), 70000);
+  EXPECT_NE(r.output.find("x 6081h:00 = 70000 (0x00011170, UNSIGNED32) written"), std::string::npos) << r.output;
+  EXPECT_EQ(rt_.object(0, 0x6081, 0), (std::vector<std::uint8_t>{0x70, 0x11, 0x01, 0x00}));
+}
+
+// Every type prints the way people read it: identity in hex first, strings quoted, long byte
+// strings as a dump; --json carries the typed value, its hex and the raw bytes. A value that does
+// not fit fails with the reason and exit code 1.
+TEST_F(Drivegatectl, ParamTypesPrintAsTheyRead) {
+  rt_.set_object(0, 0x1018, 1, core::ParamType::U32, "0x6A");
+  CtlRun r = ctl("param get x 1018:1");
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("x 1018h:01 = 0x0000006A (106, UNSIGNED32)"), std::string::npos) << r.output;
+  rt_.set_object(0, 0x1008, 0, core::ParamType::VisibleString, "drivegate simulated servo drive");
+  r = ctl("param get x 0x1008");
+  EXPECT_NE(r.output.find("x 1008h:00 = \"drivegate simulated servo drive\" (VISIBLE_STRING, 31 bytes)"),
+            std::string::npos)
+      << r.output;
+  r = ctl("--json param get x 0x1008");
+  EXPECT_NE(r.output.find(R"("type":"string","size":31,"bytes":"64 72)"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(R"("value":"drivegate simulated servo drive")"), std::string::npos) << r.output;
+  rt_.set_object(0, 0x2001, 0, core::ParamType::U64, "0xFFFFFFFFFFFFFFF6");
+  r = ctl("--json param get x 2001");
+  EXPECT_NE(r.output.find(R"("value":18446744073709551606,"hex":"0xFFFFFFFFFFFFFFF6")"), std::string::npos)
+      << r.output;
+  rt_.set_object(0, 0x2002, 0, core::ParamType::R64, "-2.5e-3");
+  r = ctl("param get x 2002");
+  EXPECT_NE(r.output.find("x 2002h:00 = -0.0025 (REAL64)"), std::string::npos) << r.output;
+  rt_.set_object(0, 0x2003, 0, core::ParamType::Domain, "00 01 02 03 04 05 06 07 08 09 0a 0b 0c 0d 0e 0f 10 11");
+  r = ctl("param get x 2003");
+  EXPECT_NE(r.output.find("(DOMAIN, 18 bytes)\n  0000: 00 01 02 03 04 05 06 07 08 09 0A 0B 0C 0D 0E 0F\n  0010: 10 11"),
+            std::string::npos)
+      << r.output;
+  rt_.set_object(0, 0x2004, 0, core::ParamType::Unknown, "0102");
+  r = ctl("param get x 2004");
+  EXPECT_NE(r.output.find("= 01 02 (2 bytes; type not known: give --type to decode)"), std::string::npos) << r.output;
+  r = ctl("param get x 2004 --type i16");
+  EXPECT_NE(r.output.find("= 513 (0x0201, INTEGER16)"), std::string::npos) << r.output;
+  r = ctl("param set x 2001 -5");
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_NE(r.output.find("outside the range of UNSIGNED64"), std::string::npos) << r.output;
+  r = ctl("param get x 2001 --type quad");
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("--type: unknown type 'quad'"), std::string::npos) << r.output;
 }
 
 TEST_F(Drivegatectl, ParamByName) {
   daemon::ParameterLookup a83;
   a83.index = 0x2053;
-  a83.size = 1;
   rt_.add_name("A83", a83);
-  rt_.set_object(0, 0x2053, 0, 9);
+  rt_.set_object(0, 0x2053, 0, core::ParamType::U8, "9");
   CtlRun r = ctl("param get x A83");
   EXPECT_EQ(r.status, 0) << r.output;
-  EXPECT_NE(r.output.find("x A83 (2053:0) = 9"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("x A83 (2053h:00) = 9 (0x09, UNSIGNED8)"), std::string::npos) << r.output;
   r = ctl("param get x A999");
   EXPECT_EQ(r.status, 1) << r.output;
   EXPECT_NE(r.output.find("param get x A999: no object named 'A999'"), std::string::npos) << r.output;
   // With the h suffix a word that starts with a letter is an index.
-  rt_.set_object(0, 0xA83, 0, 5);
+  rt_.set_object(0, 0xA83, 0, core::ParamType::U8, "5");
   r = ctl("param get x A83h");
   EXPECT_EQ(r.status, 0) << r.output;
-  EXPECT_NE(r.output.find("0A83:0 = 5"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("0A83h:00 = 5"), std::string::npos) << r.output;
 }
 
 TEST_F(Drivegatectl, VelocityStreamsKeepAliveThenStops) {

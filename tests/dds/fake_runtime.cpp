@@ -1,5 +1,8 @@
 #include "fake_runtime.hpp"
 
+#include <algorithm>
+#include <stdexcept>
+
 namespace drivegate::dds_test {
 
 FakeRuntime::FakeRuntime(std::string gateway, std::vector<std::string> axis_names) : gateway_(std::move(gateway)) {
@@ -47,12 +50,27 @@ void FakeRuntime::add_name(std::string name, daemon::ParameterLookup object) {
   names_[std::move(name)] = object;
 }
 
-daemon::ParameterLookup FakeRuntime::lookup_parameter(std::size_t, std::string_view name) const {
+daemon::ParameterLookup FakeRuntime::lookup_parameter(std::size_t axis_id, std::string_view name,
+                                                      std::uint16_t index, std::uint8_t sub) const {
   std::lock_guard lock(mutex_);
-  if (const auto it = names_.find(std::string(name)); it != names_.end()) return it->second;
-  daemon::ParameterLookup none;
-  none.error = "no object named '" + std::string(name) + "'";
-  return none;
+  daemon::ParameterLookup out;
+  if (!name.empty()) {
+    const auto it = names_.find(std::string(name));
+    if (it == names_.end()) {
+      out.error = "no object named '" + std::string(name) + "'";
+      return out;
+    }
+    out = it->second;
+  } else {
+    out.ok = true;
+    out.index = index;
+    out.sub = sub;
+  }
+  if (const auto it = objects_.find(std::make_tuple(axis_id, out.index, out.sub)); it != objects_.end()) {
+    out.type = it->second.type;
+    out.type_source = "the test's dictionary";
+  }
+  return out;
 }
 
 bool FakeRuntime::submit_parameter(std::size_t axis_id, const core::ParamRequest& req) {
@@ -61,13 +79,20 @@ bool FakeRuntime::submit_parameter(std::size_t axis_id, const core::ParamRequest
   core::ParamReply r;
   r.id = req.id;
   r.axis = static_cast<core::AxisIndex>(axis_id);
+  r.type = req.type;
   const auto key = std::make_tuple(axis_id, req.index, req.sub);
+  const auto it = objects_.find(key);
   if (req.write) {
-    objects_[key] = req.value;
+    auto& o = objects_[key];
+    o.bytes.assign(req.bytes().begin(), req.bytes().end());
+    if (o.type == core::ParamType::Unknown) o.type = req.type;
     r.ok = true;
-  } else if (const auto it = objects_.find(key); it != objects_.end()) {
+    r.size = req.size;
+    std::copy_n(req.data.begin(), req.size, r.data.begin());
+  } else if (it != objects_.end()) {
     r.ok = true;
-    r.value = it->second;
+    r.size = static_cast<std::uint16_t>(it->second.bytes.size());
+    std::copy(it->second.bytes.begin(), it->second.bytes.end(), r.data.begin());
   } else {
     r.error_code = 0x06020000;  // CiA 301 SDO abort: object does not exist
     r.error.assign("object does not exist in the object dictionary");
@@ -115,9 +140,12 @@ void FakeRuntime::set_complete_commands(bool complete) {
   complete_ = complete;
 }
 
-void FakeRuntime::set_object(std::size_t axis_id, std::uint16_t index, std::uint8_t sub, std::int64_t value) {
+void FakeRuntime::set_object(std::size_t axis_id, std::uint16_t index, std::uint8_t sub, core::ParamType type,
+                             std::string_view value) {
+  const core::EncodedParam e = core::encode_param(type == core::ParamType::Unknown ? core::ParamType::Domain : type, value);
+  if (!e.error.empty()) throw std::invalid_argument("set_object: " + e.error);
   std::lock_guard lock(mutex_);
-  objects_[std::make_tuple(axis_id, index, sub)] = value;
+  objects_[std::make_tuple(axis_id, index, sub)] = Object{type, e.bytes};
 }
 
 void FakeRuntime::push_event(std::size_t axis_id, core::EventKind kind, std::string_view text) {
@@ -140,10 +168,10 @@ std::vector<std::pair<std::size_t, core::Setpoint>> FakeRuntime::setpoints() con
   return setpoints_;
 }
 
-std::int64_t FakeRuntime::object(std::size_t axis_id, std::uint16_t index, std::uint8_t sub) const {
+std::vector<std::uint8_t> FakeRuntime::object(std::size_t axis_id, std::uint16_t index, std::uint8_t sub) const {
   std::lock_guard lock(mutex_);
   const auto it = objects_.find(std::make_tuple(axis_id, index, sub));
-  return it == objects_.end() ? -1 : it->second;
+  return it == objects_.end() ? std::vector<std::uint8_t>{} : it->second.bytes;
 }
 
 }  // namespace drivegate::dds_test

@@ -21,7 +21,8 @@ class FakeRuntime final : public daemon::Runtime {
   bool submit_command(std::size_t axis_id, const core::Command& cmd) override;
   bool submit_setpoint(std::size_t axis_id, const core::Setpoint& sp) override;
   bool submit_parameter(std::size_t axis_id, const core::ParamRequest& req) override;
-  [[nodiscard]] daemon::ParameterLookup lookup_parameter(std::size_t axis_id, std::string_view name) const override;
+  [[nodiscard]] daemon::ParameterLookup lookup_parameter(std::size_t axis_id, std::string_view name,
+                                                         std::uint16_t index, std::uint8_t sub) const override;
   [[nodiscard]] core::AxisSnapshot snapshot(std::size_t axis_id) const override;
   [[nodiscard]] std::size_t bus_count() const noexcept override { return 1; }
   [[nodiscard]] daemon::BusStatus bus_status(std::size_t bus) const override;
@@ -30,7 +31,10 @@ class FakeRuntime final : public daemon::Runtime {
   // Test controls and observations.
   void set_busy(bool busy);
   void set_complete_commands(bool complete);  // false: reply Accepted only
-  void set_object(std::size_t axis_id, std::uint16_t index, std::uint8_t sub, std::int64_t value);
+  // An object and its type as the axis' EDS would give it (Unknown: the gateway would not know it);
+  // `value` as drivegatectl takes it.
+  void set_object(std::size_t axis_id, std::uint16_t index, std::uint8_t sub, core::ParamType type,
+                  std::string_view value);
   // Parameter names lookup_parameter() knows (for every axis).
   void add_name(std::string name, daemon::ParameterLookup object);
   void push_event(std::size_t axis_id, core::EventKind kind, std::string_view text);
@@ -40,7 +44,8 @@ class FakeRuntime final : public daemon::Runtime {
   };
   [[nodiscard]] std::vector<Received> commands() const;
   [[nodiscard]] std::vector<std::pair<std::size_t, core::Setpoint>> setpoints() const;
-  [[nodiscard]] std::int64_t object(std::size_t axis_id, std::uint16_t index, std::uint8_t sub) const;
+  // The object's bytes (empty when it does not exist).
+  [[nodiscard]] std::vector<std::uint8_t> object(std::size_t axis_id, std::uint16_t index, std::uint8_t sub) const;
 
  private:
   std::string gateway_;
@@ -51,7 +56,11 @@ class FakeRuntime final : public daemon::Runtime {
   bool complete_ = true;
   std::vector<Received> commands_;
   std::vector<std::pair<std::size_t, core::Setpoint>> setpoints_;
-  std::map<std::tuple<std::size_t, std::uint16_t, std::uint8_t>, std::int64_t> objects_;
+  struct Object {
+    core::ParamType type = core::ParamType::Unknown;
+    std::vector<std::uint8_t> bytes;
+  };
+  std::map<std::tuple<std::size_t, std::uint16_t, std::uint8_t>, Object> objects_;
   daemon::Outbox pending_;
 };
 

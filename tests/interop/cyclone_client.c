@@ -381,6 +381,7 @@ struct param_wait {
   int64_t value;
   uint32_t error_code;
   char error[256];
+  char type_error[96];
 };
 
 static bool take_param_reply(struct client *c, void *arg) {
@@ -390,13 +391,21 @@ static bool take_param_reply(struct client *c, void *arg) {
   const dds_return_t n = dds_take(c->param_reply_reader, samples, infos, MAX_TAKE, MAX_TAKE);
   if (n < 0) fail_setup("dds_take param_reply", n);
   for (dds_return_t i = 0; i < n && !w->have; i++) {
-    const drivegate_msg_ParamReply *r = samples[i];
+    const drivegate_msg_ParameterReply *r = samples[i];
     if (!infos[i].valid_data || strcmp(r->client, c->name) != 0 || r->id < w->first_id || r->id > w->last_id)
       continue;
     w->have = true;
     w->id = r->id;
-    w->ok = r->ok;
-    w->value = r->value;
+    /* The gateway types 6064h as INTEGER32 (CiA 402): four little-endian bytes. */
+    w->ok = r->ok && strcmp(r->type, "i32") == 0 && r->data._length == 4;
+    if (r->ok && !w->ok)
+      snprintf(w->type_error, sizeof w->type_error, "type '%s' with %" PRIu32 " bytes, expected i32 with 4", r->type,
+               r->data._length);
+    if (w->ok) {
+      uint32_t raw = 0;
+      for (int b = 3; b >= 0; b--) raw = (raw << 8) | r->data._buffer[b];
+      w->value = (int32_t)raw;
+    }
     w->error_code = r->error_code;
     snprintf(w->error, sizeof w->error, "%s", r->error);
   }
@@ -405,7 +414,7 @@ static bool take_param_reply(struct client *c, void *arg) {
 }
 
 static enum outcome param_read(struct client *c) {
-  drivegate_msg_ParamRequest req;
+  drivegate_msg_ParameterRequest req;
   memset(&req, 0, sizeof req);
   req.gateway = (char *)c->opt.gateway;
   req.axis = (char *)c->opt.axis;
@@ -413,9 +422,9 @@ static enum outcome param_read(struct client *c) {
   req.write = false;
   req.index = c->opt.param_index;
   req.subindex = c->opt.param_subindex;
-  req.size = 4;
-  req.is_signed = true;
   req.name = "";
+  req.type = ""; /* the gateway's type for the object */
+  req.value = "";
 
   struct param_wait w;
   memset(&w, 0, sizeof w);
@@ -443,8 +452,8 @@ static enum outcome param_read(struct client *c) {
     return r;
   }
   if (!w.ok) {
-    printf("param read %04" PRIX16 ":%" PRIX8 " id=%" PRIu64 ": FAILED error_code=0x%08" PRIX32 " %s (%.0f ms)\n",
-           req.index, req.subindex, w.id, w.error_code, w.error, ms);
+    printf("param read %04" PRIX16 ":%" PRIX8 " id=%" PRIu64 ": FAILED error_code=0x%08" PRIX32 " %s%s (%.0f ms)\n",
+           req.index, req.subindex, w.id, w.error_code, w.error, w.type_error, ms);
     return FAILED;
   }
   printf("param read %04" PRIX16 ":%" PRIX8 " id=%" PRIu64 ": ok value=%" PRId64 " (%.0f ms)\n", req.index,
@@ -479,9 +488,9 @@ int main(int argc, char **argv) {
    * discovered. */
   c.state_reader = make_reader(&c, &drivegate_msg_AxisState_desc, "axis_state", QOS_STATE);
   c.command_reply_reader = make_reader(&c, &drivegate_msg_CommandReply_desc, "command_reply", QOS_REPLY);
-  c.param_reply_reader = make_reader(&c, &drivegate_msg_ParamReply_desc, "param_reply", QOS_REPLY);
+  c.param_reply_reader = make_reader(&c, &drivegate_msg_ParameterReply_desc, "param_reply", QOS_REPLY);
   c.command_writer = make_writer(&c, &drivegate_msg_AxisCommand_desc, "axis_command");
-  c.param_writer = make_writer(&c, &drivegate_msg_ParamRequest_desc, "param_request");
+  c.param_writer = make_writer(&c, &drivegate_msg_ParameterRequest_desc, "param_request");
 
   printf("client %s on domain %" PRIu32 ", namespace %s, gateway %s, axis %s\n", c.name, c.opt.domain, c.opt.ns,
          c.opt.gateway, c.opt.axis);

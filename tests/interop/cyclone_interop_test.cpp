@@ -198,7 +198,7 @@ TEST(Interop, CycloneClientDrivesTheDaemon) {
                            "param read 6064:0 id="})
     EXPECT_NE(run.output.find(step), std::string::npos) << "no line '" << step << "' in\n" << run.output;
   // Both directions decode: doubles and strings of AxisState after the relative move of 1 mm from
-  // 0, and the int64 of ParamReply: 6064h position actual value, 1 mm = 26214.4 counts.
+  // 0, and the INTEGER32 bytes of ParameterReply: 6064h position actual value, 1 mm = 26214.4 counts.
   const double position = number_after(run.output, "axis_state after move:", "position=");
   EXPECT_NEAR(position, 1.0, 0.01) << run.output;
   const double counts = number_after(run.output, "param read 6064:0", "ok value=");

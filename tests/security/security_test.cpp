@@ -125,13 +125,13 @@ TEST_F(Security, AnEngineerReadsAndWritesParameters) {
   p.axis = "x";
   p.write = true;
   p.index = 0x6081;
-  p.value = 12345;
+  p.value = "12345";
   auto r = eng.param(p, 10s);
   ASSERT_TRUE(r.ok) << r.error;
   p.write = false;
   r = eng.param(p, 10s);
   ASSERT_TRUE(r.ok) << r.error;
-  EXPECT_EQ(r.value, 12345);
+  EXPECT_EQ(r.integer(), 12345);
   EXPECT_EQ(eng.send(request("x", "enable"), true, 10s).outcome, client::Outcome::Completed);
 }
 

@@ -79,6 +79,29 @@ SdoRequestId SdoClient::write_bytes(int channel, ObjectId object, std::span<cons
   return submit(channel, Kind::Download, object, 0, data);
 }
 
+SdoRequestId SdoClient::read_into(int channel, ObjectId object, std::span<std::uint8_t> into,
+                                  std::uint8_t expected_size) noexcept {
+  if (expected_size > 4 || into.empty() || into.size() > kMaxBuffer) return kNoSdoRequest;
+  return attach(submit(channel, Kind::Upload, object, expected_size, {}), into.data(), nullptr, into.size());
+}
+
+SdoRequestId SdoClient::write_from(int channel, ObjectId object, std::span<const std::uint8_t> data) noexcept {
+  if (data.empty() || data.size() > kMaxBuffer) return kNoSdoRequest;
+  // Four bytes or fewer go out expedited from the slot; no need to hold the caller's buffer.
+  if (data.size() <= 4) return submit(channel, Kind::Download, object, 0, data);
+  return attach(submit(channel, Kind::Download, object, 0, {}), nullptr, data.data(), data.size());
+}
+
+SdoRequestId SdoClient::attach(SdoRequestId id, std::uint8_t* into, const std::uint8_t* from, std::size_t size) noexcept {
+  Slot* s = id == kNoSdoRequest ? nullptr : find(id);
+  if (s == nullptr) return kNoSdoRequest;
+  s->into = into;
+  s->from = from;
+  s->size = from != nullptr ? static_cast<std::uint16_t>(size) : std::uint16_t{0};
+  s->capacity = into != nullptr ? static_cast<std::uint16_t>(size) : std::uint16_t{0};
+  return id;
+}
+
 SdoRequestId SdoClient::submit(int channel, Kind kind, ObjectId object, std::uint8_t expected_size,
                                std::span<const std::uint8_t> data) noexcept {
   if (channel < 0 || static_cast<std::size_t>(channel) >= channels_.size()) return kNoSdoRequest;
@@ -96,6 +119,10 @@ SdoRequestId SdoClient::submit(int channel, Kind kind, ObjectId object, std::uin
   slot.expected_size = expected_size;
   slot.size = static_cast<std::uint16_t>(data.size());
   slot.abort_code = 0;
+  slot.size_indicated = true;
+  slot.into = nullptr;
+  slot.from = nullptr;
+  slot.capacity = 0;
   std::copy(data.begin(), data.end(), slot.data.begin());
   const auto slot_no = static_cast<std::size_t>(free - ch.slots.begin());
   ch.fifo[(ch.fifo_head + ch.fifo_size) % kQueueDepth] = static_cast<std::uint8_t>(slot_no);
@@ -129,7 +156,8 @@ SdoResult SdoClient::result(SdoRequestId id) const noexcept {
       r.status = SdoStatus::Done;
       if (s->kind == Kind::Upload) {
         r.size = s->size;
-        if (s->size <= 4) r.value = get_le(s->data, 0, s->size);
+        r.size_indicated = s->size_indicated;
+        if (s->size <= 4) r.value = get_le({s->source(), s->size}, 0, s->size);
       }
       break;
     case SlotState::Failed:
@@ -145,7 +173,7 @@ SdoResult SdoClient::result(SdoRequestId id) const noexcept {
 std::span<const std::uint8_t> SdoClient::data(SdoRequestId id) const noexcept {
   const Slot* s = find(id);
   if (s == nullptr || s->state != SlotState::Done || s->kind != Kind::Upload) return {};
-  return {s->data.data(), s->size};
+  return {s->source(), s->size};
 }
 
 SdoResult SdoClient::take(SdoRequestId id) noexcept {
@@ -171,8 +199,12 @@ void SdoClient::cancel(SdoRequestId id) noexcept {
       s->state = SlotState::Free;
       break;
     }
-    // The server is in the middle of it: let the transfer end on the wire, forget the result.
-    case SlotState::InFlight: s->state = SlotState::Cancelled; break;
+    // The server is in the middle of it: let the transfer end on the wire, forget the result. A
+    // transfer through the caller's buffer cannot go on without it: it is aborted.
+    case SlotState::InFlight:
+      s->state = SlotState::Cancelled;
+      if (s->external()) fail_and_abort(ch, *s, sdo_abort_code::kGeneral);
+      break;
     case SlotState::Done:
     case SlotState::Failed: s->state = SlotState::Free; break;
     case SlotState::Free:
@@ -247,12 +279,17 @@ void SdoClient::on_upload(Channel& ch, Slot& slot, const SdoMessage& m) noexcept
       // 42h (no size) carries the object's own length, which only the caller knows
       // (stoeber-sd6-canopen.md §6.4); without it all four bytes are handed up.
       const std::uint8_t n = m.size_indicated || slot.expected_size == 0 ? m.length : slot.expected_size;
-      std::copy_n(m.data.begin(), n, slot.data.begin());
+      if (n > slot.room()) {
+        fail_and_abort(ch, slot, sdo_abort_code::kOutOfMemory);
+        return;
+      }
+      std::copy_n(m.data.begin(), n, slot.sink());
       slot.size = n;
+      slot.size_indicated = m.size_indicated || slot.expected_size != 0;
       finish(ch, slot, SlotState::Done, 0);
       return;
     }
-    if (m.size_indicated && m.size > kMaxData) {
+    if (m.size_indicated && m.size > slot.room()) {
       fail_and_abort(ch, slot, sdo_abort_code::kOutOfMemory);
       return;
     }
@@ -275,7 +312,7 @@ void SdoClient::on_upload(Channel& ch, Slot& slot, const SdoMessage& m) noexcept
     return;
   }
   const std::size_t received = std::size_t{ch.offset} + m.length;
-  if (received > kMaxData) {
+  if (received > slot.room()) {
     fail_and_abort(ch, slot, sdo_abort_code::kOutOfMemory);
     return;
   }
@@ -283,7 +320,7 @@ void SdoClient::on_upload(Channel& ch, Slot& slot, const SdoMessage& m) noexcept
     fail_and_abort(ch, slot, sdo_abort_code::kTooLong);
     return;
   }
-  std::copy_n(m.data.begin(), m.length, slot.data.begin() + ch.offset);
+  std::copy_n(m.data.begin(), m.length, slot.sink() + ch.offset);
   ch.offset = static_cast<std::uint16_t>(received);
   if (m.last) {
     if (ch.total_indicated && received != ch.total) {
@@ -335,7 +372,7 @@ void SdoClient::on_download(Channel& ch, Slot& slot, const SdoMessage& m) noexce
 void SdoClient::next_download_segment(Channel& ch, const Slot& slot) noexcept {
   const std::size_t n = std::min<std::size_t>(7, slot.size - ch.offset);
   ch.last_sent = ch.offset + n == slot.size;
-  ch.frame = sdo_download_segment(ch.toggle, {slot.data.data() + ch.offset, n}, ch.last_sent);
+  ch.frame = sdo_download_segment(ch.toggle, {slot.source() + ch.offset, n}, ch.last_sent);
   ch.offset = static_cast<std::uint16_t>(ch.offset + n);
   ch.frame_due = true;
   ch.deadline = core::TimePoint::max();
@@ -389,7 +426,9 @@ void SdoClient::start(Channel& ch, core::TimePoint now, TxQueue& tx) noexcept {
 
 SdoBytes SdoClient::initiate_frame(const Slot& slot) noexcept {
   if (slot.kind == Kind::Upload) return sdo_upload_request(slot.object);
-  if (slot.size <= 4) return sdo_download_expedited(slot.object, get_le(slot.data, 0, slot.size), static_cast<std::uint8_t>(slot.size));
+  if (slot.size <= 4)
+    return sdo_download_expedited(slot.object, get_le({slot.source(), slot.size}, 0, slot.size),
+                                  static_cast<std::uint8_t>(slot.size));
   return sdo_download_initiate(slot.object, slot.size);
 }
 

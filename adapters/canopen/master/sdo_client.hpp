@@ -5,9 +5,12 @@
 // reference drives and is not implemented.
 //
 // Channels are registered at construction time (node, channel number, COB-IDs); SD6 channels 2..4
-// use the STÖBER COB-IDs (cob::sdo_rx(channel, node)). Requests carry up to kMaxData bytes, enough
-// for identity strings and EDS-named objects; values of 1..4 bytes are the common case. A segmented
-// upload longer than kMaxData is aborted with 05040005h (out of memory) and fails with that code.
+// use the STÖBER COB-IDs (cob::sdo_rx(channel, node)). Requests carry up to kMaxData bytes in the
+// client's own slots (the boot's writes, identity reads); read_into() and write_from() transfer
+// larger objects (strings, domains) through the caller's buffer instead. An upload longer than its
+// buffer is aborted with 05040005h (out of memory) and fails with that code. A caller that cancels
+// a transfer with its own buffer in the middle of a segmented exchange gets its buffer back at
+// once: the client aborts the transfer on the bus with 08000000h (general error).
 //
 // Timeouts and retries: a request whose server does not answer within `timeout` is sent again from
 // its initiate frame up to `retries` times; then (or on a timeout in the middle of a segmented
@@ -57,6 +60,8 @@ struct SdoResult {
   std::uint32_t abort_code = 0;  // when Failed (server's code, or 05040000h timeout, 05030000h toggle)
   std::uint32_t value = 0;       // uploads of 1..4 bytes: little-endian value (zero-extended)
   std::uint16_t size = 0;        // bytes received (uploads)
+  bool size_indicated = true;    // false: an expedited upload without size (42h); `size` is then the
+                                 // caller's expected size, or all 4 bytes when it gave none
 };
 
 struct SdoClientCounters {
@@ -74,7 +79,8 @@ struct SdoClientCounters {
 
 class SdoClient {
  public:
-  static constexpr std::size_t kMaxData = 64;        // bytes per request
+  static constexpr std::size_t kMaxData = 64;        // bytes per request in the client's slots
+  static constexpr std::size_t kMaxBuffer = 0xFFFF;  // bytes per request in a caller's buffer
   static constexpr std::size_t kQueueDepth = 32;     // waiting requests per channel
 
   // Throws std::invalid_argument for a channel list that cannot work (node outside 1..127, channel
@@ -92,6 +98,11 @@ class SdoClient {
   SdoRequestId write(int channel, ObjectId object, std::uint32_t value, std::uint8_t size) noexcept;
   // Download of up to kMaxData bytes (expedited when <= 4, else segmented).
   SdoRequestId write_bytes(int channel, ObjectId object, std::span<const std::uint8_t> data) noexcept;
+  // Upload into / download from the caller's buffer (up to kMaxBuffer bytes), which stays in use
+  // until take() or cancel(). `expected_size` as for read().
+  SdoRequestId read_into(int channel, ObjectId object, std::span<std::uint8_t> into,
+                         std::uint8_t expected_size = 0) noexcept;
+  SdoRequestId write_from(int channel, ObjectId object, std::span<const std::uint8_t> data) noexcept;
 
   // Status of a request. Done/Failed are reported until take() or cancel().
   [[nodiscard]] SdoResult result(SdoRequestId id) const noexcept;
@@ -132,8 +143,20 @@ class SdoClient {
     ObjectId object{};
     std::uint8_t expected_size = 0;  // uploads: length of a 42h response (0 = all four bytes)
     std::uint16_t size = 0;          // downloads: bytes to send; uploads: bytes received
+    bool size_indicated = true;      // uploads: the server said how many bytes
     std::uint32_t abort_code = 0;
     std::array<std::uint8_t, kMaxData> data{};
+    // The caller's buffer (read_into / write_from), else null and `data` is used.
+    std::uint8_t* into = nullptr;
+    const std::uint8_t* from = nullptr;
+    std::uint16_t capacity = 0;  // of `into`
+
+    [[nodiscard]] bool external() const noexcept { return into != nullptr || from != nullptr; }
+    [[nodiscard]] std::uint8_t* sink() noexcept { return into != nullptr ? into : data.data(); }
+    [[nodiscard]] const std::uint8_t* source() const noexcept {
+      return from != nullptr ? from : into != nullptr ? into : data.data();
+    }
+    [[nodiscard]] std::size_t room() const noexcept { return into != nullptr ? capacity : kMaxData; }
   };
   // Where the transfer in flight stands: which response the client waits for.
   enum class Phase : std::uint8_t { Idle, Initiate, Segment };
@@ -164,6 +187,8 @@ class SdoClient {
 
   SdoRequestId submit(int channel, Kind kind, ObjectId object, std::uint8_t expected_size,
                       std::span<const std::uint8_t> data) noexcept;
+  // The slot just queued takes the caller's buffer.
+  SdoRequestId attach(SdoRequestId id, std::uint8_t* into, const std::uint8_t* from, std::size_t size) noexcept;
   [[nodiscard]] const Slot* find(SdoRequestId id) const noexcept;
   [[nodiscard]] Slot* find(SdoRequestId id) noexcept;
   void start(Channel& ch, core::TimePoint now, TxQueue& tx) noexcept;

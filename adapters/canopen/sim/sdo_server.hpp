@@ -72,7 +72,7 @@ struct SdoServerCounters {
 
 class SdoServer {
  public:
-  static constexpr std::size_t kBufferSize = 256;  // bytes of one segmented transfer
+  static constexpr std::size_t kBufferSize = 4096;  // bytes of one segmented transfer (a domain of 4 KiB)
 
   SdoServer(SdoServerConfig config, SdoBackend& backend) noexcept;
 

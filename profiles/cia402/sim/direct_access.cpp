@@ -61,7 +61,7 @@ void DirectObjectAccess::begin_cycle() noexcept {
   for (Request& r : requests_) {
     if (!r.in_use || r.result.state != RequestState::Pending) continue;
     if (!link_up_) {
-      r.result = RequestResult{RequestState::Failed, 0, abort_code::kTimeout};
+      r.result = RequestResult{RequestState::Failed, 0, abort_code::kTimeout, 0, true};
       continue;
     }
     if (r.cycles_left > 0) --r.cycles_left;
@@ -87,9 +87,34 @@ RequestId DirectObjectAccess::submit_write(ObjectDef def, std::int64_t value) no
   return submit(def, true, value);
 }
 
+RequestId DirectObjectAccess::submit_upload(ObjectId id, std::span<std::uint8_t> into,
+                                            std::uint8_t /*expected_size*/) noexcept {
+  Request* r = allocate(ObjectDef{id, DataType::U32}, false, 0);
+  if (r == nullptr) return kNoRequest;
+  r->as_bytes = true;
+  r->into = into;
+  return start(*r);
+}
+
+RequestId DirectObjectAccess::submit_download(ObjectId id, std::span<const std::uint8_t> data) noexcept {
+  // Longer than any drive object: refused like a drive would (length too high).
+  const bool too_long = data.size() > Request{}.data.size();
+  Request* r = allocate(ObjectDef{id, DataType::U32}, true, 0);
+  if (r == nullptr) return kNoRequest;
+  r->as_bytes = true;
+  r->size = too_long ? r->data.size() + 1 : data.size();
+  std::copy_n(data.begin(), std::min(data.size(), r->data.size()), r->data.begin());
+  return start(*r);
+}
+
 RequestId DirectObjectAccess::submit(ObjectDef def, bool is_write, std::int64_t value) noexcept {
+  Request* r = allocate(def, is_write, value);
+  return r == nullptr ? kNoRequest : start(*r);
+}
+
+DirectObjectAccess::Request* DirectObjectAccess::allocate(ObjectDef def, bool is_write, std::int64_t value) noexcept {
   const auto free_slot = std::find_if(requests_.begin(), requests_.end(), [](const Request& r) { return !r.in_use; });
-  if (free_slot == requests_.end()) return kNoRequest;
+  if (free_slot == requests_.end()) return nullptr;
   Request& r = *free_slot;
   r.in_use = true;
   r.is_write = is_write;
@@ -98,18 +123,26 @@ RequestId DirectObjectAccess::submit(ObjectDef def, bool is_write, std::int64_t 
   r.def = def;
   r.value = value;
   r.cycles_left = latency_;
-  r.result = RequestResult{RequestState::Pending, 0, 0};
+  r.result = RequestResult{RequestState::Pending, 0, 0, 0, true};
+  r.as_bytes = false;
+  r.into = {};
+  r.size = 0;
+  return &r;
+}
+
+RequestId DirectObjectAccess::start(Request& r) noexcept {
   if (latency_ == 0) {
     if (link_up_) {
       execute(r);
     } else {
-      r.result = RequestResult{RequestState::Failed, 0, abort_code::kTimeout};
+      r.result = RequestResult{RequestState::Failed, 0, abort_code::kTimeout, 0, true};
     }
   }
   return r.id;
 }
 
 void DirectObjectAccess::execute(Request& r) noexcept {
+  if (r.as_bytes) return execute_bytes(r);
   const auto type = drive_.dictionary().type_of(r.def.id);
   std::uint32_t code = abort_code::kNone;
   std::int64_t value = 0;
@@ -124,7 +157,28 @@ void DirectObjectAccess::execute(Request& r) noexcept {
     code = rr.abort_code;
     value = rr.value;
   }
-  r.result = RequestResult{code == abort_code::kNone ? RequestState::Done : RequestState::Failed, value, code};
+  r.result = RequestResult{code == abort_code::kNone ? RequestState::Done : RequestState::Failed, value, code, 0, true};
+}
+
+void DirectObjectAccess::execute_bytes(Request& r) noexcept {
+  const auto type = drive_.dictionary().type_of(r.def.id);
+  const auto fail = [&](std::uint32_t code) { r.result = RequestResult{RequestState::Failed, 0, code, 0, true}; };
+  if (!type) return fail(drive_.dictionary().missing_code(r.def.id));
+  const std::size_t size = size_of(*type);
+  if (r.is_write) {
+    if (r.size != size) return fail(r.size > size ? 0x06070012U : 0x06070013U);  // length too high / too low
+    std::uint64_t raw = 0;
+    for (std::size_t i = size; i-- > 0;) raw = (raw << 8) | r.data[i];
+    const std::uint32_t code = drive_.write_object(r.def.id, normalise(*type, static_cast<std::int64_t>(raw)));
+    if (code != abort_code::kNone) return fail(code);
+    r.result = RequestResult{RequestState::Done, 0, 0, 0, true};
+    return;
+  }
+  const ReadResult rr = drive_.read_object(r.def.id);
+  if (rr.abort_code != abort_code::kNone) return fail(rr.abort_code);
+  if (size > r.into.size()) return fail(0x05040005U);  // out of memory
+  for (std::size_t i = 0; i < size; ++i) r.into[i] = static_cast<std::uint8_t>(static_cast<std::uint64_t>(rr.value) >> (8 * i));
+  r.result = RequestResult{RequestState::Done, 0, 0, static_cast<std::uint32_t>(size), true};
 }
 
 RequestResult DirectObjectAccess::poll(RequestId id) noexcept {

@@ -38,6 +38,9 @@ class DirectObjectAccess final : public ObjectAccess {
   [[nodiscard]] bool inputs_fresh() const noexcept override { return fresh_; }
   RequestId submit_read(ObjectDef def) noexcept override;
   RequestId submit_write(ObjectDef def, std::int64_t value) noexcept override;
+  // Byte-level requests see a drive object as the little-endian bytes of its type.
+  RequestId submit_upload(ObjectId id, std::span<std::uint8_t> into, std::uint8_t expected_size) noexcept override;
+  RequestId submit_download(ObjectId id, std::span<const std::uint8_t> data) noexcept override;
   RequestResult poll(RequestId id) noexcept override;
   void cancel(RequestId id) noexcept override;
 
@@ -69,12 +72,19 @@ class DirectObjectAccess final : public ObjectAccess {
     std::int64_t value = 0;
     unsigned cycles_left = 0;
     RequestResult result{};
+    bool as_bytes = false;            // submit_upload / submit_download
+    std::span<std::uint8_t> into{};   // upload destination
+    std::array<std::uint8_t, 8> data{};  // download bytes (no drive object is longer)
+    std::size_t size = 0;
   };
 
   [[nodiscard]] const Slot* find(ObjectId id) const noexcept;
   Slot* find(ObjectId id) noexcept;
   RequestId submit(ObjectDef def, bool is_write, std::int64_t value) noexcept;
+  Request* allocate(ObjectDef def, bool is_write, std::int64_t value) noexcept;
+  RequestId start(Request& r) noexcept;  // completes at once when the latency is 0
   void execute(Request& r) noexcept;
+  void execute_bytes(Request& r) noexcept;
 
   DriveModel& drive_;
   std::vector<Slot> slots_;  // sorted by key
