@@ -92,6 +92,12 @@ constexpr Persona kAkd{
     .product_code = 0x3630304D,  // "M006" as four ASCII bytes (part 1 quirk 12)
     .revision = 0x00140000,      // CANopen part 0.20 in the upper word (part 1 quirk 12)
     .initial_mode = std::nullopt,
+    // Four characters "Yzzz": voltage class and current rating (part 1 §13.1), as in the product
+    // code; 1009h "will be supported in the future" (absent here); 100Ah the CANopen part's version,
+    // 0.20 as the revision says.
+    .device_name = "M006",
+    .hardware_version = "",
+    .software_version = "0.20",
     .sdo_channels = 1,  // a single SDO server with fixed COB-IDs, no 1200h (part 1 quirk 7)
     .upload_without_size = false,
     .heartbeat_consumer = true,  // one 1016h entry (part 1 §11.2, quirk 11)
@@ -182,6 +188,10 @@ constexpr Persona kNord{
     .product_code = std::nullopt,
     .revision = std::nullopt,
     .initial_mode = 2,  // vl (quirk 2)
+    // The digest lists no identity strings: illustrative values (segmented: longer than 4 bytes).
+    .device_name = "NORD SK 500P",
+    .hardware_version = "",
+    .software_version = "V1.2 R0",
     .sdo_channels = 1,
     .upload_without_size = false,
     .heartbeat_consumer = true,
@@ -242,6 +252,11 @@ constexpr Persona kSd6{
     .product_code = 40,         // rated power in 0.1 kW (quirk 13): a 4 kW drive
     .revision = std::nullopt,
     .initial_mode = std::nullopt,
+    // 1008h is E50 (the device name, segmented when longer than 4 characters), 100Ah E53[3]
+    // (stoeber-sd6-canopen.md §10); the values are illustrative. No 1009h.
+    .device_name = "SD6 axis controller",
+    .hardware_version = "",
+    .software_version = "6.5-K",
     .sdo_channels = 4,            // §6.3, quirk 1
     .upload_without_size = true,  // 42h (§6.4, quirk 19)
     .heartbeat_consumer = false,  // no 1016h (quirk 7)

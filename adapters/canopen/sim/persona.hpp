@@ -69,6 +69,11 @@ struct Persona {
   std::optional<std::uint32_t> product_code;
   std::optional<std::uint32_t> revision;
   std::optional<std::int8_t> initial_mode;  // 6060h at power-on, when the drive supports it
+  // Identity strings, const VISIBLE_STRINGs (CiA 301 §7.5.2.6-8): 1008h device name, 1009h
+  // hardware version, 100Ah software version. Empty: the drive does not have the object.
+  std::string_view device_name = "drivegate simulated CiA 402 drive";
+  std::string_view hardware_version = "sim-1";
+  std::string_view software_version = "drivegate-sim 1.0";
 
   // Communication objects.
   int sdo_channels = 1;               // SDO servers; channels 2..4 use the SD6 COB-ID scheme (wire/cob_id.hpp)

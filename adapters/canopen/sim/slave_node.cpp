@@ -76,6 +76,7 @@ SlaveNode::SlaveNode(SlaveNodeConfig config)
       model_(config_.drive),
       vendor_(config_.persona.vendor_objects.size()),
       model_defaults_(writable_profile_objects(model_.dictionary())),
+      byte_objects_(byte_objects_of(config_.persona)),
       nmt_(NmtSlaveConfig{.node = config_.node, .options = config_.persona.nmt}),
       emcy_(EmcyProducerConfig{.node = config_.node}),
       pdos_(*this, config_.persona.pdo, config_.rpdos, config_.tpdos) {
@@ -272,6 +273,7 @@ void SlaveNode::reset_application() noexcept {
 
 void SlaveNode::restore_persona_defaults() noexcept {
   vendor_.reset_to_defaults();
+  for (auto& b : byte_objects_) b.value.assign(b.power_on.begin(), b.power_on.end());
   // Accepted at construction, so accepted again.
   for (const auto& d : config_.persona.application_defaults) (void)model_.write_object(d.id, d.value);
 }
@@ -407,7 +409,42 @@ const SdoServer* SlaveNode::sdo(int channel) const noexcept {
 // ---------------------------------------------------------------------------------------------
 // Object dictionary
 
+// The byte objects of a persona (slave_node.hpp, ByteObject).
+std::vector<SlaveNode::ByteObject> SlaveNode::byte_objects_of(const Persona& p) {
+  std::vector<SlaveNode::ByteObject> out;
+  const auto add = [&](ObjectId id, bool writable, std::size_t fixed, std::vector<std::uint8_t> bytes) {
+    ByteObject o;
+    o.id = id;
+    o.writable = writable;
+    o.fixed = fixed;
+    o.power_on = std::move(bytes);
+    o.value.reserve(kMaxBytes);
+    o.value = o.power_on;
+    out.push_back(std::move(o));
+  };
+  const auto text = [](std::string_view s) { return std::vector<std::uint8_t>(s.begin(), s.end()); };
+  if (!p.device_name.empty()) add({0x1008, 0}, false, 0, text(p.device_name));
+  if (!p.hardware_version.empty()) add({0x1009, 0}, false, 0, text(p.hardware_version));
+  if (!p.software_version.empty()) add({0x100A, 0}, false, 0, text(p.software_version));
+  std::vector<std::uint8_t> domain(kMaxBytes);
+  for (std::size_t i = 0; i < domain.size(); ++i) domain[i] = static_cast<std::uint8_t>(i * 7 + 1);
+  add({0x5FF0, 0}, true, 0, std::move(domain));
+  add({0x5FF1, 0}, true, 8, {0xEF, 0xCD, 0xAB, 0x89, 0x67, 0x45, 0x23, 0x01});  // 0123456789ABCDEFh
+  add({0x5FF2, 0}, true, 4, {0x00, 0x00, 0xCC, 0x41});                          // 25.5 as REAL32
+  return out;
+}
+
+SlaveNode::ByteObject* SlaveNode::byte_object(ObjectId id) noexcept {
+  for (auto& b : byte_objects_)
+    if (b.id == id) return &b;
+  return nullptr;
+}
+
 SdoReadResult SlaveNode::sdo_read(ObjectId object, std::span<std::uint8_t> out) noexcept {
+  if (const ByteObject* b = byte_object(object)) {
+    if (b->value.size() <= out.size()) std::copy(b->value.begin(), b->value.end(), out.begin());
+    return {0, b->value.size()};  // longer than `out`: the server aborts with 05040005h
+  }
   const ValueRead v = read_value(object);
   if (v.abort != 0) return {v.abort, 0};
   put_le(out, 0, v.size, v.raw);
@@ -415,6 +452,14 @@ SdoReadResult SlaveNode::sdo_read(ObjectId object, std::span<std::uint8_t> out) 
 }
 
 std::uint32_t SlaveNode::sdo_write(ObjectId object, std::span<const std::uint8_t> data) noexcept {
+  if (ByteObject* b = byte_object(object)) {
+    if (!b->writable) return abort::kReadOnly;
+    const std::size_t limit = b->fixed != 0 ? b->fixed : b->value.capacity();
+    if (data.size() > limit) return abort::kTooLong;
+    if (b->fixed != 0 && data.size() < b->fixed) return abort::kTooShort;
+    b->value.assign(data.begin(), data.end());  // within the reserved capacity
+    return 0;
+  }
   return write_value(object, get_le(data, 0, std::min<std::size_t>(data.size(), 4)), data.size());
 }
 

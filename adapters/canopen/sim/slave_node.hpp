@@ -144,6 +144,20 @@ class SlaveNode final : private SdoBackend, private PdoObjects {
   [[nodiscard]] std::int64_t read(ObjectId id) const noexcept override;
   void write(ObjectId id, std::int64_t value) noexcept override;
 
+  // Objects read and written as bytes: the persona's identity strings (1008h..100Ah) and the test
+  // objects every simulated drive adds so that a master can exercise every size and segmented
+  // transfers (not from a manual): 5FF0h DOMAIN of 4 KiB, 5FF1h UNSIGNED64, 5FF2h REAL32, all rw.
+  struct ByteObject {
+    ObjectId id;
+    bool writable = false;
+    std::size_t fixed = 0;  // bytes a write must carry; 0: any length up to kMaxBytes
+    std::vector<std::uint8_t> power_on;
+    std::vector<std::uint8_t> value;  // capacity reserved at construction: writes never allocate
+  };
+  static constexpr std::size_t kMaxBytes = 4096;
+  [[nodiscard]] static std::vector<ByteObject> byte_objects_of(const Persona& p);
+  [[nodiscard]] ByteObject* byte_object(ObjectId id) noexcept;
+
   [[nodiscard]] ValueRead read_value(ObjectId id) const noexcept;
   std::uint32_t write_value(ObjectId id, std::uint32_t raw, std::size_t size) noexcept;
   [[nodiscard]] std::optional<ValueRead> read_comm(ObjectId id) const noexcept;
@@ -176,6 +190,7 @@ class SlaveNode final : private SdoBackend, private PdoObjects {
   // Writable device-profile objects (6000h..6FFFh) of the model with their power-on values, for
   // Reset Node; collected once at construction.
   std::vector<ObjectValue> model_defaults_;
+  std::vector<ByteObject> byte_objects_;
   NmtSlave nmt_;
   EmcyProducer emcy_;
   SlavePdos pdos_;  // calls mappable() while it is constructed: everything above is ready by then
