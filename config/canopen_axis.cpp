@@ -22,6 +22,14 @@ std::string type_text(cia402::DataType type) {
   return std::string{to_string(type)} + " (" + std::to_string(size_of(type) * 8) + " bits)";
 }
 
+// " (its section at line 12 was skipped: DataType \"x\" is not a data type code)" when the EDS
+// describes `id` in a section it could not use; the warning about it is not shown with errors.
+std::string skipped_text(const EdsDictionary& eds, cia402::ObjectId id) {
+  const EdsSkipped* s = find_eds_skipped(eds.skipped, id);
+  if (!s) return "";
+  return " (its section at line " + std::to_string(s->line) + " was skipped: " + s->reason + ")";
+}
+
 std::string eds_text(const EdsObject& o) {
   return eds_type_name(o.data_type) + " (" + (eds_type_bits(o.data_type) ? std::to_string(*eds_type_bits(o.data_type)) + " bits, " : "") +
          "line " + std::to_string(o.line) + ")";
@@ -30,7 +38,8 @@ std::string eds_text(const EdsObject& o) {
 // Every PDO entry of the device must exist in the EDS, be mappable, go the right way and have the
 // mapped size: otherwise the drive would abort the mapping at boot (0604 0041h / 0604 0042h).
 void check_maps_against_eds(const MapReader& c, const DeviceProfile& device, const std::string& eds_name,
-                            const std::vector<EdsObject>& objects) {
+                            const EdsDictionary& eds) {
+  const auto& objects = eds.objects;
   for (const bool receive : {true, false}) {
     for (const auto& pdo : receive ? device.canopen.rpdos : device.canopen.tpdos) {
       for (const auto& e : pdo.entries) {
@@ -38,7 +47,7 @@ void check_maps_against_eds(const MapReader& c, const DeviceProfile& device, con
                                  pdo_name(receive, pdo) + ", ";
         const EdsObject* o = find_eds_object(objects, e.object);
         if (!o) {
-          c.error("eds", what + "which " + eds_name + " does not list");
+          c.error("eds", what + "which " + eds_name + " does not list" + skipped_text(eds, e.object));
           continue;
         }
         if (!o->pdo_mapping) {
@@ -58,12 +67,13 @@ void check_maps_against_eds(const MapReader& c, const DeviceProfile& device, con
 }
 
 void check_writes_against_eds(const MapReader& c, const std::vector<StartupWrite>& writes, const std::string& whose,
-                              const std::string& eds_name, const std::vector<EdsObject>& objects) {
+                              const std::string& eds_name, const EdsDictionary& eds) {
+  const auto& objects = eds.objects;
   for (const auto& w : writes) {
     const std::string what = whose + " start-up write of " + object_text(w.def.id) + " ";
     const EdsObject* o = find_eds_object(objects, w.def.id);
     if (!o)
-      c.error("eds", what + "names an object " + eds_name + " does not list");
+      c.error("eds", what + "names an object " + eds_name + " does not list" + skipped_text(eds, w.def.id));
     else if (!o->writable())
       c.error("eds", what + "names an object that is " + std::string{to_string(o->access)} + " in " + eds_name +
                          " (line " + std::to_string(o->line) + ")");
@@ -83,7 +93,8 @@ void read_eds(const MapReader& c, const DeviceProfile* device, const fs::path& b
     return;
   }
   a.canopen.eds = file.string();
-  auto objects = parse_eds(file, *c.source().problems);
+  // The EDS' warnings go to the same Problems, so into Plan::warnings and --check-config.
+  auto objects = load_eds(file, *c.source().problems);
   if (!objects) {
     c.error("eds", "EDS \"" + file.string() + "\" has errors, listed with its file name");
     return;
@@ -94,7 +105,7 @@ void read_eds(const MapReader& c, const DeviceProfile* device, const fs::path& b
     check_writes_against_eds(c, device->canopen.startup_writes, "device \"" + device->name + "\"", eds_name, *objects);
   }
   check_writes_against_eds(c, a.canopen.startup_writes, "axis", eds_name, *objects);
-  a.canopen.eds_objects = std::move(*objects);
+  a.canopen.eds_objects = std::move(objects->objects);
 }
 
 // Synchronous PDOs only move with SYNC; a bus without it would leave the drive's data stale.

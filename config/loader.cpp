@@ -314,7 +314,10 @@ Plan compile(const std::string& text, const std::string& file, const LoadOptions
   }
 
   problems.throw_if_errors();
-  for (const auto& w : problems.warnings()) plan.warnings.push_back(w.to_string());
+  // Each once: axes sharing an EDS file would otherwise repeat its warnings.
+  for (const auto& w : problems.warnings())
+    if (auto line = w.to_string(); std::find(plan.warnings.begin(), plan.warnings.end(), line) == plan.warnings.end())
+      plan.warnings.push_back(std::move(line));
   return plan;
 }
 

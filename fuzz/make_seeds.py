@@ -7,7 +7,9 @@ sdo:           SDO frames of the digests' test vectors (akd-canopen-part1-commun
                stoeber-sd6-canopen.md §6.4 and §9 D-1..D-5) and segmented-transfer frames.
 can_engines:   frame records (format in fuzz_can_engines.cpp) for each persona: NMT, SYNC, SDO,
                heartbeat, guarding RTR, EMCY, PDO.
-eds, config:   copies of tests/config/devices/akd-canopen.eds and config/demo.yaml.
+eds:           copies of tests/config/devices/akd-canopen.eds and of the EDS test corpus
+               tests/config/eds/*.eds (number forms, data types, CompactSubObj, a file in the wild).
+config:        a copy of config/demo.yaml.
 """
 import pathlib
 import shutil
@@ -92,6 +94,8 @@ def copies():
     d = CORPUS / "eds"
     d.mkdir(parents=True, exist_ok=True)
     shutil.copy(ROOT / "tests/config/devices/akd-canopen.eds", d / "akd-canopen.eds")
+    for eds in sorted((ROOT / "tests/config/eds").glob("*.eds")):
+        shutil.copy(eds, d / eds.name)
     d = CORPUS / "config"
     d.mkdir(parents=True, exist_ok=True)
     shutil.copy(ROOT / "config/demo.yaml", d / "demo.yaml")

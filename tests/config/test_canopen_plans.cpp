@@ -2,7 +2,12 @@
 // checks, --check-config output, and every error with its exact message.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <fstream>
+#include <sstream>
+
 #include "config/describe.hpp"
+#include "config/eds.hpp"
 #include "tests/config/test_support.hpp"
 
 namespace drivegate::config {
@@ -429,7 +434,7 @@ TEST(CanopenPlanErrors, EdsDirectionAndAxisWrites) {
 class CanopenEdsFiles : public test::TempDir {};
 
 TEST_F(CanopenEdsFiles, MissingAndBrokenEds) {
-  write("bad.eds", "[6040]\nParameterName=Controlword\nDataType=0x0099\nAccessType=rw\n");
+  write("bad.eds", "[6040]\nParameterName=Controlword\nDataType=UNSIGNED16\nAccessType=rw\n");
   const std::string label = (dir_ / "plan.yaml").string();
   const std::string e = errors_of(R"(gateway: { name: g }
 buses: [{ name: can0, type: canopen, cycle_time: 4ms }]
@@ -443,6 +448,58 @@ axes:
   EXPECT_REPORTED(e, label + ":5:79: axes[1].canopen.eds: EDS \"" + (dir_ / "bad.eds").string() +
                          "\" has errors, listed with its file name");
   EXPECT_REPORTED(e, (dir_ / "bad.eds").string() + ":3:1: [6040].DataType: must be a CiA 301 data type");
+}
+
+std::string akd_eds() {
+  std::ifstream in(DRIVEGATE_TEST_DEVICE_DIR "/akd-canopen.eds");
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+int line_at(const std::string& text, std::size_t pos) {
+  return 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(pos), '\n'));
+}
+
+// What an EDS deviates in is a warning of the plan, so --check-config shows it; two axes with the
+// same EDS show it once.
+TEST_F(CanopenEdsFiles, EdsWarningsReachThePlan) {
+  const std::string akd = akd_eds() + "\n[2FFF]\nParameterName=Vendor thing\nDataType=0x0040\nAccessType=rw\n";
+  write("drive.eds", akd + "PDOMapping=yes\n");
+  const Plan plan = load_plan_from_string(R"(gateway: { name: g }
+buses: [{ name: can0, type: canopen, cycle_time: 4ms }]
+axes:
+  - { name: x, bus: can0, address: 1, device: kollmorgen-akd, canopen: { eds: drive.eds } }
+  - { name: y, bus: can0, address: 2, device: kollmorgen-akd, canopen: { eds: drive.eds } }
+)",
+                                          (dir_ / "plan.yaml").string(), test_options());
+  const std::string warning = (dir_ / "drive.eds").string() + ":" + std::to_string(line_at(akd, akd.size())) +
+                              ":1: [2FFF].PDOMapping: should be 0 or 1, got \"yes\"; read as 1 (mappable)";
+  EXPECT_EQ(std::count(plan.warnings.begin(), plan.warnings.end(), warning), 1) << testing::PrintToString(plan.warnings);
+  EXPECT_NE(describe_plan(plan).find("warnings\n  " + warning + "\n"), std::string::npos) << describe_plan(plan);
+  const EdsObject* vendor = find_eds_object(plan.buses[0].axes[0].canopen.eds_objects, "vendor thing");
+  ASSERT_NE(vendor, nullptr);
+  EXPECT_EQ(eds_type_name(vendor->data_type), "0x0040 (vendor-defined)");
+}
+
+// An object the device maps but the EDS had to skip: the error says why, since a refused load shows
+// no warnings.
+TEST_F(CanopenEdsFiles, SkippedObjectIsExplainedInTheError) {
+  std::string akd = akd_eds();
+  const std::size_t section = akd.find("[6071]");
+  const std::size_t type = akd.find("DataType=0x0003", section);
+  ASSERT_NE(type, std::string::npos);
+  akd.replace(type, 15, "DataType=INT16");
+  write("drive.eds", akd);
+  const std::string e = errors_of(R"(gateway: { name: g }
+buses: [{ name: can0, type: canopen, cycle_time: 4ms }]
+axes:
+  - { name: x, bus: can0, address: 1, device: kollmorgen-akd, canopen: { eds: drive.eds } }
+)",
+                                  test_options(), (dir_ / "plan.yaml").string());
+  EXPECT_REPORTED(e, "device \"kollmorgen-akd\" maps 6071h in RPDO 1, which EDS \"drive.eds\" does not list (its "
+                     "section at line " + std::to_string(line_at(akd, section)) +
+                         " was skipped: DataType \"INT16\" is not a data type code)");
 }
 
 // Drives that watch the gateway fault when its cycle stalls: --check-config says so for a real bus
