@@ -44,8 +44,9 @@ class Bus {
   [[nodiscard]] virtual std::size_t axis_count() const noexcept = 0;
   [[nodiscard]] virtual AxisController& controller(std::size_t axis) noexcept = 0;
   [[nodiscard]] virtual LinkState link_state(std::size_t axis) const noexcept = 0;
-  // Why the link is in its present state, when there is more to say than the state's name (e.g.
-  // "boot failed at identity: 1018h:01 reads ..."). Valid until the next cycle.
+  // What brought the link to its present state, in words (e.g. "boot failed at identity: 1018h:01
+  // reads ..."): set by the latest transition itself, never the reason of an earlier one, since
+  // the axis' link_changed event quotes it. Valid until the next cycle.
   [[nodiscard]] virtual std::string_view link_detail(std::size_t /*axis*/) const noexcept { return {}; }
 
   // Cyclic path.

@@ -126,7 +126,10 @@ void CanopenBus::open(core::TimePoint now) {
   open_ = true;
   controller_ = transport_->controller_state();
   if (options_.sync) sync_.start(now);
-  for (auto& n : nodes_) enter(*n, Phase::Start, now);
+  for (auto& n : nodes_) {
+    n->detail.format("waiting for node %u's boot-up", unsigned{n->id});
+    enter(*n, Phase::Start, now);
+  }
 }
 
 void CanopenBus::close() noexcept {
@@ -342,7 +345,10 @@ void CanopenBus::handle_nmt_events(core::TimePoint now) noexcept {
         }
         break;
       case NmtEventKind::Recovered:
-        if (n->phase == Phase::Lost || n->phase == Phase::Backoff) enter(*n, Phase::Probe, now);
+        if (n->phase == Phase::Lost || n->phase == Phase::Backoff) {
+          n->detail.format("node %u is heard again: asking it (SDO read of 1000h)", unsigned{n->id});
+          enter(*n, Phase::Probe, now);
+        }
         break;
       case NmtEventKind::ToggleError: break;  // counted by the NMT master; misses decide
     }
@@ -359,7 +365,10 @@ void CanopenBus::advance(Node& n, core::TimePoint now) noexcept {
       // A drive powering up announces itself; one that was already running (or does not repeat
       // its boot-up: SD6 quirk 9) is probed by SDO, put into pre-operational and configured
       // completely, whatever state an earlier master left it in.
-      if (now - n.since >= kBootUpWait) enter(n, Phase::Probe, now);
+      if (now - n.since >= kBootUpWait) {
+        n.detail.format("node %u sent no boot-up: asking it (SDO read of 1000h)", unsigned{n.id});
+        enter(n, Phase::Probe, now);
+      }
       break;
     case Phase::Probe:
       if (n.probe == kNoSdoRequest) {
@@ -373,6 +382,8 @@ void CanopenBus::advance(Node& n, core::TimePoint now) noexcept {
           sdo_.take(n.probe);
           n.probe = kNoSdoRequest;
           nmt_.command(NmtCommand::EnterPreOperational, n.id, tx_);
+          n.detail.format(n.had_link ? "node %u answered again; configuring it" : "node %u answered; configuring it",
+                          unsigned{n.id});
           enter(n, Phase::Configuring, now);
           ++n.boots;
           n.boot.start();
@@ -395,7 +406,7 @@ void CanopenBus::advance(Node& n, core::TimePoint now) noexcept {
           nmt_.watch(n.id, now);
           n.pdos.enable(true, now);
           n.backoff = core::Duration::zero();
-          n.detail.assign("");
+          n.detail.format("node %u configured", unsigned{n.id});
           enter(n, Phase::Operational, now);
           break;
         case NodeBoot::Status::Failed:
@@ -409,8 +420,12 @@ void CanopenBus::advance(Node& n, core::TimePoint now) noexcept {
     case Phase::Backoff:
     case Phase::Lost:
       // Probe again after the back-off (Lost: after boot_retry); a boot-up or heartbeat may come first.
-      if (now - n.since >= (n.backoff == core::Duration::zero() ? options_.boot_retry : n.backoff))
+      if (const auto wait = n.backoff == core::Duration::zero() ? options_.boot_retry : n.backoff;
+          now - n.since >= wait) {
+        n.detail.format("node %u: asking it again after %lld ms (SDO read of 1000h)", unsigned{n.id},
+                        static_cast<long long>(std::chrono::duration_cast<std::chrono::milliseconds>(wait).count()));
         enter(n, Phase::Probe, now);
+      }
       break;
     case Phase::Operational:
       if (core::FixedString<200> why; n.io->take_control_lost(why)) {

@@ -16,6 +16,24 @@
 // A bus-off of the gateway's controller takes every node to Lost; when the controller is back,
 // every node is probed and reconfigured. Nothing needs a daemon restart.
 //
+// link_detail() says what the node's last transition did, set by that transition and never left
+// over from an earlier one; the axis' link_changed event carries it ("link lost -> configuring:
+// node 35 answered again; configuring it"). In order of the life cycle:
+//   waiting for node N's boot-up                          start (link booting)
+//   node N sent no boot-up: asking it (SDO read of 1000h) probe after 500 ms without boot-up
+//   node N booted: configuring it                         boot-up received (also after a loss)
+//   node N answered[ again]; configuring it               probe answered
+//   node N configured                                     NMT start sent (link operational)
+//   node N: <boot step, object and SDO abort>             boot failed (link offline, or lost)
+//   node N does not answer (SDO read of 1000h: <abort>)   probe failed
+//   node N: asking it again after T ms (...)              next probe after the back-off
+//   node N stopped answering (heartbeat timeout | node guarding)       operational -> lost
+//   node N is heard again: asking it (SDO read of 1000h)  heartbeat/guard reply of a lost node
+//   node N left operational (now S): configuring it again another master stopped it
+//   <why the profile found the drive not following>       safe stop (link degraded)
+//   node N was stopped over SDO ...: configuring it again safe stop done
+//   the gateway's CAN controller is bus-off / CAN controller recovered from bus-off: ...
+//
 // receive() and transmit() are the cyclic path: no allocation, lock, logging or blocking.
 #include <array>
 #include <atomic>

@@ -93,6 +93,45 @@ TEST(CanopenBus, PowerLossIsRecoveredAutomaticallyAndComesBackDisabled) {
   EXPECT_EQ(h.bus->boots(h.axis("nord")), 1U);
 }
 
+// The link events of an axis, in order.
+std::vector<std::string> link_events(const BusHarness& h, core::AxisIndex axis) {
+  std::vector<std::string> v;
+  for (const auto& e : h.events)
+    if (e.axis == axis && e.kind == core::EventKind::LinkChanged) v.emplace_back(e.text.view());
+  return v;
+}
+
+// A cut cable: the AKD runs on and does not boot again, so when it answers again it is found by
+// the probe. Every link event says what its own transition did, never the failure before it (a
+// field report read "link lost -> configuring: node 35 stopped answering").
+TEST(CanopenBus, EveryLinkEventSaysWhatItsOwnTransitionDid) {
+  BusHarness h;
+  const auto akd = h.axis("akd");
+  ASSERT_TRUE(h.run_until([&] { return h.all_up(); }, 5s)) << h.events_text();
+  ASSERT_FALSE(link_events(h, akd).empty());
+  EXPECT_EQ(link_events(h, akd).back(), "link configuring -> operational: node 1 configured") << h.events_text();
+
+  h.events.clear();
+  h.drive("akd").set_silent(true);
+  ASSERT_TRUE(h.run_until([&] { return h.bus->link_state(akd) == LinkState::Lost; }, 2s)) << h.events_text();
+  // Probed (and failing) while the cable is cut: the link stays lost, no new event.
+  h.run_until([] { return false; }, 3s);
+  EXPECT_EQ(h.bus->link_state(akd), LinkState::Lost);
+  h.drive("akd").set_silent(false);
+  ASSERT_TRUE(h.run_until([&] { return h.bus->link_state(akd) == LinkState::Operational; }, 15s)) << h.events_text();
+  EXPECT_EQ(h.bus->boots(akd), 2U);
+
+  const auto links = link_events(h, akd);
+  ASSERT_EQ(links.size(), 3U) << h.events_text();
+  EXPECT_EQ(links[0], "link operational -> lost: node 1 stopped answering (heartbeat timeout)");
+  EXPECT_EQ(links[1], "link lost -> configuring: node 1 answered again; configuring it");
+  EXPECT_EQ(links[2], "link configuring -> operational: node 1 configured");
+  for (std::size_t i = 1; i < links.size(); ++i) {
+    EXPECT_EQ(links[i].find("stopped answering"), std::string::npos) << links[i];
+    EXPECT_EQ(links[i].find("does not answer"), std::string::npos) << links[i];
+  }
+}
+
 TEST(CanopenBus, GatewayBusOffTakesEveryNodeDownAndBackUp) {
   BusHarness h;
   ASSERT_TRUE(h.run_until([&] { return h.all_operational(); }, 5s)) << h.events_text();

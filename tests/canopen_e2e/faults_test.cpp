@@ -99,9 +99,19 @@ TEST_F(CanopenE2eFaults, PowerLossIsRecoveredByItselfAndComesBackDisabled) {
   ASSERT_NO_FATAL_FAILURE(sim_command("power-on 1", "ok power-on node 1"));
   ASSERT_NO_FATAL_FAILURE(sim_command("power-on 3", "ok power-on node 3"));
   ASSERT_TRUE(wait_all("switch_on_disabled", 10s)) << diagnostics();
-  // Reconfigured from scratch after the boot-up (AKD) or the probe (SD6).
-  for (const char* axis : {"akd", "sd6"})
+  // Reconfigured from scratch after the boot-up (AKD) or the probe (SD6). Each link event says what
+  // its own transition did, not the loss before it.
+  for (const char* axis : {"akd", "sd6"}) {
     EXPECT_TRUE(wait_event(axis, "link_changed", "link lost -> configuring", 1s)) << axis << diagnostics();
+    EXPECT_TRUE(wait_event(axis, "link_changed", "link configuring -> operational: node", 1s)) << axis << diagnostics();
+    for (const auto& e : events()) {
+      if (e.axis != axis || e.kind != "link_changed" || e.text.find("link lost -> ") == std::string::npos) continue;
+      EXPECT_EQ(e.text.find("stopped answering"), std::string::npos) << e.text;
+      EXPECT_EQ(e.text.find("heartbeat"), std::string::npos) << e.text;
+      EXPECT_EQ(e.text.find("node guarding"), std::string::npos) << e.text;
+      EXPECT_NE(e.text.find("configuring it"), std::string::npos) << e.text;
+    }
+  }
   for (const char* axis : {"akd", "sd6"}) {
     const auto r = send(axis, "enable");
     EXPECT_EQ(r.outcome, Outcome::Completed) << axis << ": " << r.reason << diagnostics();
