@@ -52,8 +52,10 @@ class Bus {
   // Cyclic path.
   virtual void receive(TimePoint now) noexcept = 0;
   virtual void transmit(TimePoint now) noexcept = 0;
-  // Events about the bus itself (another master on the wire, ...), taken after receive(); false
-  // when there is none. The runner publishes them with no axis.
+  // Events the bus itself reports, taken after receive(); false when there is none. With `axis`
+  // kNoAxis (or out of range) the event is about the bus (another master on the wire, ...); with
+  // an axis index it is about that axis' device (a CANopen EMCY) and the runner adds the axis'
+  // state. The runner stamps them with the cycle's time. A bus bounds how many it holds.
   virtual bool next_event(Event& /*out*/) noexcept { return false; }
 
   // May be called from any thread while the bus runs (implementations keep relaxed atomics).

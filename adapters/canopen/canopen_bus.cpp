@@ -236,9 +236,7 @@ void CanopenBus::receive(core::TimePoint now) noexcept {
   }
   handle_controller_state(now);
   handle_nmt_events(now);
-  EmcyReport report;
-  while (emcy_.next_report(report)) {
-  }
+  publish_emcy(now);
   for (auto& n : nodes_) {
     advance(*n, now);
     n->io->begin_cycle(now, n->phase == Phase::Operational);
@@ -283,10 +281,76 @@ void CanopenBus::note_foreign_master(const CanFrame& f, core::TimePoint now) noe
 }
 
 bool CanopenBus::next_event(core::Event& out) noexcept {
-  if (!foreign_pending_) return false;
-  foreign_pending_ = false;
-  out = foreign_event_;
+  if (foreign_pending_) {
+    foreign_pending_ = false;
+    out = foreign_event_;
+    return true;
+  }
+  if (emcy_count_ == 0) return false;
+  out = emcy_events_[emcy_head_];
+  emcy_head_ = (emcy_head_ + 1) % emcy_events_.size();
+  --emcy_count_;
   return true;
+}
+
+bool CanopenBus::take_emcy_token(Node& n, core::TimePoint now) noexcept {
+  if (n.emcy_tokens >= kEmcyBurst) {
+    n.emcy_refilled = now;  // a full bucket earns nothing: the refill period starts with its first use
+  } else if (const auto earned = (now - n.emcy_refilled) / kEmcyRefill; earned > 0) {
+    n.emcy_tokens = static_cast<std::uint32_t>(std::min<std::int64_t>(kEmcyBurst, n.emcy_tokens + earned));
+    n.emcy_refilled = n.emcy_tokens >= kEmcyBurst ? now : n.emcy_refilled + earned * kEmcyRefill;
+  }
+  if (n.emcy_tokens == 0) return false;
+  --n.emcy_tokens;
+  return true;
+}
+
+// Every EMCY of a node is an event of its axis (a warning, an error reset / no error, a fault):
+// its code, error register and vendor bytes, with the text the device profile's tables give it.
+// A node that floods EMCYs is limited by its token bucket; what is held back is counted and summed
+// up in one warning once the node has a token again.
+void CanopenBus::publish_emcy(core::TimePoint now) noexcept {
+  const auto room = [&] { return emcy_count_ < emcy_events_.size(); };
+  const auto push = [&](const core::Event& e) {
+    emcy_events_[(emcy_head_ + emcy_count_) % emcy_events_.size()] = e;
+    ++emcy_count_;
+  };
+  for (auto& np : nodes_) {
+    Node& n = *np;
+    if (n.emcy_held_back == 0 || !room() || !take_emcy_token(n, now)) continue;
+    core::Event e{};
+    e.axis = static_cast<core::AxisIndex>(n.channel);
+    e.kind = core::EventKind::Warning;
+    e.text.format("node %u sent %llu EMCYs that were not published (at most %u at once, then one per %lld s); the "
+                  "last: %s",
+                  unsigned{n.id}, static_cast<unsigned long long>(n.emcy_held_back), unsigned{kEmcyBurst},
+                  static_cast<long long>(std::chrono::duration_cast<std::chrono::seconds>(kEmcyRefill).count()),
+                  n.emcy_last_held.text.c_str());
+    n.emcy_held_back = 0;
+    push(e);
+  }
+  EmcyReport r;
+  while (room() && emcy_.next_report(r)) {
+    Node* n = node_by_id(r.node);
+    if (n == nullptr) continue;  // the consumer reports registered nodes only
+    if (!take_emcy_token(*n, now)) {
+      ++emcy_rate_dropped_;
+      ++n->emcy_held_back;
+      n->emcy_last_held = r;
+      continue;
+    }
+    core::Event e{};
+    e.axis = static_cast<core::AxisIndex>(n->channel);
+    e.kind = core::EventKind::Emcy;
+    e.code = r.emcy.code;
+    // The register and the vendor bytes always fit: a long text is cut instead, visibly.
+    const core::FixedString<core::Text::capacity() - 50> what(r.text.view());
+    const auto& v = r.emcy.vendor;
+    e.text.format("EMCY %s; register 0x%02X, vendor bytes %02X %02X %02X %02X %02X", what.c_str(),
+                  unsigned{r.emcy.error_register}, unsigned{v[0]}, unsigned{v[1]}, unsigned{v[2]}, unsigned{v[3]},
+                  unsigned{v[4]});
+    push(e);
+  }
 }
 
 void CanopenBus::handle_controller_state(core::TimePoint now) noexcept {

@@ -548,3 +548,52 @@ TEST_F(RunnerFixture, SetpointsForAModeThatTakesNoneWarn) {
   runner.setpoint(sp, now + 3ms, out);
   EXPECT_EQ(runner.rejected_setpoints(), 2u);
 }
+
+// Events a bus reports about one of its axes (a CANopen EMCY) keep their axis and get its state;
+// the others are about the bus.
+TEST(BusRunner, BusEventsKeepTheirAxis) {
+  struct EventBus final : public Bus {
+    std::string_view name() const noexcept override { return "fake"; }
+    std::string_view type() const noexcept override { return "fake"; }
+    void open(TimePoint) override {}
+    void close() noexcept override {}
+    std::size_t axis_count() const noexcept override { return 2; }
+    AxisController& controller(std::size_t i) noexcept override { return ctl[i]; }
+    LinkState link_state(std::size_t) const noexcept override { return LinkState::Operational; }
+    void receive(TimePoint) noexcept override {}
+    void transmit(TimePoint) noexcept override {}
+    bool next_event(Event& out) noexcept override {
+      if (pending == 0) return false;
+      out = Event{};
+      out.kind = EventKind::Emcy;
+      out.axis = pending == 2 ? 1 : 7;
+      out.code = 0x3280;
+      --pending;
+      return true;
+    }
+    BusCounters counters() const noexcept override { return {}; }
+    FakeController ctl[2];
+    int pending = 0;
+  } bus;
+  for (auto& c : bus.ctl) {
+    c.fb.valid = true;
+    c.fb.state = AxisState::SwitchOnDisabled;
+  }
+  std::vector<AxisSpec> specs{drivegate::test::linear_axis_spec(), drivegate::test::linear_axis_spec()};
+  specs[1].name = "y";
+  BusRunner runner(bus, specs);
+  runner.cycle(TimePoint{1s});
+  Event e;
+  while (runner.pop_event(e)) {
+  }
+  bus.pending = 2;
+  runner.cycle(TimePoint{1s + 1ms});
+  std::vector<Event> emcy;
+  while (runner.pop_event(e))
+    if (e.kind == EventKind::Emcy) emcy.push_back(e);
+  ASSERT_EQ(emcy.size(), 2u);
+  EXPECT_EQ(emcy[0].axis, 1);
+  EXPECT_EQ(emcy[0].state, AxisState::SwitchOnDisabled);
+  EXPECT_EQ(emcy[0].stamp_ns, to_ns(TimePoint{1s + 1ms}));
+  EXPECT_EQ(emcy[1].axis, kNoAxis);  // no such axis: about the bus
+}
