@@ -63,6 +63,7 @@ void AxisRunner::command(const Command& cmd, TimePoint now, RunnerOutput& out) n
   submitting_ = cmd.id;
   submitting_kind_ = cmd.kind;
   accepted_sent_ = false;
+  submit_finished_ = false;
   const Admission adm = controller_.submit(conv.drive, now, *this);
   submitting_ = 0;
   if (!adm.accepted) {
@@ -70,6 +71,11 @@ void AxisRunner::command(const Command& cmd, TimePoint now, RunnerOutput& out) n
     return;
   }
   if (!accepted_sent_) send_reply(cmd.id, ReplyStatus::Accepted, {});
+  // A command that selects a mode: the axis is entering it until the command completes or fails.
+  if (conv.drive.mode != Mode::None && !submit_finished_ && !is_internal(cmd.id)) {
+    entering_id_ = cmd.id;
+    entering_mode_ = conv.drive.mode;
+  }
   // Every motion or device command takes over from a running velocity or torque command: that run
   // has ended as the client asked. Halt, resume, enable and fault reset leave it running.
   if (live_command_ != 0 && live_command_ != cmd.id && ends_live_run(cmd.kind)) {
@@ -128,8 +134,11 @@ void AxisRunner::setpoint(const Setpoint& sp, TimePoint now, RunnerOutput& out) 
   const Mode mode = controller_.feedback().mode;
   if (!mode_is_cyclic(mode)) {
     // In pv, vl and tq a set-point is the keep-alive of the last velocity/torque command; its
-    // values are not used (the command sets the target). Elsewhere it has no meaning.
-    if (mode_needs_live_source(mode)) {
+    // values are not used (the command sets the target). The same holds from the moment such a
+    // command (or a switch to a cyclic mode) was accepted, while the drive still shows the mode it
+    // is leaving: the keep-alives belong to the mode it is entering. Elsewhere a set-point has no
+    // meaning.
+    if (mode_needs_live_source(mode) || (entering_id_ != 0 && mode_needs_live_source(entering_mode_))) {
       last_activity_ = now;
     } else if (rejected_setpoints_++ % 1000 == 0) {
       Text why;
@@ -180,6 +189,7 @@ void AxisRunner::observe_link(TimePoint now, LinkState link, std::string_view de
                static_cast<int>(detail.size()), detail.data());
     const bool was_up = last_link_ == LinkState::Operational;
     last_link_ = link;
+    entering_id_ = 0;
     if (link == LinkState::Operational) {
       default_mode_pending_ = true;
       default_mode_attempts_ = 0;
@@ -333,7 +343,9 @@ void AxisRunner::completed(CommandId id) noexcept {
     send_reply(id, ReplyStatus::Accepted, {});
     accepted_sent_ = true;
   }
+  if (id == submitting_) submit_finished_ = true;
   if (id == move_in_flight_) move_in_flight_ = 0;
+  if (id == entering_id_) entering_id_ = 0;  // the drive is in its mode now
   if (id == live_command_) {
     // The drive runs at the commanded speed or torque: the run goes on until something ends it.
     live_reached_ = true;
@@ -348,6 +360,8 @@ void AxisRunner::failed(CommandId id, std::string_view reason) noexcept {
     send_reply(id, ReplyStatus::Accepted, {});
     accepted_sent_ = true;
   }
+  if (id == submitting_) submit_finished_ = true;
+  if (id == entering_id_) entering_id_ = 0;  // the switch did not happen
   if (id == move_in_flight_) move_in_flight_ = 0;
   if (id == active_command_) active_command_ = 0;
   if (id == live_command_) {

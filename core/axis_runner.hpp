@@ -92,6 +92,13 @@ class AxisRunner final : private ControllerSink {
   bool live_reached_ = false;  // the controller finished its handshake; the reply is held back
   Text ending_;                // while the gateway stops the axis itself: why (non-empty)
 
+  // The mode a client's accepted command is switching the axis into, while that command is in the
+  // controller's hands (0: none): set-points are judged against it, not against the mode the drive
+  // still shows, so a velocity command's keep-alives from pp are not refused as pp's.
+  CommandId entering_id_ = 0;
+  Mode entering_mode_ = Mode::None;
+  bool submit_finished_ = false;  // the command inside controller_.submit() completed or failed there
+
   LinkState last_link_ = LinkState::Offline;
   CommandId active_command_ = 0;
   CommandId submitting_ = 0;    // id inside controller_.submit(), for inline completion

@@ -106,6 +106,7 @@ std::string_view to_string(EventKind k) noexcept {
     case EventKind::Info: return "info";
     case EventKind::ControlLost: return "control_lost";
     case EventKind::DuplicateGateway: return "duplicate_gateway";
+    case EventKind::Emcy: return "emcy";
   }
   return "info";
 }

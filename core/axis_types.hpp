@@ -69,6 +69,7 @@ enum class EventKind : std::uint8_t {
   Info,
   ControlLost,  // the drive stopped following the gateway's controlword/telegram; it is being stopped
   DuplicateGateway,  // another instance of this gateway (same name) is on the DDS domain
+  Emcy,  // a message the drive sent on its own (CANopen EMCY): code, error register, vendor bytes
 };
 
 // Modes that need a live command source: silence longer than the axis' command timeout stops them.

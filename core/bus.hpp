@@ -44,15 +44,18 @@ class Bus {
   [[nodiscard]] virtual std::size_t axis_count() const noexcept = 0;
   [[nodiscard]] virtual AxisController& controller(std::size_t axis) noexcept = 0;
   [[nodiscard]] virtual LinkState link_state(std::size_t axis) const noexcept = 0;
-  // Why the link is in its present state, when there is more to say than the state's name (e.g.
-  // "boot failed at identity: 1018h:01 reads ..."). Valid until the next cycle.
+  // What brought the link to its present state, in words (e.g. "boot failed at identity: 1018h:01
+  // reads ..."): set by the latest transition itself, never the reason of an earlier one, since
+  // the axis' link_changed event quotes it. Valid until the next cycle.
   [[nodiscard]] virtual std::string_view link_detail(std::size_t /*axis*/) const noexcept { return {}; }
 
   // Cyclic path.
   virtual void receive(TimePoint now) noexcept = 0;
   virtual void transmit(TimePoint now) noexcept = 0;
-  // Events about the bus itself (another master on the wire, ...), taken after receive(); false
-  // when there is none. The runner publishes them with no axis.
+  // Events the bus itself reports, taken after receive(); false when there is none. With `axis`
+  // kNoAxis (or out of range) the event is about the bus (another master on the wire, ...); with
+  // an axis index it is about that axis' device (a CANopen EMCY) and the runner adds the axis'
+  // state. The runner stamps them with the cycle's time. A bus bounds how many it holds.
   virtual bool next_event(Event& /*out*/) noexcept { return false; }
 
   // May be called from any thread while the bus runs (implementations keep relaxed atomics).

@@ -24,7 +24,10 @@ void BusRunner::cycle(TimePoint now) noexcept {
   bus_.receive(now);
   Event bus_event;
   while (bus_.next_event(bus_event)) {
-    bus_event.axis = kNoAxis;
+    if (bus_event.axis >= axes_.size())
+      bus_event.axis = kNoAxis;
+    else
+      bus_event.state = axes_[bus_event.axis].snapshot().state;
     bus_event.stamp_ns = to_ns(now);
     event(bus_event);
   }

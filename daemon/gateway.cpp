@@ -21,13 +21,14 @@ bool is_disabled(core::AxisState s) noexcept {
   return s == core::AxisState::SwitchOnDisabled || s == core::AxisState::NotReadyToSwitchOn ||
          s == core::AxisState::Fault;
 }
-std::string_view severity_of(core::EventKind k) {
-  switch (k) {
+std::string_view severity_of(const core::Event& e) {
+  switch (e.kind) {
     case core::EventKind::Fault:
     case core::EventKind::ControlLost:
     case core::EventKind::DuplicateGateway:
     case core::EventKind::CommandTimeout: return "error";
     case core::EventKind::Warning: return "warning";
+    case core::EventKind::Emcy: return e.code == 0 ? "info" : "warning";  // 0000h: error reset / no error
     default: return "info";
   }
 }
@@ -170,7 +171,7 @@ void Gateway::drain(Outbox& out) {
       e.bus = b.plan->name;
       e.axis_id = e.event.axis == core::kNoAxis ? SIZE_MAX : b.first_axis + e.event.axis;
       const std::string who = e.axis_id == SIZE_MAX ? "bus " + e.bus : "axis " + axes_[e.axis_id].name;
-      const auto sev = severity_of(e.event.kind);
+      const auto sev = severity_of(e.event);
       const auto level = sev == "error" ? spdlog::level::err : sev == "warning" ? spdlog::level::warn : spdlog::level::info;
       // Codes are drive error codes for faults and warnings; other events use them internally.
       const bool has_code = e.event.kind == core::EventKind::Fault || e.event.kind == core::EventKind::Warning ||

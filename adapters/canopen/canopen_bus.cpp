@@ -126,7 +126,10 @@ void CanopenBus::open(core::TimePoint now) {
   open_ = true;
   controller_ = transport_->controller_state();
   if (options_.sync) sync_.start(now);
-  for (auto& n : nodes_) enter(*n, Phase::Start, now);
+  for (auto& n : nodes_) {
+    n->detail.format("waiting for node %u's boot-up", unsigned{n->id});
+    enter(*n, Phase::Start, now);
+  }
 }
 
 void CanopenBus::close() noexcept {
@@ -233,9 +236,7 @@ void CanopenBus::receive(core::TimePoint now) noexcept {
   }
   handle_controller_state(now);
   handle_nmt_events(now);
-  EmcyReport report;
-  while (emcy_.next_report(report)) {
-  }
+  publish_emcy(now);
   for (auto& n : nodes_) {
     advance(*n, now);
     n->io->begin_cycle(now, n->phase == Phase::Operational);
@@ -280,10 +281,76 @@ void CanopenBus::note_foreign_master(const CanFrame& f, core::TimePoint now) noe
 }
 
 bool CanopenBus::next_event(core::Event& out) noexcept {
-  if (!foreign_pending_) return false;
-  foreign_pending_ = false;
-  out = foreign_event_;
+  if (foreign_pending_) {
+    foreign_pending_ = false;
+    out = foreign_event_;
+    return true;
+  }
+  if (emcy_count_ == 0) return false;
+  out = emcy_events_[emcy_head_];
+  emcy_head_ = (emcy_head_ + 1) % emcy_events_.size();
+  --emcy_count_;
   return true;
+}
+
+bool CanopenBus::take_emcy_token(Node& n, core::TimePoint now) noexcept {
+  if (n.emcy_tokens >= kEmcyBurst) {
+    n.emcy_refilled = now;  // a full bucket earns nothing: the refill period starts with its first use
+  } else if (const auto earned = (now - n.emcy_refilled) / kEmcyRefill; earned > 0) {
+    n.emcy_tokens = static_cast<std::uint32_t>(std::min<std::int64_t>(kEmcyBurst, n.emcy_tokens + earned));
+    n.emcy_refilled = n.emcy_tokens >= kEmcyBurst ? now : n.emcy_refilled + earned * kEmcyRefill;
+  }
+  if (n.emcy_tokens == 0) return false;
+  --n.emcy_tokens;
+  return true;
+}
+
+// Every EMCY of a node is an event of its axis (a warning, an error reset / no error, a fault):
+// its code, error register and vendor bytes, with the text the device profile's tables give it.
+// A node that floods EMCYs is limited by its token bucket; what is held back is counted and summed
+// up in one warning once the node has a token again.
+void CanopenBus::publish_emcy(core::TimePoint now) noexcept {
+  const auto room = [&] { return emcy_count_ < emcy_events_.size(); };
+  const auto push = [&](const core::Event& e) {
+    emcy_events_[(emcy_head_ + emcy_count_) % emcy_events_.size()] = e;
+    ++emcy_count_;
+  };
+  for (auto& np : nodes_) {
+    Node& n = *np;
+    if (n.emcy_held_back == 0 || !room() || !take_emcy_token(n, now)) continue;
+    core::Event e{};
+    e.axis = static_cast<core::AxisIndex>(n.channel);
+    e.kind = core::EventKind::Warning;
+    e.text.format("node %u sent %llu EMCYs that were not published (at most %u at once, then one per %lld s); the "
+                  "last: %s",
+                  unsigned{n.id}, static_cast<unsigned long long>(n.emcy_held_back), unsigned{kEmcyBurst},
+                  static_cast<long long>(std::chrono::duration_cast<std::chrono::seconds>(kEmcyRefill).count()),
+                  n.emcy_last_held.text.c_str());
+    n.emcy_held_back = 0;
+    push(e);
+  }
+  EmcyReport r;
+  while (room() && emcy_.next_report(r)) {
+    Node* n = node_by_id(r.node);
+    if (n == nullptr) continue;  // the consumer reports registered nodes only
+    if (!take_emcy_token(*n, now)) {
+      ++emcy_rate_dropped_;
+      ++n->emcy_held_back;
+      n->emcy_last_held = r;
+      continue;
+    }
+    core::Event e{};
+    e.axis = static_cast<core::AxisIndex>(n->channel);
+    e.kind = core::EventKind::Emcy;
+    e.code = r.emcy.code;
+    // The register and the vendor bytes always fit: a long text is cut instead, visibly.
+    const core::FixedString<core::Text::capacity() - 50> what(r.text.view());
+    const auto& v = r.emcy.vendor;
+    e.text.format("EMCY %s; register 0x%02X, vendor bytes %02X %02X %02X %02X %02X", what.c_str(),
+                  unsigned{r.emcy.error_register}, unsigned{v[0]}, unsigned{v[1]}, unsigned{v[2]}, unsigned{v[3]},
+                  unsigned{v[4]});
+    push(e);
+  }
 }
 
 void CanopenBus::handle_controller_state(core::TimePoint now) noexcept {
@@ -342,7 +409,10 @@ void CanopenBus::handle_nmt_events(core::TimePoint now) noexcept {
         }
         break;
       case NmtEventKind::Recovered:
-        if (n->phase == Phase::Lost || n->phase == Phase::Backoff) enter(*n, Phase::Probe, now);
+        if (n->phase == Phase::Lost || n->phase == Phase::Backoff) {
+          n->detail.format("node %u is heard again: asking it (SDO read of 1000h)", unsigned{n->id});
+          enter(*n, Phase::Probe, now);
+        }
         break;
       case NmtEventKind::ToggleError: break;  // counted by the NMT master; misses decide
     }
@@ -359,7 +429,10 @@ void CanopenBus::advance(Node& n, core::TimePoint now) noexcept {
       // A drive powering up announces itself; one that was already running (or does not repeat
       // its boot-up: SD6 quirk 9) is probed by SDO, put into pre-operational and configured
       // completely, whatever state an earlier master left it in.
-      if (now - n.since >= kBootUpWait) enter(n, Phase::Probe, now);
+      if (now - n.since >= kBootUpWait) {
+        n.detail.format("node %u sent no boot-up: asking it (SDO read of 1000h)", unsigned{n.id});
+        enter(n, Phase::Probe, now);
+      }
       break;
     case Phase::Probe:
       if (n.probe == kNoSdoRequest) {
@@ -373,6 +446,8 @@ void CanopenBus::advance(Node& n, core::TimePoint now) noexcept {
           sdo_.take(n.probe);
           n.probe = kNoSdoRequest;
           nmt_.command(NmtCommand::EnterPreOperational, n.id, tx_);
+          n.detail.format(n.had_link ? "node %u answered again; configuring it" : "node %u answered; configuring it",
+                          unsigned{n.id});
           enter(n, Phase::Configuring, now);
           ++n.boots;
           n.boot.start();
@@ -395,7 +470,7 @@ void CanopenBus::advance(Node& n, core::TimePoint now) noexcept {
           nmt_.watch(n.id, now);
           n.pdos.enable(true, now);
           n.backoff = core::Duration::zero();
-          n.detail.assign("");
+          n.detail.format("node %u configured", unsigned{n.id});
           enter(n, Phase::Operational, now);
           break;
         case NodeBoot::Status::Failed:
@@ -409,8 +484,12 @@ void CanopenBus::advance(Node& n, core::TimePoint now) noexcept {
     case Phase::Backoff:
     case Phase::Lost:
       // Probe again after the back-off (Lost: after boot_retry); a boot-up or heartbeat may come first.
-      if (now - n.since >= (n.backoff == core::Duration::zero() ? options_.boot_retry : n.backoff))
+      if (const auto wait = n.backoff == core::Duration::zero() ? options_.boot_retry : n.backoff;
+          now - n.since >= wait) {
+        n.detail.format("node %u: asking it again after %lld ms (SDO read of 1000h)", unsigned{n.id},
+                        static_cast<long long>(std::chrono::duration_cast<std::chrono::milliseconds>(wait).count()));
         enter(n, Phase::Probe, now);
+      }
       break;
     case Phase::Operational:
       if (core::FixedString<200> why; n.io->take_control_lost(why)) {

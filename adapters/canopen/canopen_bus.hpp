@@ -16,6 +16,31 @@
 // A bus-off of the gateway's controller takes every node to Lost; when the controller is back,
 // every node is probed and reconfigured. Nothing needs a daemon restart.
 //
+// Every EMCY a node sends (fault, warning, error reset / no error 0000h, an AKD error-state
+// update) is an `emcy` event of its axis (next_event()): code, error register and the five vendor
+// bytes, with the text of the device profile's table. A fault's EMCY also gives the axis' fault
+// event its text. Per node at most kEmcyBurst at once and then one per kEmcyRefill are published;
+// the rest are counted (emcy_events_dropped()) and summed up in one warning event when the node
+// has a token again.
+//
+// link_detail() says what the node's last transition did, set by that transition and never left
+// over from an earlier one; the axis' link_changed event carries it ("link lost -> configuring:
+// node 35 answered again; configuring it"). In order of the life cycle:
+//   waiting for node N's boot-up                          start (link booting)
+//   node N sent no boot-up: asking it (SDO read of 1000h) probe after 500 ms without boot-up
+//   node N booted: configuring it                         boot-up received (also after a loss)
+//   node N answered[ again]; configuring it               probe answered
+//   node N configured                                     NMT start sent (link operational)
+//   node N: <boot step, object and SDO abort>             boot failed (link offline, or lost)
+//   node N does not answer (SDO read of 1000h: <abort>)   probe failed
+//   node N: asking it again after T ms (...)              next probe after the back-off
+//   node N stopped answering (heartbeat timeout | node guarding)       operational -> lost
+//   node N is heard again: asking it (SDO read of 1000h)  heartbeat/guard reply of a lost node
+//   node N left operational (now S): configuring it again another master stopped it
+//   <why the profile found the drive not following>       safe stop (link degraded)
+//   node N was stopped over SDO ...: configuring it again safe stop done
+//   the gateway's CAN controller is bus-off / CAN controller recovered from bus-off: ...
+//
 // receive() and transmit() are the cyclic path: no allocation, lock, logging or blocking.
 #include <array>
 #include <atomic>
@@ -71,6 +96,10 @@ class CanopenBus final : public core::Bus {
   bool next_event(core::Event& out) noexcept override;
   core::BusCounters counters() const noexcept override;
 
+  // EMCY events per node: this many at once, then one per kEmcyRefill.
+  static constexpr std::uint32_t kEmcyBurst = 8;
+  static constexpr core::Duration kEmcyRefill = std::chrono::seconds(1);
+
   // Diagnostics (bus thread only, or while the bus is not cycling).
   [[nodiscard]] Phase phase(std::size_t axis) const noexcept { return nodes_[axis]->phase; }
   [[nodiscard]] const SdoClient& sdo() const noexcept { return sdo_; }
@@ -85,12 +114,17 @@ class CanopenBus final : public core::Bus {
   // SYNC and NMT commands on the wire that this gateway did not send: another master.
   [[nodiscard]] std::uint64_t foreign_master_frames() const noexcept { return foreign_master_; }
   [[nodiscard]] std::uint64_t boots(std::size_t axis) const noexcept { return nodes_[axis]->boots; }
+  // EMCYs that were not published as events: over a node's rate limit, or lost in the consumer's
+  // full report queue.
+  [[nodiscard]] std::uint64_t emcy_events_dropped() const noexcept {
+    return emcy_rate_dropped_ + emcy_.counters().reports_dropped;
+  }
   [[nodiscard]] Transport& transport() noexcept { return *transport_; }
 
  private:
   struct Node {
     NodeId id = 0;
-    int channel = 0;  // SdoClient channel index
+    int channel = 0;  // SdoClient channel index, which is the axis index
     NodeBoot boot;
     NodePdos pdos;
     std::unique_ptr<NodeAccess> io;
@@ -104,6 +138,11 @@ class CanopenBus final : public core::Bus {
     cia402::ObjectId watchdog{};  // how the drive watches the gateway (1016h:01 or 100Ch); index 0: not
     std::uint64_t boots = 0;
     core::FixedString<200> detail;
+    // EMCY events: a token bucket (kEmcyBurst, one more per kEmcyRefill) and what it held back.
+    std::uint32_t emcy_tokens = kEmcyBurst;
+    core::TimePoint emcy_refilled{};
+    std::uint64_t emcy_held_back = 0;  // since the last summary
+    EmcyReport emcy_last_held{};
     std::atomic<core::LinkState> link{core::LinkState::Offline};
     Node(int sdo_channel, std::vector<BootStep> steps) : boot(sdo_channel, std::move(steps)) {}
   };
@@ -122,6 +161,8 @@ class CanopenBus final : public core::Bus {
   void release_watchdogs() noexcept;
   void publish_counters() noexcept;
   void note_foreign_master(const CanFrame& f, core::TimePoint now) noexcept;
+  void publish_emcy(core::TimePoint now) noexcept;
+  bool take_emcy_token(Node& n, core::TimePoint now) noexcept;
 
   std::string name_;
   config::CanopenBusOptions options_;
@@ -149,6 +190,11 @@ class CanopenBus final : public core::Bus {
   ControllerState controller_ = ControllerState::Active;
   std::uint64_t unexpected_ = 0;
   std::uint64_t tx_dropped_ = 0;
+  // EMCY events waiting for next_event(); reports stay in the consumer while this is full.
+  std::array<core::Event, 16> emcy_events_{};
+  std::size_t emcy_head_ = 0;
+  std::size_t emcy_count_ = 0;
+  std::uint64_t emcy_rate_dropped_ = 0;
 
   // counters() may be called from any thread.
   std::atomic<std::uint64_t> sent_{0};

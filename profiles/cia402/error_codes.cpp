@@ -7,7 +7,7 @@ namespace {
 
 // Exact codes [CiA 301 Table "Emergency error codes"; CiA 402-2 error code list].
 constexpr std::array kExact = {
-    FaultText{0x0000, "no error"},
+    FaultText{0x0000, "error reset / no error"},
     FaultText{0x1000, "generic error"},
     FaultText{0x2110, "short circuit / earth leakage (input)"},
     FaultText{0x2120, "earth leakage (input)"},

@@ -93,6 +93,134 @@ TEST(CanopenBus, PowerLossIsRecoveredAutomaticallyAndComesBackDisabled) {
   EXPECT_EQ(h.bus->boots(h.axis("nord")), 1U);
 }
 
+// The link events of an axis, in order.
+std::vector<std::string> link_events(const BusHarness& h, core::AxisIndex axis) {
+  std::vector<std::string> v;
+  for (const auto& e : h.events)
+    if (e.axis == axis && e.kind == core::EventKind::LinkChanged) v.emplace_back(e.text.view());
+  return v;
+}
+
+// A cut cable: the AKD runs on and does not boot again, so when it answers again it is found by
+// the probe. Every link event says what its own transition did, never the failure before it (a
+// field report read "link lost -> configuring: node 35 stopped answering").
+TEST(CanopenBus, EveryLinkEventSaysWhatItsOwnTransitionDid) {
+  BusHarness h;
+  const auto akd = h.axis("akd");
+  ASSERT_TRUE(h.run_until([&] { return h.all_up(); }, 5s)) << h.events_text();
+  ASSERT_FALSE(link_events(h, akd).empty());
+  EXPECT_EQ(link_events(h, akd).back(), "link configuring -> operational: node 1 configured") << h.events_text();
+
+  h.events.clear();
+  h.drive("akd").set_silent(true);
+  ASSERT_TRUE(h.run_until([&] { return h.bus->link_state(akd) == LinkState::Lost; }, 2s)) << h.events_text();
+  // Probed (and failing) while the cable is cut: the link stays lost, no new event.
+  h.run_until([] { return false; }, 3s);
+  EXPECT_EQ(h.bus->link_state(akd), LinkState::Lost);
+  h.drive("akd").set_silent(false);
+  ASSERT_TRUE(h.run_until([&] { return h.bus->link_state(akd) == LinkState::Operational; }, 15s)) << h.events_text();
+  EXPECT_EQ(h.bus->boots(akd), 2U);
+
+  const auto links = link_events(h, akd);
+  ASSERT_EQ(links.size(), 3U) << h.events_text();
+  EXPECT_EQ(links[0], "link operational -> lost: node 1 stopped answering (heartbeat timeout)");
+  EXPECT_EQ(links[1], "link lost -> configuring: node 1 answered again; configuring it");
+  EXPECT_EQ(links[2], "link configuring -> operational: node 1 configured");
+  for (std::size_t i = 1; i < links.size(); ++i) {
+    EXPECT_EQ(links[i].find("stopped answering"), std::string::npos) << links[i];
+    EXPECT_EQ(links[i].find("does not answer"), std::string::npos) << links[i];
+  }
+}
+
+// EMCYs that are not the drive's fault (a warning, error reset / no error 0000h) are events of
+// their axis: one each, with code, error register, vendor bytes and the device profile's text.
+TEST(CanopenBus, EveryEmcyIsAnEventWithItsCodeRegisterAndVendorBytes) {
+  BusHarness h;
+  const auto akd = h.axis("akd");
+  ASSERT_TRUE(h.run_until([&] { return h.all_up(); }, 5s)) << h.events_text();
+  const auto emcys = [&] {
+    std::vector<core::Event> v;
+    for (const auto& e : h.events)
+      if (e.kind == core::EventKind::Emcy) v.push_back(e);
+    return v;
+  };
+  EXPECT_TRUE(emcys().empty()) << h.events_text();
+
+  // AKD n502 "DC bus undervoltage" (akd part 1 §9.4), category 1 in byte 3.
+  Emcy warning;
+  warning.code = 0x3280;
+  warning.error_register = 0x05;
+  warning.vendor = {0x01, 0x22, 0x33, 0x44, 0x55};
+  ASSERT_TRUE(h.drive("akd").send_emcy(warning));
+  ASSERT_TRUE(h.run_until([&] { return !emcys().empty(); }, 1s)) << h.events_text();
+  h.run_until([] { return false; }, 100ms);
+  auto got = emcys();
+  ASSERT_EQ(got.size(), 1U) << h.events_text();
+  EXPECT_EQ(got[0].axis, akd);
+  EXPECT_EQ(got[0].code, 0x3280U);
+  EXPECT_EQ(got[0].text.view(),
+            "EMCY 0x3280 n502: Warning: DC bus undervoltage (category 1); register 0x05, vendor bytes 01 22 33 44 55");
+  EXPECT_EQ(got[0].state, AxisState::SwitchOnDisabled);  // a warning: the drive is not in fault
+  EXPECT_EQ(h.snap("akd").fault_code, 0U);
+
+  // The all-clear: 0000h with register 0.
+  Emcy reset;
+  reset.vendor = {0x00, 0x00, 0x00, 0x00, 0x07};
+  ASSERT_TRUE(h.drive("akd").send_emcy(reset));
+  ASSERT_TRUE(h.run_until([&] { return emcys().size() > 1; }, 1s)) << h.events_text();
+  h.run_until([] { return false; }, 100ms);
+  got = emcys();
+  ASSERT_EQ(got.size(), 2U) << h.events_text();
+  EXPECT_EQ(got[1].axis, akd);
+  EXPECT_EQ(got[1].code, 0U);
+  EXPECT_EQ(got[1].text.view(),
+            "EMCY 0x0000 No emergency error (error reset / no error) (category 0); register 0x00, vendor bytes 00 00 "
+            "00 00 07");
+  EXPECT_EQ(h.bus->emcy_events_dropped(), 0U);
+  for (const auto& e : h.events) EXPECT_NE(e.kind, core::EventKind::Fault) << e.text.view();
+}
+
+// A node that floods EMCYs cannot flood the event topic: kEmcyBurst at once, then one per second;
+// the rest are counted and summed up in one warning.
+TEST(CanopenBus, AnEmcyFloodIsBoundedAndCounted) {
+  BusHarness h;
+  const auto akd = h.axis("akd");
+  ASSERT_TRUE(h.run_until([&] { return h.all_up(); }, 5s)) << h.events_text();
+  h.events.clear();
+  Emcy warning;
+  warning.code = 0x86A9;  // n167 software limit exceeded
+  warning.error_register = 0x01;
+  int sent = 0;
+  // 50 EMCYs within 200 ms (the simulated drive queues up to 8 and sends one per cycle).
+  for (int cycle = 0; cycle < 50; ++cycle) {
+    if (h.drive("akd").send_emcy(warning)) ++sent;
+    h.cycle();
+  }
+  h.run_until([] { return false; }, 100ms);  // sent, but not a second later
+  const auto count = [&](core::EventKind kind) {
+    std::size_t n = 0;
+    for (const auto& e : h.events) n += e.axis == akd && e.kind == kind ? 1U : 0U;
+    return n;
+  };
+  ASSERT_EQ(sent, 50);
+  EXPECT_EQ(count(core::EventKind::Emcy), CanopenBus::kEmcyBurst) << h.events_text();
+  EXPECT_EQ(h.bus->emcy_events_dropped(), 50U - CanopenBus::kEmcyBurst);
+  // A second later the node has a token again: one warning says what was held back.
+  h.run_until([] { return false; }, 1s);
+  EXPECT_EQ(count(core::EventKind::Emcy), CanopenBus::kEmcyBurst) << h.events_text();
+  ASSERT_EQ(count(core::EventKind::Warning), 1U) << h.events_text();
+  std::string summary;
+  for (const auto& e : h.events)
+    if (e.axis == akd && e.kind == core::EventKind::Warning) summary = std::string(e.text.view());
+  EXPECT_NE(summary.find("node 1 sent 42 EMCYs that were not published"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("0x86A9"), std::string::npos) << summary;
+  // Quiet again: the bucket refills and the next EMCY is published at once.
+  h.run_until([] { return false; }, 8s);
+  ASSERT_TRUE(h.drive("akd").send_emcy(warning));
+  h.run_until([] { return false; }, 100ms);
+  EXPECT_EQ(count(core::EventKind::Emcy), CanopenBus::kEmcyBurst + 1) << h.events_text();
+}
+
 TEST(CanopenBus, GatewayBusOffTakesEveryNodeDownAndBackUp) {
   BusHarness h;
   ASSERT_TRUE(h.run_until([&] { return h.all_operational(); }, 5s)) << h.events_text();
@@ -140,13 +268,14 @@ TEST(CanopenBus, CyclesAllocateNothingWhileAxesMove) {
   h.cycle();
   core::ParamRequest read = drivegate::test::param_read(0, 0x6064, 0, core::ParamType::I32);
   read.axis = h.axis("sd6");
-  std::size_t params = 0, replies = 0, faults = 0, links = 0;
+  std::size_t params = 0, replies = 0, faults = 0, links = 0, emcys = 0;
   const auto drain = [&] {
     core::Reply r;
     while (h.runner->pop_reply(r)) ++replies;
     core::Event e;
     while (h.runner->pop_event(e)) {
       faults += e.kind == core::EventKind::Fault ? 1U : 0U;
+      emcys += e.kind == core::EventKind::Emcy ? 1U : 0U;
       links += e.kind == core::EventKind::LinkChanged ? 1U : 0U;
     }
     core::ParamReply p;
@@ -165,6 +294,12 @@ TEST(CanopenBus, CyclesAllocateNothingWhileAxesMove) {
       ASSERT_TRUE(h.runner->push_command(cmd));
     }
     if (i == 200) h.drive("sd6").inject_fault(0x4310, 2);  // a drive fault with its EMCY
+    if (i >= 250 && i < 270) {  // warnings, more than are published: events, then held back and counted
+      Emcy warning;
+      warning.code = 0x3280;
+      warning.error_register = 0x01;
+      h.drive("akd").send_emcy(warning);
+    }
     if (i == 300) {
       h.drive("sd6").clear_fault_cause();
       cmd.id = 300000;
@@ -184,6 +319,8 @@ TEST(CanopenBus, CyclesAllocateNothingWhileAxesMove) {
   // What the window was to hold really happened in it.
   EXPECT_GE(params, 20U);
   EXPECT_GE(faults, 1U);
+  EXPECT_GE(emcys, CanopenBus::kEmcyBurst);
+  EXPECT_GT(h.bus->emcy_events_dropped(), 0U);
   EXPECT_GE(links, 2U);  // nord: operational -> lost -> ... -> operational
   EXPECT_EQ(h.bus->link_state(h.axis("nord")), LinkState::Operational) << h.events_text();
   EXPECT_GT(replies, 40U);

@@ -78,6 +78,29 @@ TEST_F(CanopenE2eFaults, DriveFaultShowsTheProfileTextAndResetsOnceTheCauseIsGon
   }, 2s, status)) << status;
 }
 
+// EMCYs that are not the drive's fault reach the event topic: a warning and the all-clear 0000h,
+// one event each, with the EMCY code in `code` and register and vendor bytes in the text.
+TEST_F(CanopenE2eFaults, WarningAndErrorResetEmcysArePublishedAsEvents) {
+  ASSERT_NO_FATAL_FAILURE(sim_command("emcy 1 0x3280 0x05 1 0x22 0x33 0x44 0x55", "ok emcy node 1 0x3280"));
+  const std::string warning =
+      "EMCY 0x3280 n502: Warning: DC bus undervoltage (category 1); register 0x05, vendor bytes 01 22 33 44 55";
+  ASSERT_TRUE(wait_event("akd", "emcy", warning, 3s)) << diagnostics();
+  ASSERT_NO_FATAL_FAILURE(sim_command("emcy 1 0 0", "ok emcy node 1 0x0000"));
+  ASSERT_TRUE(wait_event("akd", "emcy", "EMCY 0x0000 No emergency error (error reset / no error)", 3s))
+      << diagnostics();
+  std::vector<client::AxisEvent> emcys;
+  for (const auto& e : events())
+    if (e.kind == "emcy") emcys.push_back(e);
+  ASSERT_EQ(emcys.size(), 2u) << diagnostics();
+  EXPECT_EQ(emcys[0].text, warning);
+  EXPECT_EQ(emcys[0].code, 0x3280u);
+  EXPECT_EQ(emcys[0].state, "switch_on_disabled");
+  EXPECT_EQ(emcys[1].code, 0u);
+  EXPECT_NE(emcys[1].text.find("register 0x00, vendor bytes 00 00 00 00 00"), std::string::npos) << emcys[1].text;
+  EXPECT_EQ(state("akd").state, "switch_on_disabled");
+  EXPECT_EQ(state("akd").fault_code, 0u);
+}
+
 // A drive that loses power is lost (the AKD's heartbeat stops, the SD6 stops answering node
 // guarding), comes back by itself when powered again, configured from scratch and disabled, and
 // can be enabled again. The NORD on the same bus never notices.
@@ -99,9 +122,19 @@ TEST_F(CanopenE2eFaults, PowerLossIsRecoveredByItselfAndComesBackDisabled) {
   ASSERT_NO_FATAL_FAILURE(sim_command("power-on 1", "ok power-on node 1"));
   ASSERT_NO_FATAL_FAILURE(sim_command("power-on 3", "ok power-on node 3"));
   ASSERT_TRUE(wait_all("switch_on_disabled", 10s)) << diagnostics();
-  // Reconfigured from scratch after the boot-up (AKD) or the probe (SD6).
-  for (const char* axis : {"akd", "sd6"})
+  // Reconfigured from scratch after the boot-up (AKD) or the probe (SD6). Each link event says what
+  // its own transition did, not the loss before it.
+  for (const char* axis : {"akd", "sd6"}) {
     EXPECT_TRUE(wait_event(axis, "link_changed", "link lost -> configuring", 1s)) << axis << diagnostics();
+    EXPECT_TRUE(wait_event(axis, "link_changed", "link configuring -> operational: node", 1s)) << axis << diagnostics();
+    for (const auto& e : events()) {
+      if (e.axis != axis || e.kind != "link_changed" || e.text.find("link lost -> ") == std::string::npos) continue;
+      EXPECT_EQ(e.text.find("stopped answering"), std::string::npos) << e.text;
+      EXPECT_EQ(e.text.find("heartbeat"), std::string::npos) << e.text;
+      EXPECT_EQ(e.text.find("node guarding"), std::string::npos) << e.text;
+      EXPECT_NE(e.text.find("configuring it"), std::string::npos) << e.text;
+    }
+  }
   for (const char* axis : {"akd", "sd6"}) {
     const auto r = send(axis, "enable");
     EXPECT_EQ(r.outcome, Outcome::Completed) << axis << ": " << r.reason << diagnostics();

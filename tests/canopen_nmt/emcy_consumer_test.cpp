@@ -86,7 +86,7 @@ TEST_F(EmcyConsumerTest, Sd6LeavingFaultTv5ClearsTheActiveFault) {
   ASSERT_NE(c_.active(kSd6), nullptr);
   const auto r = one(make_frame(0x085, {0x00, 0x00, 0x00, 0x1E, 0x00, 0x00, 0x00, 0x00}));
   EXPECT_TRUE(r.cleared);
-  EXPECT_EQ(r.text.view(), "0x0000 no error (event 30, cause 0)");  // E82 = 30 "inactive"
+  EXPECT_EQ(r.text.view(), "0x0000 error reset / no error (event 30, cause 0)");  // E82 = 30 "inactive"
   EXPECT_EQ(c_.active(kSd6), nullptr);
 }
 

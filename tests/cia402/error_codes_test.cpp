@@ -10,7 +10,7 @@ namespace drivegate::cia402 {
 namespace {
 
 TEST(ErrorCodes, ExactCodes) {
-  EXPECT_EQ(error_code_text(0x0000), "no error");
+  EXPECT_EQ(error_code_text(0x0000), "error reset / no error");
   EXPECT_EQ(error_code_text(0x1000), "generic error");
   EXPECT_EQ(error_code_text(0x2310), "continuous overcurrent (output)");
   EXPECT_EQ(error_code_text(0x3210), "DC link overvoltage");

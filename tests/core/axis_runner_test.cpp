@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <string>
 #include <vector>
 
 #include "core/bus_runner.hpp"
@@ -24,7 +25,7 @@ class FakeController final : public AxisController {
     if (abort_in_flight && in_flight != 0) sink.failed(in_flight, "aborted by a newer command");
     in_flight = cmd.id;
     if (complete_inline) sink.completed(cmd.id);
-    if (cmd.kind == CommandKind::Velocity) fb.mode = Mode::ProfileVelocity;
+    if (cmd.kind == CommandKind::Velocity && mode_follows) fb.mode = Mode::ProfileVelocity;
     return Admission::accept();
   }
   void setpoint(const DriveSetpoint& sp, TimePoint) noexcept override { last_setpoint = sp; ++setpoints; }
@@ -46,6 +47,7 @@ class FakeController final : public AxisController {
   bool refuse = false;
   bool complete_inline = false;
   bool abort_in_flight = false;
+  bool mode_follows = true;  // false: the drive still shows its old mode (6061h lags behind 6060h)
   CommandId in_flight = 0;
   CommandId complete_next = 0;
 };
@@ -69,6 +71,11 @@ class Recorder final : public RunnerOutput {
     for (const auto& e : events)
       if (e.kind == k) return true;
     return false;
+  }
+  std::string events_text() const {
+    std::string s;
+    for (const auto& e : events) s += std::string(to_string(e.kind)) + ": " + std::string(e.text.view()) + "\n";
+    return s;
   }
 };
 
@@ -467,4 +474,126 @@ TEST_F(RunnerFixture, TimeoutArmedWhileTheDriveStillSwitchesIntoTheLiveMode) {
   runner.update(now + 200ms, LinkState::Operational, out);
   ASSERT_EQ(ctl.submitted.size(), 2u);
   EXPECT_EQ(ctl.submitted[1].kind, CommandKind::QuickStop);
+}
+
+// A velocity or torque command from profile position: while the drive still shows pp, the
+// client's keep-alive set-points belong to the mode being entered. They keep the command alive
+// (no command timeout) and are not refused with "profile_position takes no set-points".
+TEST_F(RunnerFixture, KeepAlivesWhileSwitchingFromProfilePositionAreAcceptedSilently) {
+  for (const CommandKind kind : {CommandKind::Velocity, CommandKind::Torque}) {
+    SCOPED_TRACE(std::string(to_string(kind)));
+    ctl.fb.mode = Mode::ProfilePosition;
+    ctl.mode_follows = false;
+    auto c = cmd(kind == CommandKind::Velocity ? 40 : 41, kind);
+    c.velocity = 20;
+    c.torque = 10;
+    runner.command(c, now, out);
+    ASSERT_EQ(out.to(c.id).size(), 1u);
+    ASSERT_EQ(out.to(c.id)[0].status, ReplyStatus::Accepted) << out.to(c.id)[0].reason.view();
+    const std::size_t submitted = ctl.submitted.size();
+    // The switch takes longer than the command timeout (100 ms); the keep-alives hold it off.
+    for (int i = 1; i <= 8; ++i) {
+      Setpoint sp;
+      sp.axis = 0;
+      sp.velocity = 20;
+      sp.torque = 10;
+      runner.setpoint(sp, now + i * 50ms, out);
+      runner.update(now + i * 50ms, LinkState::Operational, out);
+    }
+    EXPECT_EQ(ctl.submitted.size(), submitted) << "no stop of the gateway's own";
+    EXPECT_FALSE(out.has_event(EventKind::CommandTimeout)) << out.events_text();
+    EXPECT_FALSE(out.has_event(EventKind::Warning)) << out.events_text();
+    EXPECT_EQ(runner.rejected_setpoints(), 0u);
+    EXPECT_EQ(ctl.setpoints, 0);  // a keep-alive: the command set the target
+    // The drive arrives in the mode: the keep-alives go on as before.
+    ctl.fb.mode = kind == CommandKind::Velocity ? Mode::ProfileVelocity : Mode::ProfileTorque;
+    ctl.complete_next = c.id;
+    runner.update(now + 450ms, LinkState::Operational, out);
+    Setpoint sp;
+    sp.axis = 0;
+    runner.setpoint(sp, now + 480ms, out);
+    runner.update(now + 500ms, LinkState::Operational, out);
+    EXPECT_FALSE(out.has_event(EventKind::Warning)) << out.events_text();
+    EXPECT_EQ(ctl.submitted.size(), submitted);
+    // The client stops; the next command starts from pp again.
+    runner.command(cmd(c.id + 100, CommandKind::Stop), now + 500ms, out);
+    now += 1s;
+    runner.update(now, LinkState::Operational, out);
+    out.events.clear();
+  }
+}
+
+// Set-points for an axis whose mode (and the mode it is commanded into) takes none still warn:
+// in pp without a command, and after a velocity command that a move superseded.
+TEST_F(RunnerFixture, SetpointsForAModeThatTakesNoneWarn) {
+  ctl.fb.mode = Mode::ProfilePosition;
+  ctl.mode_follows = false;
+  Setpoint sp;
+  sp.axis = 0;
+  runner.setpoint(sp, now, out);
+  ASSERT_TRUE(out.has_event(EventKind::Warning));
+  EXPECT_NE(out.events.back().text.view().find("profile_position, which takes no set-points"), std::string_view::npos)
+      << out.events_text();
+  EXPECT_EQ(runner.rejected_setpoints(), 1u);
+
+  ctl.abort_in_flight = true;
+  auto v = cmd(50, CommandKind::Velocity);
+  v.velocity = 20;
+  runner.command(v, now, out);
+  runner.setpoint(sp, now + 1ms, out);
+  EXPECT_EQ(runner.rejected_setpoints(), 1u);  // entering pv: a keep-alive
+  auto m = cmd(51, CommandKind::Move);
+  m.position = 5;
+  runner.command(m, now + 2ms, out);  // aborts the velocity command: the axis stays in pp
+  runner.setpoint(sp, now + 3ms, out);
+  EXPECT_EQ(runner.rejected_setpoints(), 2u);
+}
+
+// Events a bus reports about one of its axes (a CANopen EMCY) keep their axis and get its state;
+// the others are about the bus.
+TEST(BusRunner, BusEventsKeepTheirAxis) {
+  struct EventBus final : public Bus {
+    std::string_view name() const noexcept override { return "fake"; }
+    std::string_view type() const noexcept override { return "fake"; }
+    void open(TimePoint) override {}
+    void close() noexcept override {}
+    std::size_t axis_count() const noexcept override { return 2; }
+    AxisController& controller(std::size_t i) noexcept override { return ctl[i]; }
+    LinkState link_state(std::size_t) const noexcept override { return LinkState::Operational; }
+    void receive(TimePoint) noexcept override {}
+    void transmit(TimePoint) noexcept override {}
+    bool next_event(Event& out) noexcept override {
+      if (pending == 0) return false;
+      out = Event{};
+      out.kind = EventKind::Emcy;
+      out.axis = pending == 2 ? 1 : 7;
+      out.code = 0x3280;
+      --pending;
+      return true;
+    }
+    BusCounters counters() const noexcept override { return {}; }
+    FakeController ctl[2];
+    int pending = 0;
+  } bus;
+  for (auto& c : bus.ctl) {
+    c.fb.valid = true;
+    c.fb.state = AxisState::SwitchOnDisabled;
+  }
+  std::vector<AxisSpec> specs{drivegate::test::linear_axis_spec(), drivegate::test::linear_axis_spec()};
+  specs[1].name = "y";
+  BusRunner runner(bus, specs);
+  runner.cycle(TimePoint{1s});
+  Event e;
+  while (runner.pop_event(e)) {
+  }
+  bus.pending = 2;
+  runner.cycle(TimePoint{1s + 1ms});
+  std::vector<Event> emcy;
+  while (runner.pop_event(e))
+    if (e.kind == EventKind::Emcy) emcy.push_back(e);
+  ASSERT_EQ(emcy.size(), 2u);
+  EXPECT_EQ(emcy[0].axis, 1);
+  EXPECT_EQ(emcy[0].state, AxisState::SwitchOnDisabled);
+  EXPECT_EQ(emcy[0].stamp_ns, to_ns(TimePoint{1s + 1ms}));
+  EXPECT_EQ(emcy[1].axis, kNoAxis);  // no such axis: about the bus
 }

@@ -92,6 +92,10 @@ class SlaveNode final : private SdoBackend, private PdoObjects {
   // manufacturer bytes, `cause` in byte 4 where the persona has one (SD6 E43).
   void inject_fault(std::uint16_t code, std::uint8_t cause = 0) noexcept;
   void clear_fault_cause() noexcept;
+  // An EMCY that changes nothing in the drive (a warning such as the AKD's n-numbers, an error
+  // reset / no error 0000h): queued like the drive's own, sent while NMT serves EMCY. False when
+  // suppressed or the producer's queue is full.
+  bool send_emcy(const Emcy& emcy) noexcept { return emcy_.raise(emcy); }
   // A cut cable: nothing is received or sent (on_frame() and the outbox are the cable); the
   // engines behind it run on, so life guarding and the heartbeat consumer notice the silent master.
   void set_silent(bool on) noexcept { silent_ = on; }

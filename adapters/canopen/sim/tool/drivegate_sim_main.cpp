@@ -83,12 +83,14 @@ std::string hex8(std::uint32_t v) {
 }
 
 constexpr std::string_view kCommands =
-    "power-off NODE, power-on NODE, fault NODE CODE [CAUSE], clear NODE, silent NODE on|off, "
+    "power-off NODE, power-on NODE, fault NODE CODE [CAUSE], clear NODE, emcy NODE CODE REGISTER [BYTE3..BYTE7], "
+    "silent NODE on|off, "
     "abort NODE INDEX[:SUB] CODE, corrupt NODE COUNT [dlc|garbage], service-write NODE INDEX[:SUB] VALUE SIZE, "
     "status";
 
 std::string usage_of(const std::string& verb) {
   if (verb == "fault") return "NODE CODE [CAUSE]";
+  if (verb == "emcy") return "NODE CODE REGISTER [BYTE3..BYTE7] (code 0x0000..0xFFFF, register and bytes 0..255)";
   if (verb == "silent") return "NODE on|off";
   if (verb == "abort") return "NODE INDEX[:SUB] CODE (hex index, e.g. abort 3 0x6081 0x06090031)";
   if (verb == "corrupt") return "NODE COUNT [dlc|garbage]";
@@ -113,7 +115,7 @@ class Simulator {
     if (verb.empty()) return "error: empty command";
     if (verb == "status") return status();
     if (verb != "power-off" && verb != "power-on" && verb != "fault" && verb != "clear" && verb != "silent" &&
-        verb != "abort" && verb != "corrupt" && verb != "service-write") {
+        verb != "abort" && verb != "corrupt" && verb != "service-write" && verb != "emcy") {
       return "error: unknown command \"" + verb + "\" (" + std::string(kCommands) + ")";
     }
     in >> node_text;
@@ -179,6 +181,26 @@ class Simulator {
       }
       node->damage_next(static_cast<std::uint32_t>(*count), how == "garbage" ? FrameDamage::Garbage : FrameDamage::WrongDlc);
       return "ok corrupt " + id;
+    }
+    if (verb == "emcy" && !arg.empty()) {
+      // An EMCY that changes nothing in the drive: a warning, an error reset / no error (0000h).
+      canopen::Emcy e;
+      std::string register_text;
+      in >> register_text;
+      const auto code = parse_number(arg);
+      const auto reg = parse_number(register_text);
+      bool ok = code && *code <= 0xFFFF && reg && *reg <= 0xFF;
+      std::size_t bytes = 0;
+      for (std::string b; ok && in >> b; ++bytes) {
+        const auto v = parse_number(b);
+        ok = bytes < e.vendor.size() && v && *v <= 0xFF;
+        if (ok) e.vendor[bytes] = static_cast<std::uint8_t>(*v);
+      }
+      if (!ok) return "error: emcy takes " + usage_of(verb);
+      e.code = static_cast<std::uint16_t>(*code);
+      e.error_register = static_cast<std::uint8_t>(*reg);
+      if (!node->send_emcy(e)) return "error: " + id + " does not send EMCY now (NMT state, or its queue is full)";
+      return "ok emcy " + id + " " + hex4(e.code);
     }
     if (verb == "fault") {
       std::string cause_text;
