@@ -1,5 +1,6 @@
 #include "daemon/dds_bridge.hpp"
 
+#include <pthread.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -338,7 +339,10 @@ void DdsBridge::Impl::start() {
                opt_.interfaces.empty() ? std::string{} : ", interfaces " + std::to_string(opt_.interfaces.size()),
                rt_.axes().size(), opt_.status_rate_hz);
   running_ = true;
-  thread_ = std::thread([this] { run(); });
+  thread_ = std::thread([this] {
+    ::pthread_setname_np(::pthread_self(), "dg-dds");  // top -H shows who uses what
+    run();
+  });
 }
 
 void DdsBridge::Impl::stop() {

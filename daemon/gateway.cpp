@@ -78,7 +78,7 @@ void Gateway::start() {
     sched.period = b.plan->cycle_time;
     sched.priority = b.plan->priority;
     sched.cpu = b.plan->cpu;
-    sched.name = "dg-" + b.plan->name;  // "dg-sim0": the cycle thread of bus sim0
+    sched.name = "dg-cycle-" + b.plan->name;  // "dg-cycle-sim0" (the kernel keeps 15 characters)
     core::BusRunner* runner = b.runner.get();
     b.thread = std::make_unique<CycleThread>(sched, [runner](core::TimePoint t, std::uint64_t) { runner->cycle(t); });
     if (!b.thread->start()) throw core::BusError("bus '" + b.plan->name + "': could not start its cycle thread");

@@ -21,7 +21,7 @@ using namespace std::chrono_literals;
 
 namespace {
 
-// The thread of `pid` named `name` (drivegated names each cycle thread "dg-<bus>").
+// The thread of `pid` named `name` (drivegated names each cycle thread "dg-cycle-<bus>").
 pid_t thread_named(pid_t pid, const std::string& name) {
   for (const auto& task : std::filesystem::directory_iterator("/proc/" + std::to_string(pid) + "/task")) {
     std::ifstream in(task.path() / "comm");
@@ -48,8 +48,9 @@ TEST(Watchdog, IsWithheldWhileACycleThreadStalls) {
   ASSERT_TRUE(notify.wait_for("READY=1", 15s)) << daemon.log();
   ASSERT_TRUE(notify.wait_for("WATCHDOG=1", 3s)) << daemon.log();
 
-  const pid_t cycle = thread_named(daemon.pid(), "dg-sim0");
-  ASSERT_GT(cycle, 0) << "no thread dg-sim0 in drivegated";
+  const pid_t cycle = thread_named(daemon.pid(), "dg-cycle-sim0");
+  ASSERT_GT(cycle, 0) << "no thread dg-cycle-sim0 in drivegated";
+  EXPECT_GT(thread_named(daemon.pid(), "dg-dds"), 0) << "the DDS bridge thread is named for top -H";
   ASSERT_EQ(::ptrace(PTRACE_SEIZE, cycle, nullptr, nullptr), 0) << std::strerror(errno);
   ASSERT_EQ(::ptrace(PTRACE_INTERRUPT, cycle, nullptr, nullptr), 0) << std::strerror(errno);
   int status = 0;
