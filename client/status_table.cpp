@@ -8,7 +8,7 @@ namespace drivegate::client {
 
 namespace {
 
-constexpr std::size_t kColumns = 8;
+constexpr std::size_t kColumns = 9;
 using Row = std::array<std::string, kColumns>;
 
 std::string number(double v, const std::string& unit) {
@@ -22,10 +22,9 @@ std::string number(double v, const std::string& unit) {
 std::string format_status_table(const std::vector<AxisState>& states, std::chrono::steady_clock::time_point now,
                                 std::chrono::milliseconds stale_after) {
   std::vector<Row> rows;
-  rows.push_back({"GATEWAY", "AXIS", "STATE", "MODE", "POSITION", "VELOCITY", "TORQUE", "FAULT"});
+  rows.push_back({"GATEWAY", "AXIS", "LINK", "STATE", "MODE", "POSITION", "VELOCITY", "TORQUE", "FAULT"});
   for (const auto& s : states) {
     std::string state = s.state;
-    if (s.link != "operational") state += " [" + s.link + "]";
     if (s.stopping) state += " (stopping)";
     if (now - s.received > stale_after) state += " (stale)";
     std::string fault;
@@ -37,7 +36,7 @@ std::string format_status_table(const std::vector<AxisState>& states, std::chron
       fault = "warning";
     }
     const std::string rate_unit = s.unit.empty() ? "" : s.unit + "/s";
-    rows.push_back({s.gateway, s.axis, state, s.mode, number(s.position, s.unit), number(s.velocity, rate_unit),
+    rows.push_back({s.gateway, s.axis, s.link, state, s.mode, number(s.position, s.unit), number(s.velocity, rate_unit),
                     number(s.torque, ""), fault});
   }
   std::array<std::size_t, kColumns> width{};

@@ -88,6 +88,9 @@ TEST_F(Drivegatectl, ListStatusAndParam) {
   r = ctl("status x");
   EXPECT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("switch_on_disabled"), std::string::npos) << r.output;
+  // The link has a column of its own.
+  EXPECT_NE(r.output.find("GATEWAY  AXIS  LINK         STATE"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("x     operational  switch_on_disabled"), std::string::npos) << r.output;
   rt_.set_object(0, 0x6061, 0, core::ParamType::I8, "-3");
   r = ctl("param get x 6061h:0");
   EXPECT_EQ(r.status, 0) << r.output;
