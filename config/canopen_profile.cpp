@@ -8,6 +8,7 @@
 #include "config/object_text.hpp"
 #include "config/parameter_names.hpp"
 #include "config/text_util.hpp"
+#include "profiles/cia402/standard_types.hpp"
 
 namespace drivegate::config {
 
@@ -60,7 +61,7 @@ std::optional<cia402::ObjectId> read_object(const YAML::Node& n, const std::stri
 
 void check_known_type(const YAML::Node& n, const std::string& path, const Source& src, cia402::ObjectId id,
                       cia402::DataType type) {
-  const auto known = known_object_type(id);
+  const auto known = cia402::profile_object_type(id);  // a profile that gives 6060h another size is caught
   if (known && size_of(*known) != size_of(type))
     src.error(n.Mark(), path,
               hex_text(id) + " is " + std::string{to_string(*known)} + " in CiA 402, got " + std::string{to_string(type)});

@@ -32,35 +32,6 @@ constexpr std::array<std::pair<std::string_view, cia402::DataType>, 6> kTypes{{
     {"u32", cia402::DataType::U32},
 }};
 
-// Every object of profiles/cia402/objects.hpp: their types are the CiA 402 ones.
-constexpr std::array kKnown{
-    cia402::obj::kErrorRegister,           cia402::obj::kErrorCode,
-    cia402::obj::kControlword,             cia402::obj::kStatusword,
-    cia402::obj::kVlTargetVelocity,        cia402::obj::kVlVelocityDemand,
-    cia402::obj::kVlVelocityActual,        cia402::obj::kVlAccelerationDeltaSpeed,
-    cia402::obj::kVlAccelerationDeltaTime, cia402::obj::kVlDecelerationDeltaSpeed,
-    cia402::obj::kVlDecelerationDeltaTime, cia402::obj::kQuickStopOption,
-    cia402::obj::kShutdownOption,          cia402::obj::kDisableOperationOption,
-    cia402::obj::kHaltOption,              cia402::obj::kFaultReactionOption,
-    cia402::obj::kModesOfOperation,        cia402::obj::kModesOfOperationDisplay,
-    cia402::obj::kPositionDemand,          cia402::obj::kPositionActual,
-    cia402::obj::kFollowingErrorWindow,    cia402::obj::kFollowingErrorTimeout,
-    cia402::obj::kPositionWindow,          cia402::obj::kPositionWindowTime,
-    cia402::obj::kVelocityActual,          cia402::obj::kVelocityWindow,
-    cia402::obj::kVelocityWindowTime,      cia402::obj::kTargetTorque,
-    cia402::obj::kMaxTorque,               cia402::obj::kTorqueActual,
-    cia402::obj::kTargetPosition,          cia402::obj::kHomeOffset,
-    cia402::obj::kSoftwareLimitMin,        cia402::obj::kSoftwareLimitMax,
-    cia402::obj::kMaxProfileVelocity,      cia402::obj::kProfileVelocity,
-    cia402::obj::kProfileAcceleration,     cia402::obj::kProfileDeceleration,
-    cia402::obj::kQuickStopDeceleration,   cia402::obj::kTorqueSlope,
-    cia402::obj::kHomingMethod,            cia402::obj::kHomingSpeedSwitch,
-    cia402::obj::kHomingSpeedZero,         cia402::obj::kHomingAcceleration,
-    cia402::obj::kIpDataRecord,            cia402::obj::kIpTimePeriodUnits,
-    cia402::obj::kIpTimePeriodIndex,       cia402::obj::kVelocityOffset,
-    cia402::obj::kTorqueOffset,            cia402::obj::kDigitalInputs,
-    cia402::obj::kTargetVelocity,          cia402::obj::kSupportedDriveModes,
-};
 }  // namespace
 
 std::optional<cia402::DataType> parse_data_type(std::string_view text) {
@@ -91,12 +62,6 @@ std::string object_text(cia402::ObjectId id) {
   else
     std::snprintf(buf, sizeof buf, "%04Xh:%u", id.index, static_cast<unsigned>(id.sub));
   return buf;
-}
-
-std::optional<cia402::DataType> known_object_type(cia402::ObjectId id) noexcept {
-  for (const auto& def : kKnown)
-    if (def.id == id) return def.type;
-  return std::nullopt;
 }
 
 std::int64_t type_min(cia402::DataType type) noexcept {

@@ -19,9 +19,6 @@ const std::vector<std::string>& data_type_names();
 std::string_view to_string(cia402::DataType type) noexcept;
 // "6040h", "6099h:1": the form the digests and --check-config use.
 std::string object_text(cia402::ObjectId id);
-// The standard type of a CiA 402 object the profile code knows (profiles/cia402/objects.hpp), so a
-// profile that gives 6060h another size is caught; nullopt for objects it does not know.
-std::optional<cia402::DataType> known_object_type(cia402::ObjectId id) noexcept;
 // Lowest and highest value of a type.
 std::int64_t type_min(cia402::DataType type) noexcept;
 std::int64_t type_max(cia402::DataType type) noexcept;

@@ -47,6 +47,8 @@ constexpr std::array<TypeInfo, 26> kTypes{{
     {ParamType::TimeDifference, "time_difference", "TIME_DIFFERENCE", 0x000D, 6},
 }};
 
+constexpr char kHexDigits[] = "0123456789ABCDEF";
+
 const TypeInfo& info(ParamType t) noexcept {
   for (const auto& i : kTypes)
     if (i.type == t) return i;
@@ -301,7 +303,6 @@ std::string visible_text(std::span<const std::uint8_t> b) {
   std::size_t n = b.size();
   while (n > 0 && b[n - 1] == 0) --n;
   std::string out;
-  static constexpr char kHex[] = "0123456789ABCDEF";
   for (std::size_t i = 0; i < n; ++i) {
     if (b[i] >= 0x20 && b[i] <= 0x7E && b[i] != '\\') {
       out.push_back(static_cast<char>(b[i]));
@@ -309,8 +310,8 @@ std::string visible_text(std::span<const std::uint8_t> b) {
       out += "\\\\";
     } else {
       out += "\\x";
-      out.push_back(kHex[b[i] >> 4]);
-      out.push_back(kHex[b[i] & 0xF]);
+      out.push_back(kHexDigits[b[i] >> 4]);
+      out.push_back(kHexDigits[b[i] & 0xF]);
     }
   }
   return out;
@@ -441,13 +442,12 @@ std::optional<double> param_as_real(ParamType t, std::span<const std::uint8_t> b
 }
 
 std::string hex_bytes(std::span<const std::uint8_t> bytes) {
-  static constexpr char kHex[] = "0123456789ABCDEF";
   std::string out;
   out.reserve(bytes.size() * 3);
   for (std::size_t i = 0; i < bytes.size(); ++i) {
     if (i != 0) out.push_back(' ');
-    out.push_back(kHex[bytes[i] >> 4]);
-    out.push_back(kHex[bytes[i] & 0xF]);
+    out.push_back(kHexDigits[bytes[i] >> 4]);
+    out.push_back(kHexDigits[bytes[i] & 0xF]);
   }
   return out;
 }
@@ -469,9 +469,8 @@ std::string format_param(ParamType t, std::span<const std::uint8_t> bytes) {
 std::optional<std::string> format_param_hex(ParamType t, std::span<const std::uint8_t> bytes) {
   const auto u = param_as_unsigned(t, bytes);
   if (!u || t == ParamType::Bool) return std::nullopt;
-  static constexpr char kHex[] = "0123456789ABCDEF";
   std::string out = "0x";
-  for (std::size_t i = bytes.size() * 2; i-- > 0;) out.push_back(kHex[(*u >> (4 * i)) & 0xF]);
+  for (std::size_t i = bytes.size() * 2; i-- > 0;) out.push_back(kHexDigits[(*u >> (4 * i)) & 0xF]);
   return out;
 }
 

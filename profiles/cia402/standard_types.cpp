@@ -105,11 +105,16 @@ ParamType to_param_type(DataType t) noexcept {
   return ParamType::Unknown;
 }
 
+std::optional<DataType> profile_object_type(ObjectId id) noexcept {
+  for (const auto& d : kProfileObjects)
+    if (d.id == id) return d.type;
+  return std::nullopt;
+}
+
 ParamType standard_param_type(ObjectId id) noexcept {
   if (id.index < 0x2000) return comm_type(id);
-  for (const auto& d : kProfileObjects)
-    if (d.id == id) return to_param_type(d.type);
-  return ParamType::Unknown;
+  const auto t = profile_object_type(id);
+  return t ? to_param_type(*t) : ParamType::Unknown;
 }
 
 }  // namespace drivegate::cia402

@@ -8,7 +8,8 @@
 namespace drivegate::canopen::test {
 namespace {
 
-TEST(ParameterNames, EdsNamesAndVendorNamesResolvePerAxis) {
+// Axis 0: an AKD with the test EDS; axis 1: an SD6 without one.
+config::Plan akd_with_eds_and_sd6() {
   const std::string yaml = std::string(R"(gateway: { name: names }
 buses:
   - { name: can0, type: canopen, cycle_time: 4ms, options: { transport: sim, bitrate: 1000000 } }
@@ -17,7 +18,11 @@ axes:
       canopen: { eds: ")") + DRIVEGATE_TEST_EDS + R"(" } }
   - { name: sd6, bus: can0, address: 3, device: stoeber-sd6, mechanics: { encoder_counts_per_rev: 10000 } }
 )";
-  const config::Plan plan = config::load_plan_from_string(yaml, "names.yaml");
+  return config::load_plan_from_string(yaml, "names.yaml");
+}
+
+TEST(ParameterNames, EdsNamesAndVendorNamesResolvePerAxis) {
+  const config::Plan plan = akd_with_eds_and_sd6();
   daemon::Gateway gw(plan);
 
   auto p = gw.lookup_parameter(0, "fbus.param05", 0, 0);  // case-insensitive
@@ -49,15 +54,7 @@ axes:
 // Without a name the object is index:sub, typed by the EDS, then the device profile (its PDO maps
 // and start-up writes), then CiA 301/402; anything else stays unknown.
 TEST(ParameterNames, TypesFromEdsProfileAndStandards) {
-  const std::string yaml = std::string(R"(gateway: { name: types }
-buses:
-  - { name: can0, type: canopen, cycle_time: 4ms, options: { transport: sim, bitrate: 1000000 } }
-axes:
-  - { name: akd, bus: can0, address: 1, device: kollmorgen-akd, unit: mm, mechanics: { feed: 5 },
-      canopen: { eds: ")") + DRIVEGATE_TEST_EDS + R"(" } }
-  - { name: sd6, bus: can0, address: 3, device: stoeber-sd6, mechanics: { encoder_counts_per_rev: 10000 } }
-)";
-  const config::Plan plan = config::load_plan_from_string(yaml, "types.yaml");
+  const config::Plan plan = akd_with_eds_and_sd6();
   daemon::Gateway gw(plan);
   struct Case {
     std::size_t axis;

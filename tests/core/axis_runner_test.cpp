@@ -372,10 +372,21 @@ class FakeBus final : public Bus {
   LinkState link_state(std::size_t) const noexcept override { return LinkState::Operational; }
   void receive(TimePoint) noexcept override { ++receives; }
   void transmit(TimePoint) noexcept override { ++transmits; }
+  // `pending_emcys` EMCY events: the first for axis 1, the others for an axis the bus does not have.
+  bool next_event(Event& out) noexcept override {
+    if (pending_emcys == 0) return false;
+    out = Event{};
+    out.kind = EventKind::Emcy;
+    out.axis = pending_emcys == 2 ? 1 : 7;
+    out.code = 0x3280;
+    --pending_emcys;
+    return true;
+  }
   BusCounters counters() const noexcept override { return {}; }
   FakeController ctl[2];
   int receives = 0;
   int transmits = 0;
+  int pending_emcys = 0;
 };
 }  // namespace
 
@@ -552,29 +563,7 @@ TEST_F(RunnerFixture, SetpointsForAModeThatTakesNoneWarn) {
 // Events a bus reports about one of its axes (a CANopen EMCY) keep their axis and get its state;
 // the others are about the bus.
 TEST(BusRunner, BusEventsKeepTheirAxis) {
-  struct EventBus final : public Bus {
-    std::string_view name() const noexcept override { return "fake"; }
-    std::string_view type() const noexcept override { return "fake"; }
-    void open(TimePoint) override {}
-    void close() noexcept override {}
-    std::size_t axis_count() const noexcept override { return 2; }
-    AxisController& controller(std::size_t i) noexcept override { return ctl[i]; }
-    LinkState link_state(std::size_t) const noexcept override { return LinkState::Operational; }
-    void receive(TimePoint) noexcept override {}
-    void transmit(TimePoint) noexcept override {}
-    bool next_event(Event& out) noexcept override {
-      if (pending == 0) return false;
-      out = Event{};
-      out.kind = EventKind::Emcy;
-      out.axis = pending == 2 ? 1 : 7;
-      out.code = 0x3280;
-      --pending;
-      return true;
-    }
-    BusCounters counters() const noexcept override { return {}; }
-    FakeController ctl[2];
-    int pending = 0;
-  } bus;
+  FakeBus bus;
   for (auto& c : bus.ctl) {
     c.fb.valid = true;
     c.fb.state = AxisState::SwitchOnDisabled;
@@ -586,7 +575,7 @@ TEST(BusRunner, BusEventsKeepTheirAxis) {
   Event e;
   while (runner.pop_event(e)) {
   }
-  bus.pending = 2;
+  bus.pending_emcys = 2;
   runner.cycle(TimePoint{1s + 1ms});
   std::vector<Event> emcy;
   while (runner.pop_event(e))

@@ -166,7 +166,7 @@ void DirectObjectAccess::execute_bytes(Request& r) noexcept {
   if (!type) return fail(drive_.dictionary().missing_code(r.def.id));
   const std::size_t size = size_of(*type);
   if (r.is_write) {
-    if (r.size != size) return fail(r.size > size ? 0x06070012U : 0x06070013U);  // length too high / too low
+    if (r.size != size) return fail(r.size > size ? abort_code::kTooLong : abort_code::kTooShort);
     std::uint64_t raw = 0;
     for (std::size_t i = size; i-- > 0;) raw = (raw << 8) | r.data[i];
     const std::uint32_t code = drive_.write_object(r.def.id, normalise(*type, static_cast<std::int64_t>(raw)));
@@ -176,7 +176,7 @@ void DirectObjectAccess::execute_bytes(Request& r) noexcept {
   }
   const ReadResult rr = drive_.read_object(r.def.id);
   if (rr.abort_code != abort_code::kNone) return fail(rr.abort_code);
-  if (size > r.into.size()) return fail(0x05040005U);  // out of memory
+  if (size > r.into.size()) return fail(abort_code::kOutOfMemory);
   for (std::size_t i = 0; i < size; ++i) r.into[i] = static_cast<std::uint8_t>(static_cast<std::uint64_t>(rr.value) >> (8 * i));
   r.result = RequestResult{RequestState::Done, 0, 0, static_cast<std::uint32_t>(size), true};
 }
