@@ -145,7 +145,8 @@ void read_canopen_axis(const MapReader& axis, const BusPlan& bus, const DevicePr
                               "\" (option gateway_node_id); give the drive another node-ID or change gateway_node_id");
 
   const MapReader c = axis.map("canopen", Need::Optional);
-  c.check_keys({"eds", "sdo_channel", "startup_writes"});
+  c.check_keys({"eds", "sdo_channel", "startup_writes", "gateway_watch"});
+  a.canopen.gateway_watch = read_gateway_watch(c);
   if (const auto ch = c.integer("sdo_channel", Need::Optional, 1, 4)) {
     const int channels = device ? device->canopen.sdo_channels : 4;
     if (*ch > channels)

@@ -18,7 +18,7 @@ canopen::BusTraffic canopen_traffic(const BusPlan& bus) {
       n.tpdos.push_back({static_cast<std::uint8_t>(p.mapped_bytes()), static_cast<std::uint8_t>(p.transmission_type),
                          std::chrono::microseconds(100) * p.inhibit_time_100us,
                          std::chrono::milliseconds(p.event_timer_ms)});
-    if (dev.error_control == ErrorControl::Guarding) {
+    if (gateway_watch_of(a) == GatewayWatch::Guarding) {
       n.error_control = canopen::NodeErrorControl::Guarding;
       n.error_control_period = o.guard_time;
     } else {

@@ -329,6 +329,16 @@ void read_startup_writes(const MapReader& parent, std::string_view key, const st
   }
 }
 
+std::optional<GatewayWatch> read_gateway_watch(const MapReader& parent) {
+  static const std::vector<std::string> kChoices{"heartbeat", "guarding", "required", "optional"};
+  const auto v = parent.choice("gateway_watch", Need::Optional, kChoices);
+  if (!v) return std::nullopt;
+  if (*v == "heartbeat") return GatewayWatch::Heartbeat;
+  if (*v == "guarding") return GatewayWatch::Guarding;
+  if (*v == "required") return GatewayWatch::Required;
+  return GatewayWatch::Optional;
+}
+
 void read_canopen_device(const MapReader& root, DeviceProfile& p, bool cyclic_given) {
   if (!root.has("canopen")) return;
   const MapReader c = root.map("canopen", Need::Optional);
@@ -336,6 +346,7 @@ void read_canopen_device(const MapReader& root, DeviceProfile& p, bool cyclic_gi
   auto& co = p.canopen;
   co.present = true;
   c.check_keys({"device_type", "device_type_mask", "persona", "sdo_channels", "error_control", "consumer_heartbeat",
+                "gateway_watch",
                 "pdo_policy", "disable_unused_pdos", "fixed_mapping_count", "sync_periods", "rpdos", "tpdos",
                 "startup_writes", "emcy", "parameter_names"});
   if (const auto v = c.integer("device_type", Need::Optional, 0, 0xFFFFFFFF)) co.device_type = static_cast<std::uint32_t>(*v);
@@ -343,7 +354,8 @@ void read_canopen_device(const MapReader& root, DeviceProfile& p, bool cyclic_gi
     co.device_type_mask = static_cast<std::uint32_t>(*v);
   if (c.has("device_type_mask") && !c.has("device_type"))
     c.error("device_type_mask", "only with device_type (the value 1000h is compared with)");
-  static const std::vector<std::string> kPersonas{"akd", "nord-sk500p", "stoeber-sd6", "generic"};
+  static const std::vector<std::string> kPersonas{"akd", "nord-sk500p", "stoeber-sd6", "generic",
+                                                    "generic-no-heartbeat", "generic-no-watch"};
   co.persona = c.choice("persona", Need::Optional, kPersonas).value_or(co.persona);
   // SDO channel k answers on 580h + 20h*(k-1) + node [stoeber-sd6-canopen.md §5.3]: at most 4.
   co.sdo_channels = static_cast<int>(c.integer("sdo_channels", Need::Optional, 1, 4).value_or(1));
@@ -362,6 +374,14 @@ void read_canopen_device(const MapReader& root, DeviceProfile& p, bool cyclic_gi
     if (!co.consumer_heartbeat)
       c.error("consumer_heartbeat", "false with error_control: heartbeat leaves the drive unable to notice a dead "
                                     "gateway; use error_control: guarding (as stoeber-sd6 does)");
+  }
+
+  co.gateway_watch = co.error_control == ErrorControl::Guarding ? GatewayWatch::Guarding : GatewayWatch::Heartbeat;
+  if (const auto w = read_gateway_watch(c)) {
+    if (co.error_control == ErrorControl::Guarding && *w != GatewayWatch::Guarding)
+      c.error("gateway_watch", "only guarding with error_control: guarding");
+    else
+      co.gateway_watch = *w;
   }
 
   static const std::vector<std::string> kPolicies{"write", "verify"};

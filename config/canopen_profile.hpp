@@ -17,6 +17,10 @@ void read_canopen_device(const MapReader& root, DeviceProfile& p, bool cyclic_gi
 
 // A `startup_writes:` list under `parent` (absent: nothing). Objects are "0x6046:1" or, with
 // `naming`, manufacturer parameter names ("A83").
+// A `gateway_watch:` choice under `parent` (heartbeat | guarding | required | optional); nullopt
+// when absent or wrong (the error names the allowed values).
+std::optional<GatewayWatch> read_gateway_watch(const MapReader& parent);
+
 void read_startup_writes(const MapReader& parent, std::string_view key, const std::optional<ParameterNaming>& naming,
                          std::vector<StartupWrite>& out);
 

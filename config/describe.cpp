@@ -85,10 +85,10 @@ void describe_canopen_axis(const Printer& p, const AxisPlan& a, const CanopenBus
     std::snprintf(buf, sizeof buf, "1000h = %08Xh under mask %08Xh", *co.device_type, co.device_type_mask);
     p.row("device type", buf);
   }
-  if (co.error_control == ErrorControl::Heartbeat) {
+  if (gateway_watch_of(a) != GatewayWatch::Guarding) {
     std::string t = "heartbeat: drive sends every " + format_duration(bus.drive_heartbeat) + ", lost after " +
                     std::to_string(bus.heartbeat_misses) + " silent periods";
-    if (co.consumer_heartbeat)
+    if (gateway_watch_of(a) == GatewayWatch::Heartbeat)
       t += "; drive watches the gateway's heartbeat (1016h, " +
            format_duration(bus.heartbeat_period * bus.heartbeat_misses) + ")";
     p.row("error control", t);
@@ -96,6 +96,17 @@ void describe_canopen_axis(const Printer& p, const AxisPlan& a, const CanopenBus
     p.row("error control", "guarding every " + format_duration(bus.guard_time) + ", life time factor " +
                                std::to_string(bus.life_time_factor) + " (drive stops after " +
                                format_duration(bus.guard_time * bus.life_time_factor) + " without guarding)");
+  }
+  switch (gateway_watch_of(a)) {
+    case GatewayWatch::Heartbeat: p.row("gateway watch", "heartbeat: the drive must have 1016h"); break;
+    case GatewayWatch::Guarding: p.row("gateway watch", "guarding: the drive must have 100Ch/100Dh"); break;
+    case GatewayWatch::Required:
+      p.row("gateway watch", "required: 1016h, else node guarding; a drive with neither is not started");
+      break;
+    case GatewayWatch::Optional:
+      p.row("gateway watch", "optional: 1016h, else node guarding; a drive with neither runs unwatched (warning: it "
+                             "does not stop by itself if the gateway dies)");
+      break;
   }
   p.row("SDO channel", std::to_string(a.canopen.sdo_channel));
   p.row("PDO maps", co.pdo_policy == PdoPolicy::Write

@@ -105,6 +105,16 @@ enum class ErrorControl : std::uint8_t {
               // (SD6: no consumer heartbeat, quirk 7)
 };
 
+// How the gateway makes sure the drive notices a dead gateway (DESIGN.md §4), per device profile
+// (`canopen.gateway_watch`) and per axis (`canopen: { gateway_watch: }`, which wins).
+enum class GatewayWatch : std::uint8_t {
+  Heartbeat,  // the drive must have 1016h: it consumes the gateway's heartbeat; the boot fails otherwise
+  Guarding,   // node guarding (100Ch/100Dh): the master guards the node with RTRs, the drive's life
+              // guarding notices a dead gateway
+  Required,   // whichever the drive has (1016h first, else 100Ch/100Dh); the boot fails if it has neither
+  Optional,   // as Required, but a drive with neither runs unwatched, with a warning event
+};
+
 struct StartupWrite {
   cia402::ObjectDef def;
   std::int64_t value = 0;
@@ -136,6 +146,8 @@ struct CanopenDeviceSpec {
   bool disable_unused_pdos = true;      // switch off PDOs the maps do not use (AKD part 1 §16 step 7)
   ErrorControl error_control = ErrorControl::Heartbeat;
   bool consumer_heartbeat = true;       // the drive has 1016h (watches the master's heartbeat)
+  // Default: heartbeat with error_control heartbeat, guarding with error_control guarding.
+  GatewayWatch gateway_watch = GatewayWatch::Heartbeat;
   std::vector<StartupWrite> startup_writes;
   std::vector<EmcyVendorField> emcy_fields;
   bool emcy_zero_needs_clear_register = true;  // EMCY 0000h means "no more errors" only with register 0
@@ -183,6 +195,7 @@ struct CanopenAxisOptions {
   std::string eds;  // EDS file (made absolute); objects and mappings are checked against it
   int sdo_channel = 1;  // SDO server channel the gateway uses (1..device sdo_channels)
   std::vector<StartupWrite> startup_writes;  // after the device profile's
+  std::optional<GatewayWatch> gateway_watch;  // overrides the device profile's
   std::vector<EdsObject> eds_objects;  // the EDS' objects (empty without an EDS); see find_eds_object()
 };
 
@@ -196,6 +209,11 @@ struct AxisPlan {
   SimAxisOptions sim;  // meaningful for axes on a sim bus only
   CanopenAxisOptions canopen;  // meaningful for axes on a canopen bus only
 };
+
+// The axis' gateway watch: its own option, else its device profile's.
+[[nodiscard]] inline GatewayWatch gateway_watch_of(const AxisPlan& a) noexcept {
+  return a.canopen.gateway_watch.value_or(a.device.canopen.gateway_watch);
+}
 
 // A bus-type option value after validation (see BusTypeRegistry for which keys a type takes).
 using OptionValue = std::variant<std::int64_t, double, bool, std::string, core::Duration>;

@@ -21,14 +21,20 @@ long long ms(core::Duration d) { return std::chrono::duration_cast<std::chrono::
 struct Steps {
   std::vector<BootStep> list;
   void write(std::string stage, ObjectDef def, std::int64_t value, bool optional = false, std::string why = {}) {
-    list.push_back({BootStep::Kind::Write, def, value, 0xFFFFFFFF, optional, std::move(stage), std::move(why)});
+    list.push_back({BootStep::Kind::Write, def, value, 0xFFFFFFFF, optional, std::move(stage), std::move(why), 0, 0, 0});
   }
   void seed(ObjectDef def) {
-    list.push_back({BootStep::Kind::Seed, def, 0, 0xFFFFFFFF, true, "process image", {}});
+    list.push_back({BootStep::Kind::Seed, def, 0, 0xFFFFFFFF, true, "process image", {}, 0, 0, 0});
   }
   void expect(std::string stage, ObjectDef def, std::int64_t value, std::uint32_t mask = 0xFFFFFFFF,
               std::string why = {}) {
-    list.push_back({BootStep::Kind::Expect, def, value, mask, false, std::move(stage), std::move(why)});
+    list.push_back({BootStep::Kind::Expect, def, value, mask, false, std::move(stage), std::move(why), 0, 0, 0});
+  }
+  void probe(std::string stage, ObjectDef def, std::uint8_t sets) {
+    list.push_back({BootStep::Kind::Probe, def, 0, 0xFFFFFFFF, true, std::move(stage), {}, sets, 0, 0});
+  }
+  void fail(std::string stage, std::string why) {
+    list.push_back({BootStep::Kind::Fail, {}, 0, 0xFFFFFFFF, false, std::move(stage), std::move(why), 0, 0, 0});
   }
 };
 
@@ -123,21 +129,67 @@ std::vector<BootStep> build_boot_steps(const config::AxisPlan& axis, const confi
     for (const auto& e : p.entries)
       if (e.object != cia402::obj::kControlword.id) s.seed({e.object, e.type});
 
-  // Error control (AKD part 1 §16 step 10; SD6 gateway step B6: exactly one of the two).
-  if (dev.error_control == config::ErrorControl::Heartbeat) {
+  // Error control (AKD part 1 §16 step 10; SD6 gateway step B6: exactly one of the two). With
+  // gateway_watch required / optional the drive is asked first what it has (1016h, else 100Ch and
+  // 100Dh) and the steps of the one it has run; the others are skipped.
+  const auto watch = config::gateway_watch_of(axis);
+  const auto timeout = ms(opt.heartbeat_period) * opt.heartbeat_misses;
+  const std::int64_t consumer_entry = (std::int64_t{opt.gateway_node_id} << 16) | timeout;
+  const char* const kConsumerWhy = "consumer heartbeat: the drive stops when the gateway is silent";
+  if (watch == config::GatewayWatch::Heartbeat) {
     s.write("error control", u16(0x1017, 0), ms(opt.drive_heartbeat));
-    if (dev.consumer_heartbeat) {
-      // The drive watches the gateway: timeout well above the gateway's heartbeat period.
-      const auto timeout = ms(opt.heartbeat_period) * opt.heartbeat_misses;
-      s.write("error control", u32(0x1016, 1), (std::int64_t{opt.gateway_node_id} << 16) | timeout, false,
-              "consumer heartbeat: the drive stops when the gateway is silent");
-    }
-  } else {
+    // The drive watches the gateway: timeout well above the gateway's heartbeat period.
+    s.write("error control", u32(0x1016, 1), consumer_entry, false,
+            std::string(kConsumerWhy) + " (gateway_watch: heartbeat demands 1016h)");
+  } else if (watch == config::GatewayWatch::Guarding) {
     s.write("error control", u16(0x1017, 0), 0, true, "heartbeat off: guarding and heartbeat are exclusive");
     s.write("error control", u16(0x100C, 0), ms(opt.guard_time));
     s.write("error control", u8(0x100D, 0), opt.life_time_factor);
+  } else {
+    const auto branch = [&](std::uint8_t if_found, std::uint8_t if_missing) {
+      s.list.back().if_found = if_found;
+      s.list.back().if_missing = if_missing;
+    };
+    s.probe("error control", u8(0x1016, 0), kFoundConsumerHeartbeat);
+    s.probe("error control", u16(0x100C, 0), kFoundGuardTime);
+    branch(0, kFoundConsumerHeartbeat);
+    s.probe("error control", u8(0x100D, 0), kFoundGuarding);
+    branch(kFoundGuardTime, kFoundConsumerHeartbeat);
+    // 1016h: heartbeat both ways.
+    s.write("error control", u16(0x1017, 0), ms(opt.drive_heartbeat));
+    branch(kFoundConsumerHeartbeat, 0);
+    s.write("error control", u32(0x1016, 1), consumer_entry, false, kConsumerWhy);
+    branch(kFoundConsumerHeartbeat, 0);
+    // No 1016h, but 100Ch and 100Dh: node guarding.
+    s.write("error control", u16(0x1017, 0), 0, true, "heartbeat off: guarding and heartbeat are exclusive");
+    branch(kFoundGuarding, 0);
+    s.write("error control", u16(0x100C, 0), ms(opt.guard_time));
+    branch(kFoundGuarding, 0);
+    s.write("error control", u8(0x100D, 0), opt.life_time_factor);
+    branch(kFoundGuarding, 0);
+    // Neither.
+    const std::string neither = "node " + std::to_string(axis.address) +
+                                " has neither 1016h (consumer heartbeat) nor 100Ch/100Dh (node guarding)";
+    if (watch == config::GatewayWatch::Required) {
+      s.fail("error control", neither + ", so it would not stop if the gateway died (gateway_watch: required)");
+      branch(0, kFoundConsumerHeartbeat | kFoundGuarding);
+    } else {
+      s.write("error control", u16(0x1017, 0), ms(opt.drive_heartbeat));
+      branch(0, kFoundConsumerHeartbeat | kFoundGuarding);
+    }
   }
   return std::move(s.list);
+}
+
+WatchOutcome watch_outcome(config::GatewayWatch watch, std::uint8_t found) noexcept {
+  switch (watch) {
+    case config::GatewayWatch::Heartbeat: return WatchOutcome::Heartbeat;
+    case config::GatewayWatch::Guarding: return WatchOutcome::Guarding;
+    default: break;
+  }
+  if ((found & kFoundConsumerHeartbeat) != 0) return WatchOutcome::Heartbeat;
+  if ((found & kFoundGuarding) != 0) return WatchOutcome::Guarding;
+  return WatchOutcome::Unwatched;
 }
 
 NodePdoConfig build_pdo_config(const config::AxisPlan& axis) {

@@ -11,6 +11,20 @@
 
 namespace drivegate::canopen {
 
+// What the error-control probes of a boot found (NodeBoot::found()), with gateway_watch required
+// or optional: the drive has 1016h, 100Ch, 100Ch and 100Dh.
+inline constexpr std::uint8_t kFoundConsumerHeartbeat = 1U << 0;
+inline constexpr std::uint8_t kFoundGuardTime = 1U << 1;
+inline constexpr std::uint8_t kFoundGuarding = 1U << 2;
+
+// How the gateway and the drive watch each other after a boot that succeeded.
+enum class WatchOutcome : std::uint8_t {
+  Heartbeat,  // the drive consumes the gateway's heartbeat (1016h); the master consumes the drive's
+  Guarding,   // the master guards the node with RTRs; the drive's life guarding watches the gateway
+  Unwatched,  // the master consumes the drive's heartbeat; the drive does not watch the gateway
+};
+WatchOutcome watch_outcome(config::GatewayWatch watch, std::uint8_t found) noexcept;
+
 std::vector<BootStep> build_boot_steps(const config::AxisPlan& axis, const config::BusPlan& bus);
 
 struct NodePdoConfig {

@@ -36,7 +36,8 @@ std::vector<NmtNodeConfig> nmt_nodes_for(const config::BusPlan& plan) {
   for (const auto& a : plan.axes) {
     NmtNodeConfig c;
     c.node = static_cast<NodeId>(a.address);
-    c.watch = a.device.canopen.error_control == config::ErrorControl::Guarding ? Watch::Guarding : Watch::Heartbeat;
+    // Required / optional: heartbeat until a boot finds the drive guards instead (advance()).
+    c.watch = config::gateway_watch_of(a) == config::GatewayWatch::Guarding ? Watch::Guarding : Watch::Heartbeat;
     c.heartbeat_timeout = o.drive_heartbeat * o.heartbeat_misses;
     c.guard_time = o.guard_time;
     c.life_time_factor = o.life_time_factor;
@@ -99,10 +100,9 @@ CanopenBus::CanopenBus(const config::BusPlan& plan, std::unique_ptr<Transport> t
     auto n = std::make_unique<Node>(static_cast<int>(i), std::move(steps));
     n->id = static_cast<NodeId>(a.address);
     n->channel = static_cast<int>(i);
-    if (a.device.canopen.error_control == config::ErrorControl::Guarding)
-      n->watchdog = {0x100C, 0};
-    else if (a.device.canopen.consumer_heartbeat)
-      n->watchdog = {0x1016, 1};
+    n->gateway_watch = config::gateway_watch_of(a);
+    n->watchdog = n->gateway_watch == config::GatewayWatch::Guarding ? cia402::ObjectId{0x100C, 0}
+                                                                     : cia402::ObjectId{0x1016, 1};
     const NodePdoConfig pdo = build_pdo_config(a);
     if (!n->pdos.configure(pdo.rpdos, pdo.tpdos))
       throw core::BusError("bus '" + name_ + "' axis '" + a.spec.name + "': PDO maps exceed the process image");
@@ -286,6 +286,17 @@ bool CanopenBus::next_event(core::Event& out) noexcept {
     out = foreign_event_;
     return true;
   }
+  for (auto& n : nodes_) {
+    if (!n->unwatched_pending) continue;
+    n->unwatched_pending = false;
+    out = core::Event{};
+    out.axis = static_cast<core::AxisIndex>(n->channel);
+    out.kind = core::EventKind::Warning;
+    out.text.format("node %u has neither 1016h (consumer heartbeat) nor 100Ch/100Dh (node guarding): it will not stop "
+                    "by itself if the gateway dies (gateway_watch: optional)",
+                    unsigned{n->id});
+    return true;
+  }
   if (emcy_count_ == 0) return false;
   out = emcy_events_[emcy_head_];
   emcy_head_ = (emcy_head_ + 1) % emcy_events_.size();
@@ -465,14 +476,27 @@ void CanopenBus::advance(Node& n, core::TimePoint now) noexcept {
       break;
     case Phase::Configuring:
       switch (n.boot.step(sdo_, n.pdos.image())) {
-        case NodeBoot::Status::Done:
+        case NodeBoot::Status::Done: {
+          // How the drive watches the gateway is what its boot found (gateway_watch required /
+          // optional) or what the plan demanded.
+          const WatchOutcome outcome = watch_outcome(n.gateway_watch, n.boot.found());
+          const Watch how = outcome == WatchOutcome::Guarding ? Watch::Guarding : Watch::Heartbeat;
+          nmt_nodes_[static_cast<std::size_t>(n.channel)].watch = how;
+          n.watchdog = outcome == WatchOutcome::Heartbeat  ? cia402::ObjectId{0x1016, 1}
+                       : outcome == WatchOutcome::Guarding ? cia402::ObjectId{0x100C, 0}
+                                                           : cia402::ObjectId{};
+          if (outcome == WatchOutcome::Unwatched && !n.unwatched_reported) {
+            n.unwatched_reported = true;
+            n.unwatched_pending = true;
+          }
           nmt_.command(NmtCommand::Start, n.id, tx_);
-          nmt_.watch(n.id, now);
+          nmt_.watch(n.id, how, now);
           n.pdos.enable(true, now);
           n.backoff = core::Duration::zero();
           n.detail.format("node %u configured", unsigned{n.id});
           enter(n, Phase::Operational, now);
           break;
+        }
         case NodeBoot::Status::Failed:
           n.detail.format("node %u: %.*s", unsigned{n.id}, static_cast<int>(n.boot.failure().view().size()),
                           n.boot.failure().view().data());

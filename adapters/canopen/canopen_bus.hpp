@@ -136,6 +136,9 @@ class CanopenBus final : public core::Bus {
     int safe_step = 0;  // SafeStop: which of its SDO steps runs
     bool had_link = false;  // was operational before: a loss shows as Lost, not Offline
     cia402::ObjectId watchdog{};  // how the drive watches the gateway (1016h:01 or 100Ch); index 0: not
+    config::GatewayWatch gateway_watch = config::GatewayWatch::Heartbeat;  // the axis' choice
+    bool unwatched_pending = false;   // the "drive does not watch the gateway" warning waits for next_event()
+    bool unwatched_reported = false;  // ... and is given once
     std::uint64_t boots = 0;
     core::FixedString<200> detail;
     // EMCY events: a token bucket (kEmcyBurst, one more per kEmcyRefill) and what it held back.

@@ -164,6 +164,8 @@ TEST(CanopenPlans, AxesCarryTheirCanopenSection) {
   ASSERT_EQ(z.canopen.startup_writes.size(), 1U);
   EXPECT_EQ(z.canopen.startup_writes[0].def.id, (ObjectId{0x2053, 0}));  // A83 by the SD6 naming
   EXPECT_EQ(z.device.canopen.error_control, ErrorControl::Guarding);
+  EXPECT_EQ(gateway_watch_of(z), GatewayWatch::Guarding);
+  EXPECT_EQ(gateway_watch_of(x), GatewayWatch::Heartbeat);
 }
 
 TEST(CanopenPlans, CheckConfigShowsTheCanopenPlan) {
@@ -332,7 +334,27 @@ TEST(CanopenPlanErrors, SdoChannels) {
   const std::string akd = errors_of(one_axis("", "kollmorgen-akd", 5, "    canopen: { sdo_channel: 2, sdo: 1 }\n"));
   EXPECT_REPORTED(akd, "t.yaml:9:29: axes[0].canopen.sdo_channel: device \"kollmorgen-akd\" has 1 SDO channel, got 2");
   EXPECT_REPORTED(akd, "t.yaml:9:32: axes[0].canopen.sdo: unknown field (allowed: eds, "
-                       "sdo_channel, startup_writes)");
+                       "sdo_channel, startup_writes, gateway_watch)");
+}
+
+TEST(CanopenPlanErrors, GatewayWatchIsOneOfFourChoices) {
+  const std::string e = errors_of(one_axis("", "generic-cia402", 5, "    mechanics: { encoder_counts_per_rev: 100 }\n"
+                                                                  "    canopen: { gateway_watch: always }\n"));
+  EXPECT_REPORTED(e, "t.yaml:10:31: axes[0].canopen.gateway_watch: must be one of heartbeat, guarding, required, "
+                     "optional, got \"always\"");
+  for (const char* v : {"heartbeat", "guarding", "required", "optional"}) {
+    const Plan plan = load_plan_from_string(
+        one_axis("", "generic-cia402", 5,
+                 std::string("    mechanics: { encoder_counts_per_rev: 100 }\n    canopen: { gateway_watch: ") + v +
+                     " }\n"),
+        "t.yaml", test_options());
+    ASSERT_TRUE(plan.buses[0].axes[0].canopen.gateway_watch.has_value()) << v;
+  }
+  // Defaults: the profile's (generic-cia402: optional; AKD: heartbeat; SD6: guarding).
+  const Plan plan = load_plan_from_string(one_axis("", "generic-cia402", 5,
+                                                   "    mechanics: { encoder_counts_per_rev: 100 }\n"),
+                                          "t.yaml", test_options());
+  EXPECT_EQ(gateway_watch_of(plan.buses[0].axes[0]), GatewayWatch::Optional);
 }
 
 TEST(CanopenPlanErrors, ModesAndHomingTheDeviceLacks) {

@@ -326,7 +326,7 @@ TEST_F(CanopenProfileErrors, ScalarFields) {
   colour: red
 )" + kMaps);
   EXPECT_REPORTED(e, at(6, 21) + "canopen.device_type_mask: must be an integer in 1..4294967295, got \"0\"");
-  EXPECT_REPORTED(e, at(7, 12) + "canopen.persona: must be one of akd, nord-sk500p, stoeber-sd6, generic, got \"akdd\", "
+  EXPECT_REPORTED(e, at(7, 12) + "canopen.persona: must be one of akd, nord-sk500p, stoeber-sd6, generic, generic-no-heartbeat, generic-no-watch, got \"akdd\", "
                                  "did you mean \"akd\"?");
   EXPECT_REPORTED(e, at(8, 17) + "canopen.sdo_channels: must be an integer in 1..4, got \"5\"");
   EXPECT_REPORTED(e, at(9, 18) + "canopen.error_control: must be one of heartbeat, guarding, got \"polling\"");
@@ -350,6 +350,18 @@ TEST_F(CanopenProfileErrors, ErrorControlMustLetTheDriveWatchTheGateway) {
   EXPECT_REPORTED(guard, at(7, 23) + "canopen.consumer_heartbeat: only with error_control: heartbeat");
   EXPECT_EQ(errors_of("canopen:\n  error_control: guarding\n" + kMaps), "(loaded without error)");
   EXPECT_FALSE(load_device_profile(dir_ / "drive.yaml").canopen.consumer_heartbeat);
+}
+
+TEST_F(CanopenProfileErrors, GatewayWatch) {
+  const std::string bad = errors_of("canopen:\n  gateway_watch: never\n" + kMaps);
+  EXPECT_REPORTED(bad, at(6, 18) + "canopen.gateway_watch: must be one of heartbeat, guarding, required, optional, "
+                                   "got \"never\"");
+  const std::string guard = errors_of("canopen:\n  error_control: guarding\n  gateway_watch: optional\n" + kMaps);
+  EXPECT_REPORTED(guard, at(7, 18) + "canopen.gateway_watch: only guarding with error_control: guarding");
+  EXPECT_EQ(errors_of("canopen:\n  gateway_watch: optional\n" + kMaps), "(loaded without error)");
+  EXPECT_EQ(load_device_profile(dir_ / "drive.yaml").canopen.gateway_watch, GatewayWatch::Optional);
+  EXPECT_EQ(errors_of("canopen:\n  error_control: guarding\n" + kMaps), "(loaded without error)");
+  EXPECT_EQ(load_device_profile(dir_ / "drive.yaml").canopen.gateway_watch, GatewayWatch::Guarding);
 }
 
 TEST_F(CanopenProfileErrors, FixedMappingCountLimitsEntries) {

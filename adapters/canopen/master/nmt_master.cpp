@@ -71,6 +71,11 @@ void NmtMaster::watch(NodeId node, core::TimePoint now) noexcept {
   n->misses = 0;
 }
 
+void NmtMaster::watch(NodeId node, Watch how, core::TimePoint now) noexcept {
+  if (Node* n = find(node)) n->config.watch = how;
+  watch(node, now);
+}
+
 void NmtMaster::unwatch(NodeId node) noexcept {
   if (Node* n = find(node)) {
     n->watching = false;

@@ -88,6 +88,9 @@ class NmtMaster {
   // Start / stop supervising a node (heartbeat timeout or guarding RTRs). watch() restarts the
   // timers from `now`; a lost node stays lost until it is heard again.
   void watch(NodeId node, core::TimePoint now) noexcept;
+  // The same, changing how the node is watched first (a boot that found the drive has no 1016h
+  // but 100Ch/100Dh guards it instead of consuming its heartbeat).
+  void watch(NodeId node, Watch how, core::TimePoint now) noexcept;
   void unwatch(NodeId node) noexcept;
 
   [[nodiscard]] NmtState state(NodeId node) const noexcept;  // last reported state

@@ -16,6 +16,7 @@ NodeBoot::NodeBoot(int sdo_channel, std::vector<BootStep> steps) : channel_(sdo_
 void NodeBoot::start() noexcept {
   status_ = steps_.empty() ? Status::Done : Status::Running;
   next_ = 0;
+  found_ = 0;
   request_ = kNoSdoRequest;
   failure_.assign("");
 }
@@ -41,6 +42,17 @@ NodeBoot::Status NodeBoot::step(SdoClient& sdo, ProcessImage& image) noexcept {
   // Running means next_ < steps_.size(): start() and the end of every step see to it.
   if (status_ != Status::Running) return status_;
   const BootStep& s = steps_[next_];
+  const auto advance = [&] {
+    ++next_;
+    return status_ = next_ >= steps_.size() ? Status::Done : Status::Running;
+  };
+  // A step for a drive without what it needs (or with what makes it unnecessary) is skipped.
+  if ((found_ & s.if_found) != s.if_found || (found_ & s.if_missing) != 0) return advance();
+  if (s.kind == BootStep::Kind::Fail) {
+    status_ = Status::Failed;
+    failure_.format("%s: %s", s.stage.c_str(), s.why.c_str());
+    return status_;
+  }
   const auto size = cia402::size_of(s.def.type);
   if (request_ == kNoSdoRequest) {
     request_ = s.kind == BootStep::Kind::Write
@@ -57,10 +69,13 @@ NodeBoot::Status NodeBoot::step(SdoClient& sdo, ProcessImage& image) noexcept {
   }
   if (r.status == SdoStatus::Failed) {
     // A seed the drive cannot answer leaves the image value as it is (0 at first).
-    if (s.kind != BootStep::Kind::Seed && !(s.optional && missing_object(r.abort_code))) {
+    const bool missing = missing_object(r.abort_code);
+    if (s.kind != BootStep::Kind::Seed && !(s.kind == BootStep::Kind::Probe && missing) && !(s.optional && missing)) {
       fail_abort(s, r.abort_code);
       return status_;
     }
+  } else if (s.kind == BootStep::Kind::Probe) {
+    found_ = static_cast<std::uint8_t>(found_ | s.sets);
   } else if (s.kind == BootStep::Kind::Seed) {
     image.set(s.def.id, r.value);  // set() takes it to the object's type
   } else if (s.kind == BootStep::Kind::Expect) {
@@ -74,8 +89,7 @@ NodeBoot::Status NodeBoot::step(SdoClient& sdo, ProcessImage& image) noexcept {
       return status_;
     }
   }
-  ++next_;
-  return status_ = next_ >= steps_.size() ? Status::Done : Status::Running;
+  return advance();
 }
 
 }  // namespace drivegate::canopen

@@ -26,6 +26,9 @@ struct BootStep {
     Expect,  // read and compare (value & mask) == (expected & mask)
     Seed,    // read an RPDO-mapped object into the process image, so the first RPDOs carry the
              // drive's own values rather than zeros it may refuse (e.g. a 0 profile acceleration)
+    Probe,   // read; the drive has the object: set the `sets` bits of found(). A missing object
+             // (06020000h / 06090011h) leaves them clear; another abort fails the boot.
+    Fail,    // fail the boot with `why` (a drive lacking what the plan demands, told by probes)
   };
   Kind kind = Kind::Write;
   cia402::ObjectDef def{};
@@ -34,6 +37,11 @@ struct BootStep {
   bool optional = false;         // a missing object (06020000h / 06090011h) is not an error
   std::string stage;             // "identity", "start-up write", "RPDO1 mapping", "error control"
   std::string why;               // shown with a failure ("FBUS.PARAM05: fault reset only via ...")
+  // Branches on what earlier Probe steps found: the step runs only when every `if_found` bit is
+  // set in found() and every `if_missing` bit is clear; otherwise it is skipped.
+  std::uint8_t sets = 0;
+  std::uint8_t if_found = 0;
+  std::uint8_t if_missing = 0;
 };
 
 class NodeBoot {
@@ -54,6 +62,8 @@ class NodeBoot {
   [[nodiscard]] std::size_t position() const noexcept { return next_; }
   [[nodiscard]] std::size_t size() const noexcept { return steps_.size(); }
   [[nodiscard]] const core::FixedString<200>& failure() const noexcept { return failure_; }
+  // The bits the Probe steps of this run set (what the drive turned out to have).
+  [[nodiscard]] std::uint8_t found() const noexcept { return found_; }
   [[nodiscard]] const std::vector<BootStep>& steps() const noexcept { return steps_; }
 
  private:
@@ -63,6 +73,7 @@ class NodeBoot {
   std::vector<BootStep> steps_;
   Status status_ = Status::Idle;
   std::size_t next_ = 0;
+  std::uint8_t found_ = 0;
   SdoRequestId request_ = kNoSdoRequest;
   core::FixedString<200> failure_;
 };

@@ -294,7 +294,19 @@ constexpr Persona kSd6{
 
 constexpr Persona kGeneric{};
 
-constexpr std::array<const Persona*, 4> kAll{&kAkd, &kNord, &kSd6, &kGeneric};
+// Plain CiA 301 drives that leave out the optional watch objects: the consumer heartbeat (1016h
+// is optional in CiA 301 §7.5.2.31), and also node guarding (100Ch/100Dh).
+constexpr Persona generic_without(std::string_view name, bool heartbeat_consumer, bool node_guarding) {
+  Persona p{};
+  p.name = name;
+  p.heartbeat_consumer = heartbeat_consumer;
+  p.node_guarding = node_guarding;
+  return p;
+}
+constexpr Persona kGenericNoHeartbeat = generic_without("generic-no-heartbeat", false, true);
+constexpr Persona kGenericNoWatch = generic_without("generic-no-watch", false, false);
+
+constexpr std::array<const Persona*, 6> kAll{&kAkd, &kNord, &kSd6, &kGeneric, &kGenericNoHeartbeat, &kGenericNoWatch};
 
 }  // namespace
 

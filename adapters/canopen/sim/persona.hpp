@@ -6,6 +6,8 @@
 //   nord-sk500p  NORD SK 500P (nord-sk500p-ds402.md)
 //   stoeber-sd6  STÖBER SD6 with CA6 (stoeber-sd6-canopen.md)
 //   generic      a drive that follows CiA 301/402 to the letter
+//   generic-no-heartbeat  the same without 1016h: it can watch the gateway by node guarding only
+//   generic-no-watch      the same without 1016h, 100Ch and 100Dh: it cannot watch the gateway
 #include <array>
 #include <cstdint>
 #include <optional>
@@ -79,6 +81,7 @@ struct Persona {
   int sdo_channels = 1;               // SDO servers; channels 2..4 use the SD6 COB-ID scheme (wire/cob_id.hpp)
   bool upload_without_size = false;   // expedited uploads answered with 42h
   bool heartbeat_consumer = true;     // 1016h with one entry
+  bool node_guarding = true;          // 100Ch guard time and 100Dh life time factor
   bool emcy_inhibit = true;           // 1015h
   bool emcy_cob_writable = true;      // 1014h (only its valid bit: the EMCY always goes to 80h + node-ID)
   bool sdo_parameters = true;         // 1200h (and 1201h.. for the extra channels)

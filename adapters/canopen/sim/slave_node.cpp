@@ -518,8 +518,12 @@ std::optional<SlaveNode::ValueRead> SlaveNode::read_comm(ObjectId id) const noex
   switch (id.index) {
     case 0x1005: return only_sub0(4, sync_cob_);
     case 0x1006: return only_sub0(4, cycle_period_);
-    case 0x100C: return only_sub0(2, nmt_.guard_time());
-    case 0x100D: return only_sub0(1, nmt_.life_time_factor());
+    case 0x100C:
+      if (!p.node_guarding) break;
+      return only_sub0(2, nmt_.guard_time());
+    case 0x100D:
+      if (!p.node_guarding) break;
+      return only_sub0(1, nmt_.life_time_factor());
     case 0x1010:
       if (!p.store_parameters) break;
       // Sub 0: one entry, "save all"; sub 1 reads 1: the device saves on command [CiA 301].
@@ -576,10 +580,12 @@ std::optional<std::uint32_t> SlaveNode::write_comm(ObjectId id, std::uint32_t ra
       cycle_period_ = raw;
       return 0;
     case 0x100C:
+      if (!p.node_guarding) break;
       if ((code = check(0, 2)) != 0) return code;
       nmt_.set_guarding(static_cast<std::uint16_t>(raw), nmt_.life_time_factor(), now_);
       return 0;
     case 0x100D:
+      if (!p.node_guarding) break;
       if ((code = check(0, 1)) != 0) return code;
       nmt_.set_guarding(nmt_.guard_time(), static_cast<std::uint8_t>(raw), now_);
       return 0;
