@@ -19,10 +19,12 @@
 #include "config/config_error.hpp"
 #include "config/describe.hpp"
 #include "config/loader.hpp"
+#include "config/scalars.hpp"
 #include "core/bus.hpp"
 #include "daemon/dds_bridge.hpp"
 #include "daemon/gateway.hpp"
 #include "daemon/realtime.hpp"
+#include "daemon/scan.hpp"
 #include "daemon/systemd_notify.hpp"
 
 #ifndef DRIVEGATE_VERSION
@@ -39,6 +41,7 @@ constexpr std::chrono::milliseconds kSecondSignalGrace{2000};
 
 constexpr const char* kUsage = R"(usage: drivegated --config FILE [--log-level LEVEL]
        drivegated --check-config FILE
+       drivegated --scan TYPE:WHERE [--scan-timeout D] [--device-dir DIR]... [--write-config FILE [--force]]
        drivegated --version | --help
 
 Runs the gateway described by FILE: brings up every bus and axis, runs one cycle thread per bus
@@ -50,12 +53,21 @@ SIGPIPE, SIGTSTP, SIGTTIN and SIGTTOU are ignored.
   --config FILE        the deployment (YAML); see config/README.md
   --check-config FILE  validate FILE and print the compiled plan without touching any bus
   --log-level LEVEL    trace|debug|info|warn|error|critical|off (overrides gateway.log_level)
+
+  --scan TYPE:WHERE    list the devices on a bus and the device profile that fits each; only reads.
+                       canopen:can0 (SocketCAN interface), or canopen:udp-multicast?group=G&port=P&interface=A
+                       (quote it in a shell); options: interface, bitrate, group, port
+  --scan-timeout D     how long a device has to answer each request (default 100ms)
+  --device-dir DIR     also look for device profiles in DIR (before the built-in ones)
+  --write-config FILE  write a configuration skeleton for what was found (--check-config accepts it)
+  --force              replace FILE if it exists (otherwise it is kept and the command fails)
 )";
 
 struct Args {
   std::string config;
   bool check_only = false;
   std::optional<std::string> log_level;
+  std::optional<daemon::ScanCommand> scan;
 };
 
 std::optional<Args> parse_args(int argc, char** argv, int& exit_code) {
@@ -84,6 +96,31 @@ std::optional<Args> parse_args(int argc, char** argv, int& exit_code) {
       if (!v) return std::nullopt;
       a.config = *v;
       a.check_only = a.check_only || arg == "--check-config";
+    } else if (arg == "--scan") {
+      auto v = value("TYPE:WHERE");
+      if (!v) return std::nullopt;
+      if (!a.scan) a.scan.emplace();
+      a.scan->target = *v;
+    } else if (arg == "--scan-timeout" || arg == "--device-dir" || arg == "--write-config") {
+      auto v = value(arg == "--scan-timeout" ? "a duration" : arg == "--device-dir" ? "a directory" : "a file");
+      if (!v) return std::nullopt;
+      if (!a.scan) a.scan.emplace();
+      if (arg == "--device-dir") {
+        a.scan->device_dirs.emplace_back(*v);
+      } else if (arg == "--write-config") {
+        a.scan->write_config = *v;
+      } else {
+        const auto d = config::parse_duration(*v);
+        if (!d || *d <= core::Duration::zero() || *d > std::chrono::seconds(10)) {
+          std::cerr << "drivegated: --scan-timeout takes a duration above 0 and at most 10s such as 250ms, got '"
+                    << *v << "'\n";
+          return std::nullopt;
+        }
+        a.scan->answer_timeout = *d;
+      }
+    } else if (arg == "--force") {
+      if (!a.scan) a.scan.emplace();
+      a.scan->force = true;
     } else if (arg == "--log-level") {
       auto v = value("a level");
       if (!v) return std::nullopt;
@@ -93,7 +130,19 @@ std::optional<Args> parse_args(int argc, char** argv, int& exit_code) {
       return std::nullopt;
     }
   }
-  if (a.config.empty()) {
+  if (a.scan && a.scan->target.empty()) {
+    std::cerr << "drivegated: --scan-timeout, --device-dir, --write-config and --force go with --scan\n" << kUsage;
+    return std::nullopt;
+  }
+  if (a.scan && !a.config.empty()) {
+    std::cerr << "drivegated: --scan runs on its own, without --config or --check-config\n" << kUsage;
+    return std::nullopt;
+  }
+  if (a.scan && a.scan->force && a.scan->write_config.empty()) {
+    std::cerr << "drivegated: --force goes with --write-config\n" << kUsage;
+    return std::nullopt;
+  }
+  if (a.config.empty() && !a.scan) {
     std::cerr << "drivegated: no configuration given\n" << kUsage;
     return std::nullopt;
   }
@@ -379,5 +428,6 @@ int main(int argc, char** argv) {
   int exit_code = 2;
   const auto args = parse_args(argc, argv, exit_code);
   if (!args) return exit_code;
+  if (args->scan) return daemon::run_scan_command(*args->scan, std::cout, std::cerr);
   return run(*args);
 }

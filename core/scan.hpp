@@ -1,0 +1,81 @@
+#pragma once
+// What a bus scan (`drivegated --scan TYPE:WHERE`) asks and finds, the same for every bus type
+// (DESIGN.md §7): CANopen, EtherCAT and PROFINET scanners fill these; the daemon prints them as a
+// table and writes a configuration skeleton from them (daemon/scan.hpp).
+#include <chrono>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/clock.hpp"
+
+namespace drivegate::core {
+
+// A scan that cannot run (bad WHERE, a transport that does not open, a bus another gateway holds).
+class ScanError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct ScanRequest {
+  std::string bus_type;  // "canopen", "ethercat", "profinet"
+  // The bus: its transport or interface, then options as "?key=value&key=value", e.g.
+  // "can0", "udp-multicast?group=239.1.2.3&port=43113&interface=127.0.0.1".
+  std::string where;
+  // How long a device has to answer one request (CANopen: an SDO upload).
+  Duration answer_timeout = std::chrono::milliseconds(100);
+  // How long to listen before the first request (CANopen: boot-ups and heartbeats).
+  Duration listen = std::chrono::milliseconds(200);
+  // Where device profiles are looked for, in order (as the daemon's LoadOptions::device_dirs).
+  std::vector<std::filesystem::path> device_dirs;
+};
+
+// Where a device sits on its bus: `number` is what an axis' `address` takes in the configuration
+// (CANopen node-ID, EtherCAT station position), `text` what a person reads ("5 (05h)",
+// "position 3, alias 1001h", "akd-1 192.168.0.10").
+struct DeviceAddress {
+  int number = 0;
+  std::string text;
+};
+
+// Identity numbers as the bus reports them (CANopen/CoE 1018h:01..04, EtherCAT SII, PROFINET
+// vendor/device id); nullopt where the device does not have them.
+struct DeviceIdentityNumbers {
+  std::optional<std::uint32_t> vendor_id;
+  std::optional<std::uint32_t> product_code;
+  std::optional<std::uint32_t> revision;
+  std::optional<std::uint32_t> serial;
+};
+
+struct FoundDevice {
+  DeviceAddress address;
+  std::optional<std::uint32_t> device_type;  // CANopen/CoE 1000h
+  std::string device_type_text;              // "CiA 402 servo drive", "" when unknown
+  DeviceIdentityNumbers identity;
+  std::optional<std::string> name;              // CANopen 1008h; nullopt: not present
+  std::optional<std::string> hardware_version;  // 1009h
+  std::optional<std::string> software_version;  // 100Ah
+  std::string profile;         // the device profile that fits, "" for none
+  std::string profile_reason;  // why that one, or why none
+  bool drive = false;          // an axis in the configuration skeleton (it has a profile to run it)
+  std::vector<std::string> notes;  // what a person should know (objects not present, aborts, odd frames)
+};
+
+struct ScanResult {
+  std::string bus_type;
+  std::string bus_name;     // a bus name for the configuration skeleton ("can0")
+  std::string description;  // what was scanned, "udp-multicast 239.1.2.3:43113 on 127.0.0.1"
+  // The bus' options as the configuration file writes them (key, YAML scalar), in order.
+  std::vector<std::pair<std::string, std::string>> bus_options;
+  // Cycle times to offer in the skeleton, best first; the first the configuration accepts is used.
+  std::vector<Duration> cycle_times;
+  std::vector<FoundDevice> devices;  // by address
+  std::vector<std::string> notes;    // bus-wide: other masters seen, malformed frames counted
+  Duration elapsed{};
+};
+
+}  // namespace drivegate::core
