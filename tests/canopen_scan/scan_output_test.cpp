@@ -1,0 +1,143 @@
+// The bus-neutral half of the scan: the table, the configuration skeleton (accepted by the loader
+// as it is), the file writer and the scanner registry.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "config/loader.hpp"
+#include "daemon/scan.hpp"
+
+namespace drivegate::daemon {
+namespace {
+
+using namespace std::chrono_literals;
+
+core::ScanResult two_devices() {
+  core::ScanResult r;
+  r.bus_type = "canopen";
+  r.bus_name = "can0";
+  r.description = "udp-multicast 239.1.2.3:17000 on 127.0.0.1";
+  r.bus_options = {{"transport", "udp-multicast"}, {"interface", "127.0.0.1"}, {"bitrate", "500000"},
+                   {"group", "239.1.2.3"}, {"port", "17000"}};
+  r.cycle_times = {4ms, 8ms};
+  core::FoundDevice akd;
+  akd.address = {5, "5 (05h)"};
+  akd.device_type = 0x00020192;
+  akd.device_type_text = "CiA 402 drive: servo drive";
+  akd.identity.vendor_id = 0x6A;
+  akd.name = "M006";
+  akd.profile = "kollmorgen-akd";
+  akd.profile_reason = "vendor 0x0000006A is kollmorgen-akd's";
+  akd.drive = true;
+  akd.notes = {"1009h not present"};
+  core::FoundDevice io;
+  io.address = {9, "9 (09h)"};
+  io.device_type = 0x000F0191;
+  io.device_type_text = "CiA 401 I/O module";
+  io.profile_reason = "vendor 0x00000123 matches no profile and no profile fits 1000h = 0x000F0191";
+  r.devices = {akd, io};
+  r.elapsed = 412ms;
+  return r;
+}
+
+TEST(ScanTable, OneRowPerDeviceThenReasonsAndNotes) {
+  const std::string t = format_scan_table(two_devices());
+  EXPECT_EQ(t.find("canopen udp-multicast 239.1.2.3:17000 on 127.0.0.1: 2 devices (scan took 412 ms)\n"), 0U) << t;
+  EXPECT_NE(t.find("5 (05h)  0x00020192   CiA 402 drive: servo drive  0x0000006A  -        -         -       \"M006\"  -  "
+                   "       -         kollmorgen-akd\n"),
+            std::string::npos)
+      << t;
+  EXPECT_NE(t.find("(none)\n"), std::string::npos) << t;
+  EXPECT_NE(t.find("5 (05h): kollmorgen-akd: vendor 0x0000006A is kollmorgen-akd's\n    1009h not present\n"),
+            std::string::npos)
+      << t;
+  EXPECT_NE(t.find("9 (09h): no profile: vendor 0x00000123 matches no profile"), std::string::npos) << t;
+}
+
+TEST(ScanTable, SaysSoWhenNobodyAnswered) {
+  core::ScanResult r;
+  r.bus_type = "canopen";
+  r.description = "socketcan vcan0";
+  r.notes = {"3 malformed frames dropped"};
+  EXPECT_EQ(format_scan_table(r),
+            "canopen socketcan vcan0: no devices answered (scan took 0 ms)\nnote: 3 malformed frames dropped\n");
+}
+
+TEST(ScanSkeleton, TheLoaderAcceptsItWithAnAxisPerDrive) {
+  const config::LoadOptions load;
+  const std::string text = scan_skeleton(two_devices(), load);
+  const auto plan = config::load_plan_from_string(text, "skeleton.yaml", load);
+  ASSERT_EQ(plan.buses.size(), 1U);
+  EXPECT_EQ(plan.buses[0].canopen.group, "239.1.2.3");
+  EXPECT_EQ(plan.buses[0].canopen.port, 17000);
+  EXPECT_EQ(plan.buses[0].cycle_time, 4ms);
+  ASSERT_EQ(plan.buses[0].axes.size(), 1U);
+  EXPECT_EQ(plan.buses[0].axes[0].address, 5);
+  EXPECT_EQ(plan.buses[0].axes[0].device.name, "kollmorgen-akd");
+  // The device without a profile is there as a comment saying what to do.
+  EXPECT_NE(text.find("  # 9 (09h): CiA 401 I/O module\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("not an axis here: add a device profile"), std::string::npos) << text;
+  EXPECT_NE(text.find("CHECK"), std::string::npos);
+}
+
+TEST(ScanSkeleton, TakesTheNextCycleTimeWhenTheFirstIsRefused) {
+  auto r = two_devices();
+  r.cycle_times = {3ms, 8ms};  // the SD6 runs 1, 2, 4 or 8 ms only
+  r.devices[0].profile = "stoeber-sd6";
+  const config::LoadOptions load;
+  const auto plan = config::load_plan_from_string(scan_skeleton(r, load), "skeleton.yaml", load);
+  EXPECT_EQ(plan.buses[0].cycle_time, 8ms);
+  r.cycle_times = {3ms};
+  EXPECT_THROW((void)scan_skeleton(r, load), core::ScanError);
+}
+
+TEST(ScanSkeleton, WithoutDevicesIsABusWithoutAxes) {
+  auto r = two_devices();
+  r.devices.clear();
+  const config::LoadOptions load;
+  const std::string text = scan_skeleton(r, load);
+  EXPECT_NE(text.find("axes: []\n"), std::string::npos) << text;
+  EXPECT_TRUE(config::load_plan_from_string(text, "skeleton.yaml", load).buses[0].axes.empty());
+}
+
+TEST(WriteSkeleton, KeepsAnExistingFileUnlessForced) {
+  const auto dir = std::filesystem::temp_directory_path() / ("drivegate-scan-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const auto file = dir / "cell.yaml";
+  write_skeleton(file, "first\n", false);
+  EXPECT_THROW(write_skeleton(file, "second\n", false), core::ScanError);
+  const auto read = [&] {
+    std::ifstream in(file);
+    std::ostringstream text;
+    text << in.rdbuf();
+    return text.str();
+  };
+  EXPECT_EQ(read(), "first\n");
+  write_skeleton(file, "second\n", true);
+  EXPECT_EQ(read(), "second\n");
+  // No temporary file is left behind.
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir), {}), 1);
+  EXPECT_THROW(write_skeleton(dir / "no-such-dir" / "x.yaml", "x\n", false), core::ScanError);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(ScannerRegistry, RefusesBusTypesWithoutAScanner) {
+  const auto registry = ScannerRegistry::builtin();
+  core::ScanRequest r;
+  r.bus_type = "ethercat";
+  try {
+    (void)registry.scan(r);
+    FAIL() << "scanned ethercat";
+  } catch (const core::ScanError& e) {
+    EXPECT_STREQ(e.what(), "cannot scan ethercat: no adapter in this build (scans: canopen)");
+  }
+  r.bus_type = "canbus";
+  EXPECT_THROW((void)registry.scan(r), core::ScanError);
+}
+
+}  // namespace
+}  // namespace drivegate::daemon
