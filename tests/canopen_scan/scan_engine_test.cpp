@@ -303,6 +303,29 @@ TEST_F(ScanOnWire, AServerThatStopsAnsweringAfterTheProbeTimesOutPerObject) {
   EXPECT_TRUE(has_note(n->notes, "100Ah: no answer in time"));
 }
 
+TEST_F(ScanOnWire, ANodeHeardButWithoutSdoAnswerIsListedWithoutAProfile) {
+  // Node 33 sends a pre-operational heartbeat every 100 ms and never answers an SDO request.
+  core::TimePoint next = kT0;
+  responder_ = [&](core::TimePoint t) {
+    if (t < next) return;
+    EXPECT_EQ(other_->send(make_frame(cob::error_control(33), {0x7F}), t), SendResult::Sent);
+    next = t + 100ms;
+  };
+  run();
+  ASSERT_TRUE(scan_->done());
+  const auto* n = node(33);
+  ASSERT_NE(n, nullptr);
+  EXPECT_TRUE(n->heard);
+  EXPECT_FALSE(n->answered);
+  EXPECT_FALSE(n->boot_up);
+  EXPECT_EQ(n->state, NmtState::PreOperational);
+  EXPECT_TRUE(has_note(n->notes, "heard on the bus (pre-operational) but its SDO server did not answer 1000h"));
+  const auto r = scan_result(*scan_, udp_plan(), profiles());
+  ASSERT_EQ(r.devices.size(), 1U);
+  EXPECT_FALSE(r.devices[0].drive);
+  EXPECT_EQ(r.devices[0].profile, "");
+}
+
 TEST(ScanBusPlan, TakesAnInterfaceOrUdpMulticastWithOptions) {
   core::ScanRequest r;
   r.bus_type = "canopen";
