@@ -1,6 +1,6 @@
 #include "daemon/scan.hpp"
 
-#include <fcntl.h>
+#include <stdlib.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -13,7 +13,6 @@
 
 #include "adapters/canopen/scan.hpp"
 #include "config/scalars.hpp"
-#include "core/bus.hpp"
 #include "daemon/bus_lock.hpp"
 
 namespace drivegate::daemon {

@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <bit>
 #include <cstdio>
-#include <map>
 #include <sstream>
 #include <thread>
 
