@@ -62,6 +62,9 @@ struct FoundDevice {
   std::string profile;         // the device profile that fits, "" for none
   std::string profile_reason;  // why that one, or why none
   bool drive = false;          // an axis in the configuration skeleton (it has a profile to run it)
+  // Why its identity cannot be trusted (more than one device answers at its address: a conflict);
+  // "" when it can. Such a device has no profile and is no axis.
+  std::string conflict;
   std::vector<std::string> notes;  // what a person should know (objects not present, aborts, odd frames)
 };
 
@@ -75,6 +78,7 @@ struct ScanResult {
   std::vector<Duration> cycle_times;
   std::vector<FoundDevice> devices;  // by address
   std::vector<std::string> notes;    // bus-wide: other masters seen, malformed frames counted
+  std::vector<std::string> warnings; // what must be fixed on the bus before a gateway runs it (conflicts)
   Duration elapsed{};
 };
 

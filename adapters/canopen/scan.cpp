@@ -107,7 +107,9 @@ void CanopenScan::on_frame(const CanFrame& frame, core::TimePoint now) noexcept 
   const CobSplit s = split_cob_id(frame.id);
   Node* node = valid_node_id(s.node) ? &nodes_[s.node] : nullptr;
   switch (s.function) {
-    case Function::SdoTx: sdo_.on_frame(frame, now); break;
+    case Function::SdoTx:
+      if (node == nullptr || first_answer(*node, frame)) sdo_.on_frame(frame, now);
+      break;
     case Function::ErrorControl:
       if (node == nullptr) break;
       if (frame.remote) {  // a node guarding request: someone guards this node
@@ -133,6 +135,30 @@ void CanopenScan::on_frame(const CanFrame& frame, core::TimePoint now) noexcept 
     case Function::Time:
     case Function::Other: break;
   }
+}
+
+bool CanopenScan::first_answer(Node& n, const CanFrame& frame) noexcept {
+  const SdoDecoded d = decode_sdo_response(frame.payload());
+  const SdoCommand c = d.message.command;
+  if (d.error != SdoDecodeError::None || (c != SdoCommand::InitiateUploadResponse && c != SdoCommand::Abort))
+    return true;
+  Answers* a = d.message.object == kDeviceType ? &n.answers[0] : nullptr;
+  for (std::size_t i = 0; a == nullptr && i < kIdentityObjects.size(); ++i)
+    if (d.message.object == kIdentityObjects[i]) a = &n.answers[i + 1];
+  if (a == nullptr) return true;  // not an object the scan asks: the SDO client counts it
+  SdoBytes bytes{};
+  std::copy_n(frame.data.begin(), bytes.size(), bytes.begin());
+  if (!a->first) {
+    a->first = bytes;
+    a->segmented = c == SdoCommand::InitiateUploadResponse && !d.message.expedited;
+    return true;
+  }
+  if (c == SdoCommand::Abort && a->segmented) {  // the server ends its segmented upload
+    a->segmented = false;
+    return true;
+  }
+  if (!a->second) a->second = bytes;
+  return false;
 }
 
 void CanopenScan::submit_identity(Node& n) noexcept {
@@ -241,11 +267,38 @@ core::TimePoint CanopenScan::next_deadline() const noexcept {
   return core::TimePoint::max();
 }
 
+namespace {
+
+// One answer as the note on a second answer shows it: the value, the upload's size, the abort.
+std::string answer_words(const SdoBytes& bytes) {
+  const SdoMessage m = decode_sdo_response(bytes).message;
+  if (m.command == SdoCommand::Abort) return abort_words(m.abort_code);
+  if (!m.expedited) return m.size_indicated ? "a segmented upload of " + std::to_string(m.size) + " bytes"
+                                            : "a segmented upload";
+  std::uint32_t v = 0;
+  for (std::size_t i = m.length; i-- > 0;) v = (v << 8) | m.data[i];
+  return hex32(v);
+}
+
+}  // namespace
+
 std::vector<ScannedNode> CanopenScan::nodes() const {
   std::vector<ScannedNode> out;
   for (int i = kMinNodeId; i <= kMaxNodeId; ++i) {
-    const auto& n = nodes_[static_cast<std::size_t>(i)].seen;
-    if (n.heard || n.answered) out.push_back(n);
+    const auto& n = nodes_[static_cast<std::size_t>(i)];
+    if (!n.seen.heard && !n.seen.answered) continue;
+    out.push_back(n.seen);
+    for (std::size_t k = 0; k < n.answers.size(); ++k) {
+      const Answers& a = n.answers[k];
+      if (!a.second) continue;
+      // Compared as read: 42h (size not indicated) and 43h with the same value say the same.
+      const std::string object = object_name(k == 0 ? kDeviceType : kIdentityObjects[k - 1]);
+      const std::string first = answer_words(*a.first);
+      const std::string second = answer_words(*a.second);
+      out.back().second_answers.push_back(first == second
+                                              ? object + ": answered twice, the same (" + first + ")"
+                                              : object + ": answered twice, differently: " + first + " and " + second);
+    }
   }
   return out;
 }
@@ -430,6 +483,34 @@ void match_profile(core::FoundDevice& d, const std::vector<config::DeviceProfile
   if (!others.empty()) d.profile_reason += " (fits too: " + others + ")";
 }
 
+const config::DeviceProfile* profile_named(const std::vector<config::DeviceProfile>& profiles,
+                                           const std::string& name) {
+  for (const auto& p : profiles)
+    if (p.name == name) return &p;
+  return nullptr;
+}
+
+// What a person reads about a node-ID with more than one device answering: the channel, the two
+// causes, and the drive found below it (`earlier`) whose extra SDO channels land on this node-ID
+// (stoeber-sd6-canopen.md §5.3, quirk 1).
+std::string conflict_words(NodeId node, const std::vector<core::FoundDevice>& earlier,
+                           const std::vector<config::DeviceProfile>& profiles) {
+  char b[160];
+  std::snprintf(b, sizeof b, "node-ID %d: more than one device answers on %03Xh/%03Xh (a node-ID conflict", node,
+                cob::sdo_rx(node), cob::sdo_tx(node));
+  std::string s = b;
+  for (const auto& d : earlier) {
+    const int gap = node - d.address.number;
+    const auto* p = profile_named(profiles, d.profile);
+    if (p == nullptr || gap % 32 != 0 || gap / 32 >= p->canopen.sdo_channels) continue;
+    std::snprintf(b, sizeof b, ", or another drive's extra SDO channel: node %d is a %s whose SDO channel %d is node-ID %d",
+                  d.address.number, d.profile.c_str(), gap / 32 + 1, node);
+    s += b;
+    break;
+  }
+  return s + "); its identity cannot be trusted";
+}
+
 bool same_device(const core::FoundDevice& a, const core::FoundDevice& b) {
   return a.device_type == b.device_type && a.identity.vendor_id == b.identity.vendor_id &&
          a.identity.product_code == b.identity.product_code && a.identity.revision == b.identity.revision &&
@@ -444,17 +525,12 @@ bool same_device(const core::FoundDevice& a, const core::FoundDevice& b) {
 // node-ID itself.
 void fold_extra_channels(std::vector<core::FoundDevice>& devices, const std::vector<bool>& heard,
                          const std::vector<config::DeviceProfile>& profiles, std::vector<bool>& taken) {
-  const auto profile_of = [&](const std::string& name) -> const config::DeviceProfile* {
-    for (const auto& p : profiles)
-      if (p.name == name) return &p;
-    return nullptr;
-  };
   std::vector<bool> drop(devices.size(), false);
   for (std::size_t i = 0; i < devices.size(); ++i) {
     for (std::size_t j = 0; j < i; ++j) {
       const int gap = devices[i].address.number - devices[j].address.number;
-      const auto* p = profile_of(devices[j].profile);
-      if (heard[i] || drop[j] || gap % 32 != 0 || p == nullptr || gap / 32 >= p->canopen.sdo_channels ||
+      const auto* p = profile_named(profiles, devices[j].profile);
+      if (heard[i] || !devices[i].conflict.empty() || drop[j] || gap % 32 != 0 || p == nullptr || gap / 32 >= p->canopen.sdo_channels ||
           !same_device(devices[i], devices[j]))
         continue;
       char b[96];
@@ -509,9 +585,17 @@ core::ScanResult scan_result(const CanopenScan& scan, const config::BusPlan& pla
     d.hardware_version = n.hardware_version;
     d.software_version = n.software_version;
     d.notes = n.notes;
+    d.notes.insert(d.notes.end(), n.second_answers.begin(), n.second_answers.end());
     if (n.boot_up) d.notes.insert(d.notes.begin(), "booted during the scan");
-    if (n.answered) match_profile(d, profiles);
-    else d.profile_reason = "no SDO answer: nothing to match";
+    if (!n.second_answers.empty()) {
+      d.conflict = conflict_words(n.node, r.devices, profiles);
+      d.profile_reason = "its identity cannot be trusted (more than one device answers): no profile chosen";
+      r.warnings.push_back(d.conflict);
+    } else if (n.answered) {
+      match_profile(d, profiles);
+    } else {
+      d.profile_reason = "no SDO answer: nothing to match";
+    }
     taken[n.node] = true;
     r.devices.push_back(std::move(d));
     heard.push_back(n.heard);

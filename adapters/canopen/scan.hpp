@@ -14,6 +14,12 @@
 //      and 100Ah. An object the node lacks is "not present"; an abort or a timeout on one object
 //      does not stop the others.
 //
+// One SDO server answers each request once. A second answer to one of these requests (a second
+// initiate response or abort for the same object) means more than one device answers on that
+// node-ID's channel: a node-ID conflict, or another drive's extra SDO channel. The scan keeps the
+// first answer, drops the others (they would confuse the next request on the channel) and says
+// which answers came twice; the node's identity is then a mix that cannot be trusted.
+//
 // Every request has `answer_timeout` plus the time 2 x 127 frames take on the wire at the bus'
 // bit rate (the probe's requests and answers queue on the wire) and no retry; so the scan ends by
 // itself: with nobody there after listen + about one timeout, in the worst case (a node that
@@ -32,6 +38,7 @@
 #include "adapters/canopen/master/tx_queue.hpp"
 #include "adapters/canopen/wire/can_frame.hpp"
 #include "adapters/canopen/wire/nmt_codec.hpp"
+#include "adapters/canopen/wire/sdo_codec.hpp"
 #include "config/plan.hpp"
 #include "core/clock.hpp"
 #include "core/scan.hpp"
@@ -66,6 +73,9 @@ struct ScannedNode {
   std::optional<std::string> hardware_version;
   std::optional<std::string> software_version;
   std::vector<std::string> notes;
+  // Not empty when more than one device answers at this node-ID: the objects answered twice and
+  // how ("1000h: answered twice, differently: 0x00020192 and 0x00000192").
+  std::vector<std::string> second_answers;
 };
 
 class CanopenScan {
@@ -88,14 +98,23 @@ class CanopenScan {
   // The requests asked of a node after its probe, in this order.
   static constexpr std::size_t kIdentityReads = 7;
   enum class Phase : std::uint8_t { Listen, Probe, Done };
+  // The answers to one object the scan asks (1000h, then the identity reads).
+  struct Answers {
+    std::optional<SdoBytes> first;
+    std::optional<SdoBytes> second;  // the first answer one server would not have given
+    bool segmented = false;          // `first` opened a segmented upload: the server may still abort it
+  };
   struct Node {
     ScannedNode seen;
+    std::array<Answers, kIdentityReads + 1> answers;
     SdoRequestId probe = kNoSdoRequest;
     std::array<SdoRequestId, kIdentityReads> reads{};
     std::array<std::vector<std::uint8_t>, 3> strings;  // 1008h, 1009h, 100Ah buffers
     bool finished = false;  // every request of the node has its outcome
   };
 
+  // False when `frame` is a second answer to a request of `n` (noted, not for the SDO client).
+  bool first_answer(Node& n, const CanFrame& frame) noexcept;
   void submit_identity(Node& n) noexcept;
   void collect(Node& n, core::TimePoint now);
   void finish_all();

@@ -29,10 +29,17 @@ bool has_note(const std::vector<std::string>& notes, const std::string& what) {
 // third for frames a test makes by hand. Steps of 100 us.
 class ScanOnWire : public ::testing::Test {
  protected:
-  ScanOnWire() : scanner_(wire_.connect()), drives_(wire_.connect()), other_(wire_.connect()), network_(*drives_) {
+  ScanOnWire()
+      : scanner_(wire_.connect()),
+        drives_(wire_.connect()),
+        other_(wire_.connect()),
+        more_drives_(wire_.connect()),
+        network_(*drives_),
+        more_network_(*more_drives_) {
     scanner_->open();
     drives_->open();
     other_->open();
+    more_drives_->open();
   }
 
   // Runs the scan to its end (or `limit`); returns the time it took.
@@ -42,6 +49,7 @@ class ScanOnWire : public ::testing::Test {
     std::array<CanFrame, 64> rx{};
     for (now_ = kT0; !scan_->done() && now_ < kT0 + limit; now_ += 100us) {
       network_.step(now_);
+      more_network_.step(now_);
       if (responder_) responder_(now_);
       wire_.advance(now_);
       for (std::size_t got; (got = scanner_->receive(rx, now_)) > 0;)
@@ -90,7 +98,9 @@ class ScanOnWire : public ::testing::Test {
   std::unique_ptr<InprocEndpoint> scanner_;
   std::unique_ptr<InprocEndpoint> drives_;
   std::unique_ptr<InprocEndpoint> other_;
+  std::unique_ptr<InprocEndpoint> more_drives_;
   sim::SimNetwork network_;
+  sim::SimNetwork more_network_;  // a second cable segment: drives on node-IDs network_ has too
   std::function<void(core::TimePoint)> responder_;  // a hand-made node on `other_`
   std::unique_ptr<CanopenScan> scan_;
   std::vector<ScannedNode> nodes_;
@@ -324,6 +334,80 @@ TEST_F(ScanOnWire, ANodeHeardButWithoutSdoAnswerIsListedWithoutAProfile) {
   ASSERT_EQ(r.devices.size(), 1U);
   EXPECT_FALSE(r.devices[0].drive);
   EXPECT_EQ(r.devices[0].profile, "");
+}
+
+TEST_F(ScanOnWire, TwoDevicesOnOneNodeIdAreAConflictWithoutProfile) {
+  network_.add(sim::test::akd(12));
+  more_network_.add(sim::test::nord(12));
+  network_.add(sim::test::generic(13));
+  run();
+  ASSERT_TRUE(scan_->done());
+  const auto* n = node(12);
+  ASSERT_NE(n, nullptr);
+  // The first answer is kept, the second noted: the AKD servo drive against the NORD frequency
+  // converter.
+  EXPECT_TRUE(has_note(n->second_answers, "1000h: answered twice, differently: 0x00020192 and 0x00010192"))
+      << (n->second_answers.empty() ? "" : n->second_answers[0]);
+  EXPECT_TRUE(has_note(n->second_answers, "1018h:01: answered twice, differently"));
+  ASSERT_NE(node(13), nullptr);
+  EXPECT_TRUE(node(13)->second_answers.empty());
+  // The second answers went nowhere else: the node next door reads cleanly.
+  EXPECT_EQ(node(13)->name, "drivegate simulated CiA 402 drive");
+
+  const auto r = scan_result(*scan_, udp_plan(), profiles());
+  ASSERT_EQ(r.devices.size(), 2U);
+  const auto& d = r.devices[0];
+  EXPECT_EQ(d.conflict,
+            "node-ID 12: more than one device answers on 60Ch/58Ch (a node-ID conflict); its identity cannot be "
+            "trusted");
+  EXPECT_FALSE(d.drive);
+  EXPECT_EQ(d.profile, "");
+  EXPECT_TRUE(has_note(d.notes, "1000h: answered twice"));
+  EXPECT_EQ(r.warnings, std::vector<std::string>{d.conflict});
+  EXPECT_TRUE(r.devices[1].drive);
+  EXPECT_TRUE(r.devices[1].conflict.empty());
+}
+
+TEST_F(ScanOnWire, TwoIdenticalDrivesOnOneNodeIdAreStillAConflict) {
+  network_.add(sim::test::generic(40));
+  more_network_.add(sim::test::generic(40));
+  run();
+  ASSERT_TRUE(scan_->done());
+  const auto* n = node(40);
+  ASSERT_NE(n, nullptr);
+  // Both answer the same; every object comes twice.
+  EXPECT_TRUE(has_note(n->second_answers, "1000h: answered twice, the same (0x00020192)"))
+      << (n->second_answers.empty() ? "" : n->second_answers[0]);
+  EXPECT_TRUE(has_note(n->second_answers, "1008h: answered twice, the same (a segmented upload of 33 bytes)"));
+  const auto r = scan_result(*scan_, udp_plan(), profiles());
+  ASSERT_EQ(r.devices.size(), 1U);
+  EXPECT_FALSE(r.devices[0].drive);
+  EXPECT_NE(r.devices[0].conflict.find("node-ID 40: more than one device answers on 628h/5A8h"), std::string::npos);
+  EXPECT_EQ(r.warnings.size(), 1U);
+}
+
+TEST_F(ScanOnWire, ADriveOnAnSd6ExtraChannelIsAConflictThatNamesTheSd6) {
+  // The SD6 at 3 answers on the default channels of 35, 67, 99 too (SD6 §5.3); a drive at 35.
+  network_.add(sim::test::sd6(3));
+  network_.add(sim::test::generic(35));
+  run();
+  ASSERT_TRUE(scan_->done());
+  const auto r = scan_result(*scan_, udp_plan(), profiles());
+  std::vector<int> ids;
+  for (const auto& d : r.devices) ids.push_back(d.address.number);
+  EXPECT_EQ(ids, (std::vector<int>{3, 35}));  // 67 and 99 folded into the SD6, 35 not
+  ASSERT_EQ(r.devices.size(), 2U);
+  EXPECT_EQ(r.devices[0].profile, "stoeber-sd6");
+  EXPECT_TRUE(r.devices[0].drive);
+  EXPECT_TRUE(has_note(r.devices[0].notes, "its SDO channel 3"));
+  EXPECT_FALSE(has_note(r.devices[0].notes, "its SDO channel 2"));
+  const auto& d = r.devices[1];
+  EXPECT_EQ(d.conflict,
+            "node-ID 35: more than one device answers on 623h/5A3h (a node-ID conflict, or another drive's extra SDO "
+            "channel: node 3 is a stoeber-sd6 whose SDO channel 2 is node-ID 35); its identity cannot be trusted");
+  EXPECT_FALSE(d.drive);
+  EXPECT_TRUE(has_note(d.notes, "1000h: answered twice"));
+  EXPECT_EQ(r.warnings, std::vector<std::string>{d.conflict});
 }
 
 TEST(ScanBusPlan, TakesAnInterfaceOrUdpMulticastWithOptions) {
