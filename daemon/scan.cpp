@@ -104,7 +104,8 @@ std::string format_scan_table(const core::ScanResult& result) {
       rows.push_back({d.address.text, hex32(d.device_type), d.device_type_text.empty() ? "-" : d.device_type_text,
                       hex32(d.identity.vendor_id), hex32(d.identity.product_code), hex32(d.identity.revision),
                       hex32(d.identity.serial), text_or_dash(d.name), text_or_dash(d.hardware_version),
-                      text_or_dash(d.software_version), d.profile.empty() ? "(none)" : d.profile});
+                      text_or_dash(d.software_version),
+                      !d.conflict.empty() ? "(conflict)" : d.profile.empty() ? "(none)" : d.profile});
     out << format_columns(rows);
     out << "\n";
     for (const auto& d : result.devices) {
@@ -114,6 +115,7 @@ std::string format_scan_table(const core::ScanResult& result) {
     }
   }
   for (const auto& note : result.notes) out << "note: " << note << "\n";
+  for (const auto& warning : result.warnings) out << "warning: " << warning << "\n";
   return out.str();
 }
 
@@ -139,12 +141,18 @@ std::string skeleton_text(const core::ScanResult& result, core::Duration cycle_t
     << "             # CHECK: the bus cycle (CANopen: the SYNC period)\n"
     << "    options:\n";
   for (const auto& [key, value] : result.bus_options) y << "      " << key << ": " << value << "\n";
-  const bool any = std::any_of(result.devices.begin(), result.devices.end(), [](const auto& d) { return d.drive; });
+  const auto is_axis = [](const core::FoundDevice& d) { return d.drive && d.conflict.empty(); };
+  const bool any = std::any_of(result.devices.begin(), result.devices.end(), is_axis);
   y << "axes:" << (any ? "\n" : " []\n");
   for (const auto& d : result.devices) {
     y << "  # " << d.address.text << ": " << (d.device_type_text.empty() ? "device type unknown" : d.device_type_text);
     if (d.name) y << ", \"" << *d.name << "\"";
     y << "\n  #   " << d.profile_reason << "\n";
+    if (!d.conflict.empty()) {
+      y << "  #   not an axis here: " << d.conflict << ";\n"
+        << "  #   give every device its own node-ID (and no node-ID another drive's SDO channels use) and scan again\n";
+      continue;
+    }
     if (!d.drive) {
       y << "  #   not an axis here: add a device profile for it (profiles/devices/README.md) and scan again\n";
       continue;

@@ -32,15 +32,15 @@ class ScannerRegistry {
 core::ScanRequest parse_scan_target(const std::string& target);
 
 // The table: one row per device (address, device type, identity in hex, name and versions, device
-// profile), then per device its profile reason and notes, then the bus notes. Says so when the
-// bus has no device.
+// profile, "(conflict)" where more than one device answers), then per device its profile reason
+// and notes, then the bus notes and the warnings. Says so when the bus has no device.
 std::string format_scan_table(const core::ScanResult& result);
 
 // A configuration that --check-config accepts as it is: the gateway, the scanned bus with its
-// options, one axis per device that has a device profile (the rest as comments), and comments on
-// what to fill in (mechanics, limits, names). Checked here with the configuration loader, with the
-// first of result.cycle_times it accepts; throws core::ScanError with the loader's problems when
-// none is accepted.
+// options, one axis per device that has a device profile and a trusted identity (the rest as
+// comments with the reason), and comments on what to fill in (mechanics, limits, names). Checked
+// here with the configuration loader, with the first of result.cycle_times it accepts; throws
+// core::ScanError with the loader's problems when none is accepted.
 std::string scan_skeleton(const core::ScanResult& result, const config::LoadOptions& options);
 
 // Writes `text` to `file` through a temporary file in the same directory and a rename, so that the

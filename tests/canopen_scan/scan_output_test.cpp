@@ -58,6 +58,37 @@ TEST(ScanTable, OneRowPerDeviceThenReasonsAndNotes) {
   EXPECT_NE(t.find("9 (09h): no profile: vendor 0x00000123 matches no profile"), std::string::npos) << t;
 }
 
+// The AKD's node-ID answered twice: its identity is a mix of two devices' answers.
+core::ScanResult akd_in_conflict() {
+  auto r = two_devices();
+  r.devices[0].conflict = "node-ID 5: more than one device answers on 605h/585h (a node-ID conflict); its identity "
+                          "cannot be trusted";
+  r.warnings = {r.devices[0].conflict};
+  return r;
+}
+
+TEST(ScanTable, AConflictIsMarkedInTheRowAndAWarningLine) {
+  const std::string t = format_scan_table(akd_in_conflict());
+  EXPECT_NE(t.find("(conflict)\n"), std::string::npos) << t;
+  EXPECT_EQ(t.find("kollmorgen-akd\n"), std::string::npos) << t;
+  EXPECT_NE(t.find("\nwarning: node-ID 5: more than one device answers on 605h/585h (a node-ID conflict); its "
+                   "identity cannot be trusted\n"),
+            std::string::npos)
+      << t;
+}
+
+TEST(ScanSkeleton, ADeviceInConflictIsNoAxisEvenWithAProfile) {
+  const config::LoadOptions load;
+  const auto r = akd_in_conflict();
+  ASSERT_TRUE(r.devices[0].drive);  // the skeleton does not rely on the scanner clearing it
+  const std::string text = scan_skeleton(r, load);
+  EXPECT_TRUE(config::load_plan_from_string(text, "skeleton.yaml", load).buses[0].axes.empty()) << text;
+  EXPECT_NE(text.find("  #   not an axis here: node-ID 5: more than one device answers on 605h/585h"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("give every device its own node-ID"), std::string::npos) << text;
+}
+
 TEST(ScanTable, SaysSoWhenNobodyAnswered) {
   core::ScanResult r;
   r.bus_type = "canopen";
