@@ -407,6 +407,8 @@ TEST_F(ScanOnWire, ADriveOnAnSd6ExtraChannelIsAConflictThatNamesTheSd6) {
             "channel: node 3 is a stoeber-sd6 whose SDO channel 2 is node-ID 35); its identity cannot be trusted");
   EXPECT_FALSE(d.drive);
   EXPECT_TRUE(has_note(d.notes, "1000h: answered twice"));
+  // The SD6 answers 42h (size not indicated, SD6 §6.4), the other drive 43h: the same value.
+  EXPECT_TRUE(has_note(d.notes, "1018h:03: answered twice, the same (0x00000000)"));
   EXPECT_EQ(r.warnings, std::vector<std::string>{d.conflict});
 }
 

@@ -122,6 +122,34 @@ TEST(ScanProcess, FindsTheSimulatedDrivesAndWritesAConfigurationCheckConfigAccep
   std::filesystem::remove(file);
 }
 
+TEST(ScanProcess, ADriveOnAnSd6ExtraChannelIsWarnedAboutAndNoAxisInTheSkeleton) {
+  // The field case: an SD6 at 3, whose SDO channel 2 answers on node-ID 35 (SD6 §5.3), and a
+  // drive at 35.
+  const Bus bus = unique_bus(3);
+  std::string config = drives_config(bus);
+  config = config.substr(0, config.find("  - { name: akd")) +
+           "  - { name: sd6, bus: can0, address: 3, device: stoeber-sd6, mechanics: { encoder_counts_per_rev: 131072 } }\n"
+           "  - { name: gen, bus: can0, address: 35, device: generic-cia402, mechanics: { encoder_counts_per_rev: 4096 } }\n";
+  SimProcess sim(write_config_text("scan-sim-conflict", config));
+  ASSERT_TRUE(sim.wait_ready(10s)) << sim.log();
+  const std::string file = ::testing::TempDir() + "scan-conflict-" + std::to_string(::getpid()) + ".yaml";
+  std::filesystem::remove(file);
+  const Outcome scan = drivegated("--scan " + bus.where() + " --write-config " + file);
+  ASSERT_EQ(scan.status, 0) << scan.out;
+  EXPECT_TRUE(has_line(scan.out, "^3 \\(03h\\) .* stoeber-sd6$")) << scan.out;
+  EXPECT_TRUE(has_line(scan.out, "^35 \\(23h\\) .* \\(conflict\\)$")) << scan.out;
+  EXPECT_TRUE(has_line(scan.out, "^    1000h: answered twice, differently: ")) << scan.out;
+  EXPECT_TRUE(has_line(scan.out, "^warning: node-ID 35: more than one device answers on 623h/5A3h \\(a node-ID "
+                                 "conflict, or another drive's extra SDO channel: node 3 is a stoeber-sd6 whose SDO "
+                                 "channel 2 is node-ID 35\\); its identity cannot be trusted$"))
+      << scan.out;
+  const YAML::Node written = YAML::LoadFile(file);
+  ASSERT_EQ(written["axes"].size(), 1U) << scan.out;
+  EXPECT_EQ(written["axes"][0]["address"].as<int>(), 3);
+  EXPECT_EQ(drivegated("--check-config " + file).status, 0);
+  std::filesystem::remove(file);
+}
+
 TEST(ScanProcess, NobodyThereSaysSoWithinASecond) {
   const Bus bus = unique_bus(1);
   const Outcome scan = drivegated("--scan " + bus.where());
