@@ -205,6 +205,9 @@ int main(int argc, char** argv) {
   std::printf("bench_daemon_cpu: drivegated and drivegate-sim, %d generic-cia402 drives on udp-multicast %s:%u "
               "(loopback), SYNC every 4 ms; %.0f s per phase; %% of one core from /proc (utime + stime)\n",
               kAxes, group.c_str(), port, seconds);
+  std::printf("drivegated pid %d, drivegate-sim pid %d (for top -H -p PID while it runs)\n", static_cast<int>(daemon.pid()),
+              static_cast<int>(sim.pid()));
+  std::fflush(stdout);
   const auto measure = [&](const char* phase) {
     const auto m0 = machine_ticks();
     const auto d0 = sample(daemon.pid());
@@ -225,6 +228,7 @@ int main(int argc, char** argv) {
     print_usage("drivegate-sim", su, wall);
     std::printf("  reference: machine busy %.1f %% of all cores (%.1f %% other than these two); fixed loop %.1f ms "
                 "thread CPU\n", machine_pct, machine_pct - ours_pct, ref);
+    std::fflush(stdout);
   };
 
   measure("a: axes enabled and still");
