@@ -20,7 +20,8 @@ bool BusRunner::room_for_parameter() const noexcept {
   return params_in_flight_ + param_replies_.size_approx() < param_replies_.capacity();
 }
 
-void BusRunner::cycle(TimePoint now) noexcept {
+bool BusRunner::cycle(TimePoint now) noexcept {
+  queued_ = false;
   bus_.receive(now);
   Event bus_event;
   while (bus_.next_event(bus_event)) {
@@ -57,15 +58,19 @@ void BusRunner::cycle(TimePoint now) noexcept {
     snapshots_[i].store(axes_[i].snapshot());
   }
   bus_.transmit(now);
+  return queued_;
 }
 
 void BusRunner::reply(const Reply& r) noexcept {
+  queued_ = true;
   if (!replies_.push(r)) dropped_.fetch_add(1, std::memory_order_relaxed);
 }
 void BusRunner::event(const Event& e) noexcept {
+  queued_ = true;
   if (!events_.push(e)) dropped_.fetch_add(1, std::memory_order_relaxed);
 }
 void BusRunner::parameter_reply(const ParamReply& r) noexcept {
+  queued_ = true;
   if (params_in_flight_ > 0) --params_in_flight_;
   if (!param_replies_.push(r)) dropped_.fetch_add(1, std::memory_order_relaxed);
 }

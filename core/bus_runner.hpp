@@ -38,7 +38,8 @@ class BusRunner final : private RunnerOutput {
   [[nodiscard]] std::uint64_t dropped_outputs() const noexcept { return dropped_.load(std::memory_order_relaxed); }
 
   // --- Cycle thread ---
-  void cycle(TimePoint now) noexcept;
+  // Returns true when it queued replies, events or parameter replies for the control plane.
+  bool cycle(TimePoint now) noexcept;
 
  private:
   void reply(const Reply& r) noexcept override;
@@ -72,6 +73,7 @@ class BusRunner final : private RunnerOutput {
   std::size_t params_in_flight_ = 0;  // taken, reply not yet queued
   ParamRequest held_param_{};         // refused for now by its axis (no free slot): offered again first
   bool param_held_ = false;
+  bool queued_ = false;  // this cycle queued outputs
 };
 
 }  // namespace drivegate::core

@@ -20,13 +20,11 @@
 #include <thread>
 #include <utility>
 
-#include <fastdds/dds/core/condition/GuardCondition.hpp>
-#include <fastdds/dds/core/condition/StatusCondition.hpp>
-#include <fastdds/dds/core/condition/WaitSet.hpp>
 #include <fastdds/dds/core/status/PublicationMatchedStatus.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <fastdds/dds/publisher/DataWriterListener.hpp>
 #include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/DataReaderListener.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <spdlog/spdlog.h>
 
@@ -43,9 +41,9 @@ using namespace std::chrono_literals;
 
 namespace {
 
-// The Runtime has no wake-up signal, so its outbox is drained at least this often.
-constexpr auto kMaxPoll = 5ms;
-// While requests are in flight or wait for the Runtime, the bridge comes back sooner.
+// The bridge sleeps until the Runtime's output signal (replies, events), DDS data or the next
+// publication is due. Only while requests wait for room in the Runtime's queues, or replies for
+// their client's reader or writer history, does it come back this often to retry.
 constexpr auto kBusyPoll = 1ms;
 // A request that found no place in the Runtime's queue for this long is answered "busy".
 constexpr auto kBusyAfter = 2s;
@@ -158,7 +156,7 @@ std::int64_t wall_clock_ns() {
 
 }  // namespace
 
-class DdsBridge::Impl : private dds::DataWriterListener {
+class DdsBridge::Impl : private dds::DataWriterListener, private dds::DataReaderListener {
  public:
   Impl(Runtime& runtime, DdsBridgeOptions options) : rt_(runtime), opt_(std::move(options)) {
     std::random_device rd;
@@ -173,7 +171,9 @@ class DdsBridge::Impl : private dds::DataWriterListener {
   void stop();
   [[nodiscard]] Stats stats() const {
     std::lock_guard lock(stats_mutex_);
-    return stats_;
+    Stats s = stats_;
+    s.wakeups = wakeups_.load(std::memory_order_relaxed);
+    return s;
   }
   DuplicateGateway duplicate() const {
     std::lock_guard lock(dup_mutex_);
@@ -201,11 +201,12 @@ class DdsBridge::Impl : private dds::DataWriterListener {
 
  private:
   void run();
-  void take_commands(Clock::time_point now);
+  // Each returns true when it stopped at kTakePerPass with more possibly waiting.
+  bool take_commands(Clock::time_point now);
   void handle_command(const msg::AxisCommand& in, const Prefix& from, Clock::time_point now);
   void reject(const msg::AxisCommand& in, const Prefix& from, const std::string& reason, Clock::time_point now);
   void take_setpoints();
-  void take_params(Clock::time_point now);
+  bool take_params(Clock::time_point now);
   void handle_param(const msg::ParameterRequest& in, const Prefix& from, Clock::time_point now);
   void fail_param(const msg::ParameterRequest& in, const Prefix& from, const std::string& error, Clock::time_point now);
   void retry_deferred(Clock::time_point now);
@@ -238,6 +239,8 @@ class DdsBridge::Impl : private dds::DataWriterListener {
 
   // DataWriterListener of the two reply writers: which participants have a matched reply reader.
   void on_publication_matched(dds::DataWriter* writer, const dds::PublicationMatchedStatus& info) override;
+  // DataReaderListener of the four readers (DDS threads): wakes the bridge.
+  void on_data_available(dds::DataReader* /*reader*/) override { rt_.output_signal().notify(); }
 
   Runtime& rt_;
   DdsBridgeOptions opt_;
@@ -256,11 +259,10 @@ class DdsBridge::Impl : private dds::DataWriterListener {
   dds::DataReader* sp_r_ = nullptr;
   dds::DataReader* param_r_ = nullptr;
   dds::DataReader* info_r_ = nullptr;
-  dds::GuardCondition wake_;
-  dds::WaitSet waitset_;
 
   std::thread thread_;
   std::atomic<bool> running_{false};
+  std::atomic<std::uint64_t> wakeups_{0};
 
   // Bridge-thread state.
   core::CommandId next_id_ = 1;
@@ -322,16 +324,11 @@ void DdsBridge::Impl::start() {
   bus_w_ = &node_->writer(msg::TopicId::BusStatus);
   param_w_ = &node_->writer(msg::TopicId::ParamReply, this, dds::StatusMask::publication_matched());
   info_w_ = &node_->writer(msg::TopicId::GatewayInfo);
-  cmd_r_ = &node_->reader(msg::TopicId::AxisCommand);
-  sp_r_ = &node_->reader(msg::TopicId::Setpoint);
-  param_r_ = &node_->reader(msg::TopicId::ParamRequest);
-  info_r_ = &node_->reader(msg::TopicId::GatewayInfo);
-  for (dds::DataReader* r : {cmd_r_, sp_r_, param_r_, info_r_}) {
-    r->get_statuscondition().set_enabled_statuses(dds::StatusMask::data_available());
-    waitset_.attach_condition(r->get_statuscondition());
-  }
-  wake_.set_trigger_value(false);
-  waitset_.attach_condition(wake_);
+  const auto arrival = dds::StatusMask::data_available();
+  cmd_r_ = &node_->reader(msg::TopicId::AxisCommand, this, arrival);
+  sp_r_ = &node_->reader(msg::TopicId::Setpoint, this, arrival);
+  param_r_ = &node_->reader(msg::TopicId::ParamRequest, this, arrival);
+  info_r_ = &node_->reader(msg::TopicId::GatewayInfo, this, arrival);
 
   publish_gateway_info();
   spdlog::info("dds: gateway '{}' on domain {} namespace '{}'{}{}, {} axes, state at {} Hz", gateway_, opt_.domain,
@@ -347,10 +344,8 @@ void DdsBridge::Impl::start() {
 
 void DdsBridge::Impl::stop() {
   if (!running_.exchange(false)) return;
-  wake_.set_trigger_value(true);
+  rt_.output_signal().notify();
   thread_.join();
-  for (dds::DataReader* r : {cmd_r_, sp_r_, param_r_, info_r_}) waitset_.detach_condition(r->get_statuscondition());
-  waitset_.detach_condition(wake_);
   node_.reset();
   spdlog::info("dds: bridge of gateway '{}' stopped", gateway_);
 }
@@ -368,6 +363,7 @@ void DdsBridge::Impl::on_publication_matched(dds::DataWriter* writer, const dds:
       gone_.emplace_back(p, writer == param_w_);
     }
   }
+  rt_.output_signal().notify();  // replies may wait for this reader
 }
 
 bool DdsBridge::Impl::reader_matched(const Prefix& p, bool param) const {
@@ -383,23 +379,22 @@ void DdsBridge::Impl::run() {
   auto next_state = Clock::now();
   auto next_bus = Clock::now();
   next_summary_ = Clock::now() + kSummaryPeriod;
-  dds::ConditionSeq active;
+  bool more = false;  // requests may still wait in DDS: no sleep
   while (running_) {
-    const auto now = Clock::now();
-    // Requests in flight: their replies are picked up from the Runtime sooner.
-    const bool waiting = busy() || !replies_.empty() || !param_replies_.empty() || !pending_commands_.empty() ||
-                         !pending_params_.empty();
-    const auto wait = std::clamp<Clock::duration>(next_state - now, Clock::duration::zero(),
-                                                  waiting ? Clock::duration(kBusyPoll) : Clock::duration(kMaxPoll));
-    const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(wait).count();
-    waitset_.wait(active, eprosima::fastrtps::Duration_t(static_cast<std::int32_t>(ns / 1'000'000'000),
-                                                         static_cast<std::uint32_t>(ns % 1'000'000'000)));
+    auto until = std::min({next_state, next_bus, next_summary_});
+    if (more) {
+      until = Clock::now();
+    } else if (busy() || !replies_.empty() || !param_replies_.empty()) {
+      until = std::min(until, Clock::now() + kBusyPoll);
+    }
+    rt_.output_signal().wait_until(until);
+    wakeups_.fetch_add(1, std::memory_order_relaxed);
     if (!running_) break;
     const auto t = Clock::now();
     retry_deferred(t);
-    take_commands(t);
+    more = take_commands(t);
     take_setpoints();
-    take_params(t);
+    more = take_params(t) || more;
     take_gateway_infos();
     collect_outbox(t);
     write_replies(t);
@@ -433,13 +428,13 @@ std::string DdsBridge::Impl::axis_list() const {
   return s.empty() ? "(none)" : s;
 }
 
-void DdsBridge::Impl::take_commands(Clock::time_point now) {
+bool DdsBridge::Impl::take_commands(Clock::time_point now) {
   msg::AxisCommand in;
   dds::SampleInfo info;
   // While requests wait for the Runtime the rest stay in DDS: the keep-all reader fills and the
   // clients' writers wait, instead of anything being dropped.
-  for (std::size_t n = 0; n < kTakePerPass && !busy(); ++n) {
-    if (cmd_r_->take_next_sample(&in, &info) != ReturnCode_t::RETCODE_OK) break;
+  for (std::size_t n = 0; n < kTakePerPass; ++n) {
+    if (busy() || cmd_r_->take_next_sample(&in, &info) != ReturnCode_t::RETCODE_OK) return false;
     if (!info.valid_data) continue;
     if (in.gateway() != gateway_) {
       // Another gateway's axis: the owner answers, we stay silent.
@@ -448,6 +443,7 @@ void DdsBridge::Impl::take_commands(Clock::time_point now) {
     }
     handle_command(in, prefix_of(info.publication_handle), now);
   }
+  return true;
 }
 
 void DdsBridge::Impl::reject(const msg::AxisCommand& in, const Prefix& from, const std::string& reason,
@@ -584,14 +580,15 @@ void DdsBridge::Impl::take_setpoints() {
   });
 }
 
-void DdsBridge::Impl::take_params(Clock::time_point now) {
+bool DdsBridge::Impl::take_params(Clock::time_point now) {
   msg::ParameterRequest in;
   dds::SampleInfo info;
-  for (std::size_t n = 0; n < kTakePerPass && !busy(); ++n) {
-    if (param_r_->take_next_sample(&in, &info) != ReturnCode_t::RETCODE_OK) break;
+  for (std::size_t n = 0; n < kTakePerPass; ++n) {
+    if (busy() || param_r_->take_next_sample(&in, &info) != ReturnCode_t::RETCODE_OK) return false;
     if (!info.valid_data || in.gateway() != gateway_) continue;
     handle_param(in, prefix_of(info.publication_handle), now);
   }
+  return true;
 }
 
 void DdsBridge::Impl::fail_param(const msg::ParameterRequest& in, const Prefix& from, const std::string& error,

@@ -80,7 +80,9 @@ void Gateway::start() {
     sched.cpu = b.plan->cpu;
     sched.name = "dg-cycle-" + b.plan->name;  // "dg-cycle-sim0" (the kernel keeps 15 characters)
     core::BusRunner* runner = b.runner.get();
-    b.thread = std::make_unique<CycleThread>(sched, [runner](core::TimePoint t, std::uint64_t) { runner->cycle(t); });
+    b.thread = std::make_unique<CycleThread>(sched, [runner, signal = &output_signal_](core::TimePoint t, std::uint64_t) {
+      if (runner->cycle(t)) signal->notify();
+    });
     if (!b.thread->start()) throw core::BusError("bus '" + b.plan->name + "': could not start its cycle thread");
     spdlog::info("bus {}: {} with {} axes, cycle {} us", b.plan->name, b.plan->type, b.specs.size(),
                  std::chrono::duration_cast<std::chrono::microseconds>(b.plan->cycle_time).count());
@@ -98,6 +100,7 @@ bool Gateway::submit_command(std::size_t axis_id, const core::Command& cmd) {
     r.reply.status = core::ReplyStatus::Rejected;
     r.reply.reason.assign("gateway is shutting down: every axis is being stopped and disabled");
     local_replies_.push_back(r);
+    output_signal_.notify();
     return true;
   }
   core::Command c = cmd;
@@ -124,6 +127,7 @@ bool Gateway::submit_parameter(std::size_t axis_id, const core::ParamRequest& re
     r.reply.ok = false;
     r.reply.error.assign("gateway is shutting down: no parameter access while axes are being disabled");
     local_param_replies_.push_back(r);
+    output_signal_.notify();
     return true;
   }
   core::ParamRequest r = req;

@@ -58,6 +58,7 @@ class Gateway final : public Runtime {
   std::size_t bus_count() const noexcept override { return buses_.size(); }
   BusStatus bus_status(std::size_t bus) const override;
   void drain(Outbox& out) override;
+  [[nodiscard]] WakeSignal& output_signal() noexcept override { return output_signal_; }
 
  private:
   struct BusSlot {
@@ -87,6 +88,7 @@ class Gateway final : public Runtime {
   // sequence both submit, so submissions are serialised here (control plane only).
   std::mutex submit_mutex_;
   std::atomic<bool> shutting_down_{false};
+  WakeSignal output_signal_;
   std::vector<GlobalReply> local_replies_;  // refusals made here; guarded by submit_mutex_
   std::vector<GlobalParamReply> local_param_replies_;  // likewise
   core::CommandId next_internal_ = core::kInternalCommandBit | (core::CommandId{1} << 62);

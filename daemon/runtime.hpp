@@ -4,7 +4,7 @@
 //
 // Threading: submit_*() may be called from any control-plane thread (the implementation
 // serialises them in front of its single-producer queues); drain() from one thread only.
-// snapshot() and bus_status() from any thread.
+// snapshot(), bus_status() and output_signal() from any thread.
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -14,6 +14,7 @@
 #include "core/axis_types.hpp"
 #include "core/bus.hpp"
 #include "core/command.hpp"
+#include "daemon/wake_signal.hpp"
 
 namespace drivegate::daemon {
 
@@ -98,6 +99,9 @@ class Runtime {
 
   // Appends everything the cycle threads produced since the last call.
   virtual void drain(Outbox& out) = 0;
+  // Notified whenever there is something new for drain() (a cycle thread queued replies or events),
+  // so the drainer can sleep until then. It may notify others' news too (DDS data arrival).
+  [[nodiscard]] virtual WakeSignal& output_signal() noexcept = 0;
 };
 
 }  // namespace drivegate::daemon

@@ -608,14 +608,13 @@ void CanopenBus::transmit(core::TimePoint now) noexcept {
 }
 
 void CanopenBus::flush(core::TimePoint now) noexcept {
+  // One batch per contiguous run of the queue (two when it wraps around).
   while (!tx_.empty()) {
-    const SendResult r = transport_->send(tx_.front(), now);
-    if (r == SendResult::Busy) break;  // the rest goes next cycle; timeouts cover what is late
-    if (r == SendResult::Sent)
-      sent_.fetch_add(1, std::memory_order_relaxed);
-    else
-      ++tx_dropped_;
-    tx_.pop();
+    const SendBatchResult r = transport_->send_batch(tx_.front_run(), now);
+    sent_.fetch_add(r.sent, std::memory_order_relaxed);
+    tx_dropped_ += r.taken - r.sent;
+    tx_.pop(r.taken);
+    if (r.busy || r.taken == 0) break;  // the rest goes next cycle; timeouts cover what is late
   }
 }
 

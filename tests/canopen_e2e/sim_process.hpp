@@ -30,6 +30,7 @@ class SimProcess {
   bool wait_status(const std::function<bool(const std::string&)>& done, std::chrono::milliseconds timeout,
                    std::string& last);
   [[nodiscard]] std::string log() const;
+  [[nodiscard]] pid_t pid() const { return pid_; }
 
  private:
   std::optional<std::string> next_line(std::chrono::milliseconds timeout);

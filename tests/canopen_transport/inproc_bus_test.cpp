@@ -275,5 +275,34 @@ TEST_F(ThreeNodes, SendReceiveAndAdvanceAllocateNothing) {
   EXPECT_EQ(received, 200U * 6 - 2);  // each frame reaches two nodes; one 0x183 dropped
 }
 
+// A batch that finds the transmit queue full stops there: what went out and what was refused for
+// good are taken, the frame that found no room is neither (one overflow counted), so the caller
+// keeps it and the rest for later.
+TEST(InprocBus, SendBatchStopsAtAFullQueueAndCountsIt) {
+  InprocBus bus(500'000);
+  auto a = bus.connect();
+  auto b = bus.connect();
+  a->open();
+  b->open();
+  bus.set_tx_queue_limit(*a, 4);
+  std::vector<CanFrame> frames;
+  for (std::uint32_t i = 0; i < 10; ++i) frames.push_back(frame(0x100 + i));
+  frames[1].dlc = 9;  // invalid: refused, taken
+  const auto r = a->send_batch(frames, t0);
+  EXPECT_TRUE(r.busy);
+  EXPECT_EQ(r.taken, 5U);  // four queued and the invalid one; frames[5] found the queue full
+  EXPECT_EQ(r.sent, 4U);
+  EXPECT_EQ(a->counters().tx_overflows, 1U);
+  EXPECT_EQ(a->counters().tx_frames, 4U);
+  bus.advance(t0 + 10ms);
+  EXPECT_EQ(ids(drain(*b, t0 + 10ms)), (std::vector<std::uint32_t>{0x100, 0x102, 0x103, 0x104}));
+  // The rest goes once there is room, in order.
+  const auto rest = a->send_batch(std::span<const CanFrame>(frames).subspan(r.taken), t0 + 10ms);
+  EXPECT_TRUE(rest.busy);
+  EXPECT_EQ(rest.taken, 4U);
+  bus.advance(t0 + 20ms);
+  EXPECT_EQ(ids(drain(*b, t0 + 20ms)), (std::vector<std::uint32_t>{0x105, 0x106, 0x107, 0x108}));
+}
+
 }  // namespace
 }  // namespace drivegate::canopen

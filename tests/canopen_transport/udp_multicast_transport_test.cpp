@@ -275,6 +275,79 @@ TEST(UdpMulticast, ClosedOrInvalidSendsAreRefused) {
   EXPECT_EQ(t.send(make_frame(0x181, {}), now()), SendResult::Down);
 }
 
+// One send_batch() of more frames than one sendmmsg carries: every valid frame arrives at another
+// member in order, the invalid one in the middle is refused (taken, not sent), nothing allocates;
+// the sender drops its own echoes by their source and counts each, the other member still gets them.
+TEST(UdpMulticast, BatchOfManyFramesArrivesInOrderAndEchoesAreDroppedAndCounted) {
+  UdpMulticastTransport a(options(test_port(7)));
+  UdpMulticastTransport b(options(test_port(7)));
+  a.open();
+  b.open();
+  constexpr std::size_t kFrames = 2 * kUdpBatch + 22;
+  std::vector<CanFrame> frames;
+  for (std::size_t i = 0; i < kFrames; ++i)
+    frames.push_back(make_frame(0x200 + static_cast<std::uint32_t>(i % 0x100), {static_cast<std::uint8_t>(i)}));
+  frames[kUdpBatch + 3].dlc = 9;  // cannot exist on a bus
+  SendBatchResult r;
+  {
+    test::AllocationScope scope;
+    r = a.send_batch(frames, now());
+    EXPECT_EQ(scope.count(), 0U);
+  }
+  EXPECT_FALSE(r.busy);
+  EXPECT_EQ(r.taken, kFrames);
+  EXPECT_EQ(r.sent, kFrames - 1);
+  EXPECT_EQ(a.counters().tx_frames, kFrames - 1);
+  EXPECT_EQ(a.counters().tx_overflows, 0U);
+
+  const auto got = receive_n(b, kFrames - 1);
+  ASSERT_EQ(got.size(), kFrames - 1);
+  for (std::size_t i = 0, j = 0; i < kFrames; ++i) {
+    if (i == kUdpBatch + 3) continue;
+    EXPECT_EQ(got[j].id, frames[i].id) << i;
+    EXPECT_EQ(got[j].data[0], frames[i].data[0]) << i;
+    ++j;
+  }
+  // The sender reads its echoes only to drop them.
+  std::array<CanFrame, 16> buf{};
+  const auto deadline = Clock::now() + 5s;
+  std::size_t own = 0;
+  while (a.counters().rx_filtered < kFrames - 1 && Clock::now() < deadline) {
+    pollfd p{a.wait_fd(), POLLIN, 0};
+    ::poll(&p, 1, 100);
+    own += a.receive(buf, now());
+  }
+  EXPECT_EQ(own, 0U);
+  EXPECT_EQ(a.counters().rx_filtered, kFrames - 1);
+  EXPECT_EQ(a.counters().rx_frames, 0U);
+  EXPECT_EQ(b.counters().rx_frames, kFrames - 1);
+  EXPECT_EQ(b.counters().rx_filtered, 0U);
+}
+
+// receive() reads no more datagrams than frames fit in its buffer: with more pending, the rest
+// waits for the next call, in order, none lost.
+TEST(UdpMulticast, ReceiveInBatchesNeverLosesWhatDoesNotFit) {
+  UdpMulticastTransport a(options(test_port(8)));
+  UdpMulticastTransport b(options(test_port(8)));
+  a.open();
+  b.open();
+  std::vector<CanFrame> frames;
+  for (std::uint8_t i = 0; i < 40; ++i) frames.push_back(make_frame(0x300, {i}));
+  ASSERT_EQ(a.send_batch(frames, now()).sent, frames.size());
+  std::vector<CanFrame> got;
+  std::array<CanFrame, 7> buf{};
+  const auto deadline = Clock::now() + 5s;
+  while (got.size() < frames.size() && Clock::now() < deadline) {
+    pollfd p{b.wait_fd(), POLLIN, 0};
+    ::poll(&p, 1, 100);
+    const auto n = b.receive(buf, now());
+    ASSERT_LE(n, buf.size());
+    got.insert(got.end(), buf.begin(), buf.begin() + static_cast<std::ptrdiff_t>(n));
+  }
+  ASSERT_EQ(got.size(), frames.size());
+  for (std::size_t i = 0; i < got.size(); ++i) EXPECT_EQ(got[i].data[0], i);
+}
+
 TEST(UdpMulticast, SendAndReceiveAllocateNothing) {
   UdpMulticastTransport a(options(test_port(6)));
   UdpMulticastTransport b(options(test_port(6)));

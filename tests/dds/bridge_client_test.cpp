@@ -7,6 +7,7 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <thread>
 
 #include <fastdds/dds/core/status/PublicationMatchedStatus.hpp>
 #include <fastdds/dds/core/status/SubscriptionMatchedStatus.hpp>
@@ -549,6 +550,42 @@ TEST(DdsBridge, SetpointsAndEventsFlow) {
   EXPECT_EQ(fault->axis, "x");
   EXPECT_EQ(fault->gateway, "gw1");
   EXPECT_EQ(fault->text, "overcurrent \"phase U\"");
+}
+
+// The bridge does not poll: idle, it wakes for its publications (here 2 states and 1 bus status a
+// second) and nothing else; the old loop came back every 5 ms, 200 times a second. An event the
+// Runtime queues wakes it at once, long before its next publication is due.
+TEST(DdsBridge, IdleBridgeSleepsUntilWorkOrAPublicationIsDue) {
+  FakeRuntime rt("gw1", {"x"});
+  daemon::DdsBridge bridge(rt, bridge_options(2));
+  bridge.start();
+  Client c(client_options());
+  ASSERT_TRUE(c.wait_until([&] { return has_axes(c, 1) && c.state("x").has_value(); }, kTimeout)) << seen(c);
+
+  const auto w0 = bridge.stats().wakeups;
+  const auto t0 = SteadyClock::now();
+  std::this_thread::sleep_for(std::chrono::seconds(2));  // the window observed, not a synchronisation
+  const double seconds = std::chrono::duration<double>(SteadyClock::now() - t0).count();
+  const auto wakeups = bridge.stats().wakeups - w0;
+  EXPECT_LE(static_cast<double>(wakeups), 10 * seconds) << wakeups << " wake-ups in " << seconds << " s";
+
+  // With a 5 s publication period only the Runtime's signal can bring the event out within 2.5 s.
+  FakeRuntime slow_rt("gw2", {"y"});
+  daemon::DdsBridge slow(slow_rt, bridge_options(0.2));
+  slow.start();
+  ASSERT_TRUE(c.wait_until([&] { return has_axes(c, 2); }, kTimeout)) << seen(c);
+  std::uint64_t cursor = 0;
+  (void)c.events_since(cursor);
+  slow_rt.push_event(0, core::EventKind::Warning, "woken");
+  const auto pushed = SteadyClock::now();
+  bool arrived = false;
+  ASSERT_TRUE(c.wait_until(
+      [&] {
+        for (auto& e : c.events_since(cursor)) arrived = arrived || e.text == "woken";
+        return arrived;
+      },
+      kTimeout));
+  EXPECT_LT(SteadyClock::now() - pushed, std::chrono::milliseconds(2500));
 }
 
 }  // namespace

@@ -34,6 +34,7 @@ bool FakeRuntime::submit_command(std::size_t axis_id, const core::Command& cmd) 
     r.reply.reason.assign("target reached");
     pending_.replies.push_back(r);
   }
+  signal_.notify();
   return true;
 }
 
@@ -98,6 +99,7 @@ bool FakeRuntime::submit_parameter(std::size_t axis_id, const core::ParamRequest
     r.error.assign("object does not exist in the object dictionary");
   }
   pending_.param_replies.push_back({axis_id, r});
+  signal_.notify();
   return true;
 }
 
@@ -156,6 +158,7 @@ void FakeRuntime::push_event(std::size_t axis_id, core::EventKind kind, std::str
   e.event.kind = kind;
   e.event.text.assign(text);
   pending_.events.push_back(e);
+  signal_.notify();
 }
 
 std::vector<FakeRuntime::Received> FakeRuntime::commands() const {

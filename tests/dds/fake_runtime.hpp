@@ -27,6 +27,7 @@ class FakeRuntime final : public daemon::Runtime {
   [[nodiscard]] std::size_t bus_count() const noexcept override { return 1; }
   [[nodiscard]] daemon::BusStatus bus_status(std::size_t bus) const override;
   void drain(daemon::Outbox& out) override;
+  [[nodiscard]] daemon::WakeSignal& output_signal() noexcept override { return signal_; }
 
   // Test controls and observations.
   void set_busy(bool busy);
@@ -62,6 +63,7 @@ class FakeRuntime final : public daemon::Runtime {
   };
   std::map<std::tuple<std::size_t, std::uint16_t, std::uint8_t>, Object> objects_;
   daemon::Outbox pending_;
+  daemon::WakeSignal signal_;  // notified whenever pending_ grows, as the gateway's cycle threads do
 };
 
 }  // namespace drivegate::dds_test

@@ -7,6 +7,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <system_error>
@@ -107,7 +108,17 @@ core::TimePoint reception_time(core::TimePoint now, const timespec& realtime_now
   return age > 0 ? now - core::Duration(age) : now;
 }
 
-SocketCanTransport::SocketCanTransport(SocketCanOptions options) : options_(std::move(options)) {}
+SocketCanTransport::SocketCanTransport(SocketCanOptions options) : options_(std::move(options)) {
+  // The message headers point into this object's own buffers for its whole life.
+  for (std::size_t i = 0; i < kCanBatch; ++i) {
+    rx_iov_[i] = iovec{&rx_frames_[i], sizeof(can_frame)};
+    rx_msgs_[i].msg_hdr.msg_iov = &rx_iov_[i];
+    rx_msgs_[i].msg_hdr.msg_iovlen = 1;
+    tx_iov_[i] = iovec{&tx_frames_[i], sizeof(can_frame)};
+    tx_msgs_[i].msg_hdr.msg_iov = &tx_iov_[i];
+    tx_msgs_[i].msg_hdr.msg_iovlen = 1;
+  }
+}
 
 SocketCanTransport::~SocketCanTransport() { close(); }
 
@@ -183,62 +194,98 @@ std::size_t SocketCanTransport::receive(std::span<CanFrame> out, core::TimePoint
   bool have_realtime = false;
   timespec realtime{};
   while (n < out.size()) {
-    can_frame k{};
-    iovec io{&k, sizeof k};
-    msghdr msg{};
-    msg.msg_iov = &io;
-    msg.msg_iovlen = 1;
-    msg.msg_control = control_.data();
-    msg.msg_controllen = kernel_stamps_ ? control_.size() : 0;
-    const auto got = ::recvmsg(fd_, &msg, MSG_DONTWAIT);
+    // No more messages than frames still fit in `out`: every one of them may be a frame.
+    const std::size_t want = std::min(out.size() - n, kCanBatch);
+    for (std::size_t i = 0; i < want; ++i) {
+      rx_msgs_[i].msg_hdr.msg_control = rx_control_[i].bytes.data();
+      rx_msgs_[i].msg_hdr.msg_controllen = kernel_stamps_ ? rx_control_[i].bytes.size() : 0;
+    }
+    const int got = ::recvmmsg(fd_, rx_msgs_.data(), static_cast<unsigned>(want), MSG_DONTWAIT, nullptr);
     if (got < 0) {
       if (errno == EINTR) continue;
       break;  // EAGAIN: nothing more; ENETDOWN and the like show as error frames or on send()
     }
-    if (static_cast<std::size_t>(got) != sizeof k) {  // CAN FD frames are not enabled on this socket
-      counters_.rx_malformed.add();
-      continue;
-    }
-    if ((k.can_id & CAN_ERR_FLAG) != 0) {
-      controller_.report(decode_error_frame(k.can_id & CAN_ERR_MASK, {k.data, sizeof k.data}), counters_);
-      continue;
-    }
-    CanFrame& f = out[n];
-    if (!from_linux_frame(k, f)) {
-      counters_.rx_malformed.add();
-      continue;
-    }
-    f.timestamp = now;
-    for (cmsghdr* c = CMSG_FIRSTHDR(&msg); c != nullptr; c = CMSG_NXTHDR(&msg, c)) {
-      if (c->cmsg_level != SOL_SOCKET || c->cmsg_type != SCM_TIMESTAMPNS) continue;
-      timespec stamp{};
-      std::memcpy(&stamp, CMSG_DATA(c), sizeof stamp);
-      if (!have_realtime) {  // one clock read per call, and only when a stamp needs it
-        ::clock_gettime(CLOCK_REALTIME, &realtime);
-        have_realtime = true;
+    const auto count = static_cast<std::size_t>(got);
+    for (std::size_t i = 0; i < count; ++i) {
+      const can_frame& k = rx_frames_[i];
+      msghdr& msg = rx_msgs_[i].msg_hdr;
+      if (rx_msgs_[i].msg_len != sizeof k) {  // CAN FD frames are not enabled on this socket
+        counters_.rx_malformed.add();
+        continue;
       }
-      f.timestamp = reception_time(now, realtime, stamp);
+      if ((k.can_id & CAN_ERR_FLAG) != 0) {
+        controller_.report(decode_error_frame(k.can_id & CAN_ERR_MASK, {k.data, sizeof k.data}), counters_);
+        continue;
+      }
+      CanFrame& f = out[n];
+      if (!from_linux_frame(k, f)) {
+        counters_.rx_malformed.add();
+        continue;
+      }
+      f.timestamp = now;
+      for (cmsghdr* c = CMSG_FIRSTHDR(&msg); c != nullptr; c = CMSG_NXTHDR(&msg, c)) {
+        if (c->cmsg_level != SOL_SOCKET || c->cmsg_type != SCM_TIMESTAMPNS) continue;
+        timespec stamp{};
+        std::memcpy(&stamp, CMSG_DATA(c), sizeof stamp);
+        if (!have_realtime) {  // one clock read per call, and only when a stamp needs it
+          ::clock_gettime(CLOCK_REALTIME, &realtime);
+          have_realtime = true;
+        }
+        f.timestamp = reception_time(now, realtime, stamp);
+      }
+      ++n;
+      counters_.rx_frames.add();
     }
-    ++n;
-    counters_.rx_frames.add();
+    if (count < want) break;  // nothing more pending
   }
   return n;
 }
 
-SendResult SocketCanTransport::send(const CanFrame& frame, core::TimePoint /*now*/) noexcept {
+SendResult SocketCanTransport::send(const CanFrame& frame, core::TimePoint now) noexcept {
   if (fd_ < 0 || controller_.state() == ControllerState::BusOff) return SendResult::Down;
   if (!frame.valid()) return SendResult::Invalid;
-  const can_frame k = to_linux_frame(frame);
-  if (::send(fd_, &k, sizeof k, MSG_DONTWAIT) < 0) {
-    // ENOBUFS: the interface's transmit queue is full (SocketCAN reports that, not EAGAIN).
-    if (errno == EAGAIN || errno == EWOULDBLOCK || errno == ENOBUFS) {
-      counters_.tx_overflows.add();
-      return SendResult::Busy;
-    }
-    return SendResult::Down;  // ENETDOWN: interface down
+  const auto r = send_batch({&frame, 1}, now);
+  return r.busy ? SendResult::Busy : r.sent == 1 ? SendResult::Sent : SendResult::Down;
+}
+
+SendBatchResult SocketCanTransport::send_batch(std::span<const CanFrame> frames, core::TimePoint /*now*/) noexcept {
+  SendBatchResult r;
+  // Down for every frame while bus-off: the kernel would refuse or queue them anyway.
+  if (fd_ < 0 || controller_.state() == ControllerState::BusOff) {
+    r.taken = frames.size();
+    return r;
   }
-  counters_.tx_frames.add();
-  return SendResult::Sent;
+  while (r.taken < frames.size()) {
+    // The next batch; an invalid frame is refused here and never reaches the socket.
+    std::size_t count = 0;
+    std::size_t next = r.taken;
+    for (; next < frames.size() && count < kCanBatch; ++next) {
+      if (!frames[next].valid()) continue;
+      tx_frames_[count] = to_linux_frame(frames[next]);
+      tx_frame_of_[count] = next;
+      ++count;
+    }
+    for (std::size_t done = 0; done < count;) {
+      const int sent = ::sendmmsg(fd_, tx_msgs_.data() + done, static_cast<unsigned>(count - done), MSG_DONTWAIT);
+      if (sent > 0) {
+        done += static_cast<std::size_t>(sent);
+        r.sent += static_cast<std::size_t>(sent);
+        counters_.tx_frames.add(static_cast<std::uint64_t>(sent));
+        continue;
+      }
+      if (errno == EINTR) continue;
+      // ENOBUFS: the interface's transmit queue is full (SocketCAN reports that, not EAGAIN).
+      if (errno == EAGAIN || errno == EWOULDBLOCK || errno == ENOBUFS) {
+        counters_.tx_overflows.add();
+        r.taken = tx_frame_of_[done];
+        r.busy = true;
+        return r;
+      }
+      ++done;  // ENETDOWN, interface down: this frame is refused (Down)
+    }
+    r.taken = next;
+  }
+  return r;
 }
 
 std::string SocketCanTransport::describe() const {

@@ -5,9 +5,13 @@
 // detection and recovery to the master's own controller), own frames not looped back, all I/O
 // non-blocking. The interface's bit rate and restart-ms are set outside, with `ip link`.
 //
+// I/O is batched: receive() reads what is pending with recvmmsg (up to kCanBatch frames a call),
+// send_batch() writes up to kCanBatch frames with one sendmmsg.
+//
 // The pieces that do not need a CAN socket (filters, frame mapping, error frame decoding, time
 // stamps) are pure functions, so they are tested where the kernel has no CAN support.
 #include <linux/can.h>
+#include <sys/socket.h>
 #include <time.h>
 
 #include <array>
@@ -29,6 +33,9 @@ struct CanIdFilter {
   std::uint32_t mask = kMaxStandardId;
   bool extended = false;
 };
+
+// Frames per recvmmsg / sendmmsg call.
+inline constexpr std::size_t kCanBatch = 64;
 
 struct SocketCanOptions {
   std::string interface = "can0";
@@ -70,6 +77,7 @@ class SocketCanTransport final : public Transport {
   std::size_t receive(std::span<CanFrame> out, core::TimePoint now) noexcept override;
   // Down while the controller is bus-off: the kernel would refuse or queue the frame anyway.
   SendResult send(const CanFrame& frame, core::TimePoint now) noexcept override;
+  SendBatchResult send_batch(std::span<const CanFrame> frames, core::TimePoint now) noexcept override;
 
   [[nodiscard]] ControllerState controller_state() const noexcept override { return controller_.state(); }
   [[nodiscard]] TransportCounters counters() const noexcept override { return counters_.snapshot(); }
@@ -82,8 +90,19 @@ class SocketCanTransport final : public Transport {
   bool kernel_stamps_ = false;  // SO_TIMESTAMPNS accepted
   CounterCells counters_;
   ControllerTracker controller_;
-  // Room for one SCM_TIMESTAMPNS control message (CMSG_SPACE(sizeof(timespec)) on 64-bit Linux).
-  alignas(8) std::array<unsigned char, 64> control_{};
+  // Per message of a batch: the kernel's frame and room for one SCM_TIMESTAMPNS control message
+  // (CMSG_SPACE(sizeof(timespec)) on 64-bit Linux).
+  struct alignas(8) Control {
+    std::array<unsigned char, 64> bytes{};
+  };
+  std::array<can_frame, kCanBatch> rx_frames_{};
+  std::array<Control, kCanBatch> rx_control_{};
+  std::array<iovec, kCanBatch> rx_iov_{};
+  std::array<mmsghdr, kCanBatch> rx_msgs_{};
+  std::array<can_frame, kCanBatch> tx_frames_{};
+  std::array<iovec, kCanBatch> tx_iov_{};
+  std::array<mmsghdr, kCanBatch> tx_msgs_{};
+  std::array<std::size_t, kCanBatch> tx_frame_of_{};  // the frame (index into the batch) of each message
 };
 
 }  // namespace drivegate::canopen

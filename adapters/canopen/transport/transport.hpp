@@ -3,7 +3,8 @@
 // frames (DESIGN.md §2 rule 5). Implementations: SocketCAN (production), UDP multicast (a virtual
 // bus shared by processes, python-can compatible) and the in-process bus (tests, benchmarks).
 //
-// send() and receive() are the cyclic path: non-blocking, no allocation, no lock, no logging.
+// send(), send_batch() and receive() are the cyclic path: non-blocking, no allocation, no lock, no
+// logging.
 // open() may allocate and throws TransportError with one line a person can act on.
 #include <cstdint>
 #include <span>
@@ -29,6 +30,16 @@ enum class SendResult : std::uint8_t {
   Busy,     // transmit queue full; try again later (counted as tx_overflows)
   Invalid,  // frame cannot exist on the bus (dlc > 8, id too large)
   Down,     // transport not open, or the controller is bus-off
+};
+
+// What send_batch() did with its frames, front first: `taken` frames were handled (sent, or refused
+// for good as send() would return Invalid or Down), `sent` of them went out. With `busy` the frame
+// at `taken` met a full transmit queue (counted once in tx_overflows) and neither it nor the ones
+// after it were sent; otherwise taken is the number of frames given.
+struct SendBatchResult {
+  std::size_t taken = 0;
+  std::size_t sent = 0;
+  bool busy = false;
 };
 
 struct TransportCounters {
@@ -57,6 +68,22 @@ class Transport {
   virtual std::size_t receive(std::span<CanFrame> out, core::TimePoint now) noexcept = 0;
   // Non-blocking send of one frame.
   virtual SendResult send(const CanFrame& frame, core::TimePoint now) noexcept = 0;
+  // Non-blocking send of frames in order, in as few system calls as the transport allows (SocketCAN
+  // and UDP multicast: one sendmmsg per batch); the result and the counters are what send() per
+  // frame, stopping at the first Busy, would give. This default does exactly that.
+  virtual SendBatchResult send_batch(std::span<const CanFrame> frames, core::TimePoint now) noexcept {
+    SendBatchResult r;
+    for (const CanFrame& f : frames) {
+      const SendResult s = send(f, now);
+      if (s == SendResult::Busy) {
+        r.busy = true;
+        break;
+      }
+      ++r.taken;
+      if (s == SendResult::Sent) ++r.sent;
+    }
+    return r;
+  }
 
   [[nodiscard]] virtual ControllerState controller_state() const noexcept = 0;
   // Safe to call from any thread (relaxed atomics inside).

@@ -4,6 +4,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <system_error>
 #include <utility>
@@ -43,7 +44,19 @@ sockaddr* as_sockaddr(sockaddr_in& a) noexcept { return reinterpret_cast<sockadd
 
 }  // namespace
 
-UdpMulticastTransport::UdpMulticastTransport(UdpMulticastOptions options) : options_(std::move(options)) {}
+UdpMulticastTransport::UdpMulticastTransport(UdpMulticastOptions options) : options_(std::move(options)) {
+  // The message headers point into this object's own buffers for its whole life.
+  for (std::size_t i = 0; i < kUdpBatch; ++i) {
+    rx_iov_[i] = iovec{rx_buffers_[i].data(), rx_buffers_[i].size()};
+    rx_msgs_[i].msg_hdr.msg_iov = &rx_iov_[i];
+    rx_msgs_[i].msg_hdr.msg_iovlen = 1;
+    tx_iov_[i] = iovec{tx_buffers_[i].data(), 0};
+    tx_msgs_[i].msg_hdr.msg_name = &destination_;
+    tx_msgs_[i].msg_hdr.msg_namelen = sizeof destination_;
+    tx_msgs_[i].msg_hdr.msg_iov = &tx_iov_[i];
+    tx_msgs_[i].msg_hdr.msg_iovlen = 1;
+  }
+}
 
 UdpMulticastTransport::~UdpMulticastTransport() { close(); }
 
@@ -120,40 +133,49 @@ void UdpMulticastTransport::close() noexcept {
 std::size_t UdpMulticastTransport::receive(std::span<CanFrame> out, core::TimePoint now) noexcept {
   if (rx_fd_ < 0) return 0;
   std::size_t n = 0;
-  std::size_t budget = out.size() + kDiscardBudget;
+  std::size_t budget = out.size() + kDiscardBudget;  // datagrams this call may read
   while (n < out.size() && budget > 0) {
-    --budget;
-    sockaddr_in from{};
-    socklen_t from_len = sizeof from;
-    // MSG_TRUNC: the datagram's real length, so that one longer than the buffer is not decoded cut.
-    const auto got = ::recvfrom(rx_fd_, rx_buffer_.data(), rx_buffer_.size(), MSG_DONTWAIT | MSG_TRUNC,
-                                as_sockaddr(from), &from_len);
+    // No more datagrams than frames still fit in `out`: every one of them may be a frame.
+    const std::size_t want = std::min({out.size() - n, budget, kUdpBatch});
+    for (std::size_t i = 0; i < want; ++i) {
+      rx_msgs_[i].msg_hdr.msg_name = &rx_sources_[i];
+      rx_msgs_[i].msg_hdr.msg_namelen = sizeof rx_sources_[i];
+    }
+    // MSG_TRUNC: each datagram's real length, so that one longer than its buffer is not decoded cut.
+    const int got = ::recvmmsg(rx_fd_, rx_msgs_.data(), static_cast<unsigned>(want), MSG_DONTWAIT | MSG_TRUNC, nullptr);
     if (got < 0) {
       if (errno == EINTR) continue;
       break;  // EAGAIN: nothing more; anything else is retried on the next call
     }
-    if (from.sin_port == own_source_.sin_port && from.sin_addr.s_addr == own_source_.sin_addr.s_addr) {
-      counters_.rx_filtered.add();
-      continue;
+    const auto count = static_cast<std::size_t>(got);
+    budget -= count;
+    for (std::size_t i = 0; i < count; ++i) {
+      // Our own echo, known by its source before anything is decoded.
+      const sockaddr_in& from = rx_sources_[i];
+      if (from.sin_port == own_source_.sin_port && from.sin_addr.s_addr == own_source_.sin_addr.s_addr) {
+        counters_.rx_filtered.add();
+        continue;
+      }
+      const std::size_t size = rx_msgs_[i].msg_len;
+      if (size > kRxDatagramMax || (rx_msgs_[i].msg_hdr.msg_flags & MSG_TRUNC) != 0) {
+        counters_.rx_malformed.add();
+        continue;
+      }
+      const auto d = decode_msgpack_frame({rx_buffers_[i].data(), size});
+      if (d.error != MsgpackFrameError::None) {
+        counters_.rx_malformed.add();
+        continue;
+      }
+      if (d.error_frame) {  // a peer's controller report; there is no controller here to change
+        counters_.error_frames.add();
+        continue;
+      }
+      out[n] = d.frame;
+      out[n].timestamp = now;
+      ++n;
+      counters_.rx_frames.add();
     }
-    const auto size = static_cast<std::size_t>(got);
-    if (size > rx_buffer_.size()) {
-      counters_.rx_malformed.add();
-      continue;
-    }
-    const auto d = decode_msgpack_frame({rx_buffer_.data(), size});
-    if (d.error != MsgpackFrameError::None) {
-      counters_.rx_malformed.add();
-      continue;
-    }
-    if (d.error_frame) {  // a peer's controller report; there is no controller here to change
-      counters_.error_frames.add();
-      continue;
-    }
-    out[n] = d.frame;
-    out[n].timestamp = now;
-    ++n;
-    counters_.rx_frames.add();
+    if (count < want) break;  // nothing more pending
   }
   return n;
 }
@@ -161,20 +183,48 @@ std::size_t UdpMulticastTransport::receive(std::span<CanFrame> out, core::TimePo
 SendResult UdpMulticastTransport::send(const CanFrame& frame, core::TimePoint now) noexcept {
   if (tx_fd_ < 0) return SendResult::Down;
   if (!frame.valid()) return SendResult::Invalid;
+  const auto r = send_batch({&frame, 1}, now);
+  return r.busy ? SendResult::Busy : r.sent == 1 ? SendResult::Sent : SendResult::Down;
+}
+
+SendBatchResult UdpMulticastTransport::send_batch(std::span<const CanFrame> frames, core::TimePoint now) noexcept {
+  SendBatchResult r;
+  if (tx_fd_ < 0) {  // every frame Down
+    r.taken = frames.size();
+    return r;
+  }
   // Receivers replace the timestamp with their reception time; ours is for captures only.
   const double seconds = static_cast<double>(core::to_ns(now)) * 1e-9;
-  const auto len = encode_msgpack_frame(frame, seconds, tx_buffer_);
-  const auto sent = ::sendto(tx_fd_, tx_buffer_.data(), len, MSG_DONTWAIT,
-                             reinterpret_cast<const sockaddr*>(&destination_), sizeof destination_);
-  if (sent < 0) {
-    if (errno == EAGAIN || errno == EWOULDBLOCK || errno == ENOBUFS) {
-      counters_.tx_overflows.add();
-      return SendResult::Busy;
+  while (r.taken < frames.size()) {
+    // Encode the next batch; an invalid frame is refused here and never reaches the socket.
+    std::size_t count = 0;
+    std::size_t next = r.taken;
+    for (; next < frames.size() && count < kUdpBatch; ++next) {
+      if (!frames[next].valid()) continue;
+      tx_iov_[count].iov_len = encode_msgpack_frame(frames[next], seconds, tx_buffers_[count]);
+      tx_frame_of_[count] = next;
+      ++count;
     }
-    return SendResult::Down;  // ENETUNREACH, interface gone: not something retrying now fixes
+    for (std::size_t done = 0; done < count;) {
+      const int sent = ::sendmmsg(tx_fd_, tx_msgs_.data() + done, static_cast<unsigned>(count - done), MSG_DONTWAIT);
+      if (sent > 0) {
+        done += static_cast<std::size_t>(sent);
+        r.sent += static_cast<std::size_t>(sent);
+        counters_.tx_frames.add(static_cast<std::uint64_t>(sent));
+        continue;
+      }
+      if (errno == EINTR) continue;
+      if (errno == EAGAIN || errno == EWOULDBLOCK || errno == ENOBUFS) {
+        counters_.tx_overflows.add();
+        r.taken = tx_frame_of_[done];
+        r.busy = true;
+        return r;
+      }
+      ++done;  // ENETUNREACH, interface gone: this frame is refused (Down); retrying now fixes nothing
+    }
+    r.taken = next;
   }
-  counters_.tx_frames.add();
-  return SendResult::Sent;
+  return r;
 }
 
 std::string UdpMulticastTransport::describe() const {

@@ -9,6 +9,10 @@
 // (the send socket's address and port) and dropped. There is no arbitration, no bus-off and no
 // error state: controller_state() is always Active.
 //
+// I/O is batched: receive() reads what is pending with recvmmsg, up to kUdpBatch datagrams a call,
+// and send_batch() writes up to kUdpBatch frames with one sendmmsg. An echo is recognised from the
+// datagram's source address alone, before any decoding.
+//
 // Reception time stamps are the `now` passed to receive(): the kernel's SO_TIMESTAMPNS would be
 // on CLOCK_REALTIME, not on the monotonic/virtual line frames are compared against.
 #include <array>
@@ -16,12 +20,16 @@
 #include <string>
 
 #include <netinet/in.h>
+#include <sys/socket.h>
 
 #include "adapters/canopen/transport/counter_cells.hpp"
 #include "adapters/canopen/transport/msgpack_frame.hpp"
 #include "adapters/canopen/transport/transport.hpp"
 
 namespace drivegate::canopen {
+
+// Datagrams per recvmmsg / sendmmsg call.
+inline constexpr std::size_t kUdpBatch = 64;
 
 struct UdpMulticastOptions {
   std::string group = "239.74.163.2";  // python-can's default IPv4 group
@@ -44,6 +52,7 @@ class UdpMulticastTransport final : public Transport {
 
   std::size_t receive(std::span<CanFrame> out, core::TimePoint now) noexcept override;
   SendResult send(const CanFrame& frame, core::TimePoint now) noexcept override;
+  SendBatchResult send_batch(std::span<const CanFrame> frames, core::TimePoint now) noexcept override;
 
   [[nodiscard]] ControllerState controller_state() const noexcept override { return ControllerState::Active; }
   [[nodiscard]] TransportCounters counters() const noexcept override { return counters_.snapshot(); }
@@ -58,8 +67,15 @@ class UdpMulticastTransport final : public Transport {
   sockaddr_in own_source_{};   // the send socket's address, to recognise our echoes
   CounterCells counters_;
   // python-can reads up to 4096 bytes per datagram; a longer one is malformed for us too.
-  std::array<std::uint8_t, 4096> rx_buffer_{};
-  std::array<std::uint8_t, kMsgpackFrameMaxSize> tx_buffer_{};
+  static constexpr std::size_t kRxDatagramMax = 4096;
+  std::array<std::array<std::uint8_t, kRxDatagramMax>, kUdpBatch> rx_buffers_{};
+  std::array<sockaddr_in, kUdpBatch> rx_sources_{};
+  std::array<iovec, kUdpBatch> rx_iov_{};
+  std::array<mmsghdr, kUdpBatch> rx_msgs_{};
+  std::array<std::array<std::uint8_t, kMsgpackFrameMaxSize>, kUdpBatch> tx_buffers_{};
+  std::array<iovec, kUdpBatch> tx_iov_{};
+  std::array<mmsghdr, kUdpBatch> tx_msgs_{};
+  std::array<std::size_t, kUdpBatch> tx_frame_of_{};  // the frame (index into the batch) of each message
 };
 
 }  // namespace drivegate::canopen

@@ -1,0 +1,279 @@
+// CPU of the whole drivegated process and of each of its threads with six simulated generic CiA 402
+// drives on a udp-multicast bus (4 ms SYNC, loopback), drivegate-sim in a second process: the
+// configuration of the daemon's CPU budget. Two phases of --seconds each: (a) the axes enabled and
+// still, (b) six DDS clients (one per axis, each its own participant) jogging the axes as
+// `drivegatectl velocity` does: a velocity command, then a set-point every 50 ms.
+//
+//   bench_daemon_cpu [--seconds N]   (default 10 per phase)
+//
+// CPU is utime + stime from /proc/PID/stat and /proc/PID/task/TID/stat over wall time, in % of one
+// core; threads are grouped by name (comm). The reference line per phase is what the rest of the
+// machine did meanwhile (other processes' share of both cores) and the thread CPU time of a fixed
+// loop: a slower loop or a busier machine means the figures of that phase read high.
+#include <dirent.h>
+#include <signal.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "client/client.hpp"
+#include "tests/canopen_e2e/sim_process.hpp"
+#include "tests/daemon/daemon_process.hpp"
+
+using namespace drivegate;
+using namespace std::chrono_literals;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+constexpr int kAxes = 6;
+constexpr auto kCycle = 4ms;
+constexpr auto kKeepAlivePeriod = 50ms;  // drivegatectl's (client/drivegatectl.cpp)
+constexpr double kJogVelocity = 2;       // rev/s (10000 counts per revolution)
+
+// Clock ticks of utime + stime in a /proc stat line; the name between the parentheses to `name`.
+unsigned long long stat_ticks(const std::string& path, std::string* name = nullptr) {
+  std::ifstream in(path);
+  std::string text;
+  std::getline(in, text);
+  const auto open = text.find('(');
+  const auto close = text.rfind(')');
+  if (open == std::string::npos || close == std::string::npos) return 0;
+  if (name != nullptr) *name = text.substr(open + 1, close - open - 1);
+  std::istringstream rest(text.substr(close + 2));
+  std::string field;
+  unsigned long long utime = 0, stime = 0;
+  for (int i = 3; i <= 15 && rest >> field; ++i) {
+    if (i == 14) utime = std::stoull(field);
+    if (i == 15) stime = std::stoull(field);
+  }
+  return utime + stime;
+}
+
+// A process' CPU ticks, in total and per thread (by thread id, with its name).
+struct Sample {
+  unsigned long long process = 0;
+  std::map<int, std::pair<std::string, unsigned long long>> threads;
+};
+
+Sample sample(pid_t pid) {
+  Sample s;
+  const std::string dir = "/proc/" + std::to_string(pid);
+  s.process = stat_ticks(dir + "/stat");
+  for (const auto& e : std::filesystem::directory_iterator(dir + "/task")) {
+    std::string name;
+    const auto ticks = stat_ticks(e.path().string() + "/stat", &name);
+    s.threads[std::stoi(e.path().filename().string())] = {name, ticks};
+  }
+  return s;
+}
+
+// Busy and total jiffies of the whole machine (/proc/stat "cpu" line).
+std::pair<unsigned long long, unsigned long long> machine_ticks() {
+  std::ifstream in("/proc/stat");
+  std::string cpu;
+  in >> cpu;
+  unsigned long long v[8] = {};
+  for (auto& x : v) in >> x;
+  unsigned long long total = 0;
+  for (auto x : v) total += x;
+  return {total - v[3] - v[4], total};  // idle, iowait
+}
+
+// Thread CPU time of a fixed amount of arithmetic, in ms.
+double reference_loop_ms() {
+  timespec a{}, b{};
+  ::clock_gettime(CLOCK_THREAD_CPUTIME_ID, &a);
+  volatile std::uint64_t x = 1;
+  for (int i = 0; i < 20'000'000; ++i) x = x * 6364136223846793005ULL + 1442695040888963407ULL;
+  ::clock_gettime(CLOCK_THREAD_CPUTIME_ID, &b);
+  return static_cast<double>(b.tv_sec - a.tv_sec) * 1e3 + static_cast<double>(b.tv_nsec - a.tv_nsec) / 1e6;
+}
+
+struct Usage {
+  double process_pct = 0;
+  std::map<std::string, std::pair<int, double>> threads;  // name -> (count, % of a core)
+};
+
+Usage usage(const Sample& a, const Sample& b, double seconds) {
+  const double hz = static_cast<double>(::sysconf(_SC_CLK_TCK));
+  const auto pct = [&](unsigned long long ticks) { return 100.0 * static_cast<double>(ticks) / hz / seconds; };
+  Usage u;
+  u.process_pct = pct(b.process - a.process);
+  for (const auto& [tid, t] : b.threads) {
+    const auto before = a.threads.find(tid);
+    const unsigned long long start = before == a.threads.end() ? 0 : before->second.second;
+    auto& slot = u.threads[t.first];
+    ++slot.first;
+    slot.second += pct(t.second - start);
+  }
+  return u;
+}
+
+void print_usage(const char* who, const Usage& u, double seconds) {
+  std::printf("  %-12s process %6.2f %% of a core\n", who, u.process_pct);
+  std::vector<std::pair<std::string, std::pair<int, double>>> rows(u.threads.begin(), u.threads.end());
+  std::sort(rows.begin(), rows.end(), [](const auto& x, const auto& y) { return x.second.second > y.second.second; });
+  for (const auto& [name, v] : rows) {
+    if (v.second < 0.005) continue;
+    std::printf("    %-16s x%-2d %6.2f %%", name.c_str(), v.first, v.second);
+    if (name.rfind("dg-cycle-", 0) == 0) {
+      const double cycles = seconds / std::chrono::duration<double>(kCycle).count();
+      std::printf("   %.1f us per cycle", v.second / 100.0 * seconds / cycles * 1e6);
+    }
+    std::printf("\n");
+  }
+}
+
+std::string config_text(const test::DdsIsolation& dds, const std::string& group, std::uint16_t port) {
+  std::ostringstream y;
+  y << "gateway: { name: bench, dds: { domain: " << dds.domain << ", namespace: " << dds.ns << " } }\n"
+    << "buses:\n"
+    << "  - name: can0\n"
+    << "    type: canopen\n"
+    << "    cycle_time: 4ms\n"
+    << "    options: { transport: udp-multicast, interface: 127.0.0.1, group: " << group << ", port: " << port
+    << ", bitrate: 1000000 }\n"
+    << "axes:\n";
+  for (int i = 1; i <= kAxes; ++i) {
+    y << "  - { name: a" << i << ", bus: can0, address: " << i
+      << ", device: generic-cia402, mechanics: { encoder_counts_per_rev: 10000 } }\n";
+  }
+  return y.str();
+}
+
+int fail(const std::string& what) {
+  std::fprintf(stderr, "bench_daemon_cpu: %s\n", what.c_str());
+  return 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  double seconds = 10;
+  for (int i = 1; i + 1 < argc; ++i)
+    if (std::string(argv[i]) == "--seconds") seconds = std::max(1.0, std::atof(argv[i + 1]));
+
+  const auto dds = test::unique_dds("bench_cpu");
+  // A group of this process, and a port between the RTPS port bands of the DDS domains 20..99 that
+  // test processes use (see tests/canopen_e2e/e2e_fixture.cpp).
+  const auto pid = static_cast<unsigned>(::getpid());
+  const std::string group = "239.202." + std::to_string((pid >> 8) & 0xFF) + "." + std::to_string(pid & 0xFF);
+  const auto port = static_cast<std::uint16_t>(7400 + 250 * (35 + pid % 15) + 120 + (pid / 15) % 120);
+  const auto config = test::write_config_text("bench-daemon-cpu", config_text(dds, group, port));
+
+  test::SimProcess sim(config);
+  if (!sim.wait_ready(20s)) return fail("drivegate-sim did not start:\n" + sim.log());
+  test::NotifySocket notify;
+  test::DaemonProcess daemon(config, notify.path(), "warn");
+  if (!notify.wait_for("READY=1", 30s)) return fail("drivegated did not start:\n" + daemon.log());
+
+  std::vector<std::unique_ptr<client::Client>> clients;
+  for (int i = 0; i < kAxes; ++i)
+    clients.push_back(std::make_unique<client::Client>(client::options_for(dds.domain, dds.ns, "bench-" + std::to_string(i))));
+  const auto axis = [](int i) { return "a" + std::to_string(i + 1); };
+  auto& c0 = *clients[0];
+  const bool up = c0.wait_until([&] {
+    for (int i = 0; i < kAxes; ++i) {
+      const auto s = c0.state(axis(i));
+      if (!s || s->link != "operational" || s->state != "switch_on_disabled") return false;
+    }
+    return true;
+  }, 60s);
+  if (!up) return fail("the axes did not come up\n" + daemon.log());
+  for (int i = 0; i < kAxes; ++i) {
+    client::CommandRequest en;
+    en.axis = axis(i);
+    en.kind = "enable";
+    const auto r = clients[static_cast<std::size_t>(i)]->send(en, true, 20s);
+    if (r.outcome != client::Outcome::Completed) return fail("enable " + axis(i) + ": " + r.reason);
+  }
+
+  std::printf("bench_daemon_cpu: drivegated and drivegate-sim, %d generic-cia402 drives on udp-multicast %s:%u "
+              "(loopback), SYNC every 4 ms; %.0f s per phase; %% of one core from /proc (utime + stime)\n",
+              kAxes, group.c_str(), port, seconds);
+  std::printf("drivegated pid %d, drivegate-sim pid %d (for top -H -p PID while it runs)\n", static_cast<int>(daemon.pid()),
+              static_cast<int>(sim.pid()));
+  std::fflush(stdout);
+  const auto measure = [&](const char* phase) {
+    const auto m0 = machine_ticks();
+    const auto d0 = sample(daemon.pid());
+    const auto s0 = sample(sim.pid());
+    const auto t0 = Clock::now();
+    std::this_thread::sleep_for(std::chrono::duration<double>(seconds));
+    const auto d1 = sample(daemon.pid());
+    const auto s1 = sample(sim.pid());
+    const auto m1 = machine_ticks();
+    const double wall = std::chrono::duration<double>(Clock::now() - t0).count();
+    const double ref = reference_loop_ms();
+    const auto du = usage(d0, d1, wall);
+    const auto su = usage(s0, s1, wall);
+    const double machine_pct = 100.0 * static_cast<double>(m1.first - m0.first) / static_cast<double>(m1.second - m0.second);
+    const double ours_pct = (du.process_pct + su.process_pct) / static_cast<double>(::sysconf(_SC_NPROCESSORS_ONLN));
+    std::printf("\n(%s) %.1f s\n", phase, wall);
+    print_usage("drivegated", du, wall);
+    print_usage("drivegate-sim", su, wall);
+    std::printf("  reference: machine busy %.1f %% of all cores (%.1f %% other than these two); fixed loop %.1f ms "
+                "thread CPU\n", machine_pct, machine_pct - ours_pct, ref);
+    std::fflush(stdout);
+  };
+
+  measure("a: axes enabled and still");
+
+  std::atomic<bool> stop{false};
+  std::atomic<int> errors{0};
+  std::vector<std::thread> joggers;
+  for (int i = 0; i < kAxes; ++i) {
+    joggers.emplace_back([&, i] {
+      auto& c = *clients[static_cast<std::size_t>(i)];
+      client::CommandRequest v;
+      v.axis = axis(i);
+      v.kind = "velocity";
+      v.velocity = (i % 2 == 0 ? 1 : -1) * kJogVelocity;
+      const auto started = c.send(v, false, 10s);
+      if (!started.ok()) {
+        std::fprintf(stderr, "bench_daemon_cpu: velocity %s: %s\n", v.axis.c_str(), started.reason.c_str());
+        ++errors;
+        return;
+      }
+      for (auto next = Clock::now(); !stop; next += kKeepAlivePeriod) {
+        if (!c.stream_setpoint(v.axis, started.gateway, 0, v.velocity, 0).empty()) ++errors;
+        std::this_thread::sleep_until(next + kKeepAlivePeriod);
+      }
+      client::CommandRequest s = v;
+      s.kind = "stop";
+      s.gateway = started.gateway;
+      if (!c.send(s, true, 10s).ok()) ++errors;
+    });
+  }
+  // The axes at speed before the window opens.
+  const bool moving = c0.wait_until([&] {
+    for (int i = 0; i < kAxes; ++i) {
+      const auto s = c0.state(axis(i));
+      if (!s || std::abs(s->velocity) < kJogVelocity / 2) return false;
+    }
+    return true;
+  }, 10s);
+  if (moving) measure("b: six clients jogging the axes");
+  stop = true;
+  for (auto& t : joggers) t.join();
+  if (!moving || errors > 0) return fail("the jog phase did not run as intended (axes at speed: " +
+                                         std::string(moving ? "yes" : "no") + ", errors " + std::to_string(errors) + ")");
+  clients.clear();
+  daemon.terminate(SIGTERM, 20s);
+  for (const char* suffix : {"", ".log", ".sim.log"}) std::filesystem::remove(config + suffix);
+  return 0;
+}
