@@ -314,8 +314,8 @@ constexpr Persona fixed_heartbeat() {
 }
 constexpr Persona kGenericFixedHeartbeat = fixed_heartbeat();
 
-constexpr std::array<const Persona*, 7> kAll{&kAkd,           &kNord,          &kSd6, &kGeneric, &kGenericNoHeartbeat,
-                                             &kGenericNoWatch, &kGenericFixedHeartbeat};
+constexpr std::array<const Persona*, 7> kAll{
+    &kAkd, &kNord, &kSd6, &kGeneric, &kGenericNoHeartbeat, &kGenericNoWatch, &kGenericFixedHeartbeat};
 
 }  // namespace
 
