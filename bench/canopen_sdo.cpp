@@ -175,7 +175,7 @@ class Run {
     collect(now, r);
     while (submitted_ < objects_ && client_.pending(0) < SdoClient::kQueueDepth) {
       const SdoRequestId id =
-          direction_ == Direction::Upload ? client_.read(0, kObject) : client_.write_bytes(0, kObject, data_);
+          direction_ == Direction::Upload ? client_.read(0, kObject) : client_.write_from(0, kObject, data_);
       ids_.push_back(id);
       ++submitted_;
     }

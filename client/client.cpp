@@ -96,7 +96,11 @@ class Client::Impl : public dds::DataReaderListener {
     state_r_ = &node_->reader(msg::TopicId::AxisState, nullptr, dds::StatusMask::none());
     event_r_ = &node_->reader(msg::TopicId::AxisEvent, nullptr, dds::StatusMask::none());
     bus_r_ = &node_->reader(msg::TopicId::BusStatus, nullptr, dds::StatusMask::none());
-    for (dds::DataReader* r : {info_r_, state_r_, event_r_, bus_r_}) {
+    // Permissions made before axis_link existed refuse its reader: then there are no link details.
+    std::string no_links;
+    link_r_ = optional_reader(msg::TopicId::AxisLink, no_links);
+    for (dds::DataReader* r : {info_r_, state_r_, event_r_, bus_r_, link_r_}) {
+      if (r == nullptr) continue;
       r->set_listener(this, dds::StatusMask::data_available());
       on_data_available(r);
     }
@@ -146,6 +150,7 @@ class Client::Impl : public dds::DataReaderListener {
     else if (reader == reply_r_) take_replies();
     else if (reader == event_r_) take_events();
     else if (reader == bus_r_) take_buses();
+    else if (reader == link_r_) take_links();
     else if (reader == param_r_) take_param_replies();
     {
       std::lock_guard lock(mutex_);
@@ -374,6 +379,18 @@ class Client::Impl : public dds::DataReaderListener {
     for (const auto& [key, b] : buses_) v.push_back(b);
     return v;
   }
+  std::vector<AxisLink> links() const {
+    std::lock_guard lock(mutex_);
+    std::vector<AxisLink> v;
+    for (const auto& [key, l] : links_) v.push_back(l);
+    return v;
+  }
+  std::optional<AxisLink> link(std::string_view axis, std::string_view gateway) const {
+    std::lock_guard lock(mutex_);
+    for (const auto& [key, l] : links_)
+      if (l.axis == axis && (gateway.empty() || l.gateway == gateway)) return l;
+    return std::nullopt;
+  }
   std::vector<AxisEvent> events_since(std::uint64_t& cursor) const {
     std::lock_guard lock(mutex_);
     std::vector<AxisEvent> v;
@@ -586,6 +603,14 @@ class Client::Impl : public dds::DataReaderListener {
     });
   }
 
+  void take_links() {
+    msg::take_valid<msg::AxisLink>(*link_r_, [&](const msg::AxisLink& in) {
+      AxisLink l{in.gateway(), in.axis(), in.bus(), in.bus_type(), in.address(), in.link(), in.detail(), in.since()};
+      std::lock_guard lock(mutex_);
+      links_[{l.gateway, l.axis}] = std::move(l);
+    });
+  }
+
   void take_param_replies() {
     msg::take_valid<msg::ParameterReply>(*param_r_, [&](const msg::ParameterReply& in) {
       if (in.client() != opt_.name) return;
@@ -616,6 +641,7 @@ class Client::Impl : public dds::DataReaderListener {
   dds::DataReader* reply_r_ = nullptr;
   dds::DataReader* event_r_ = nullptr;
   dds::DataReader* bus_r_ = nullptr;
+  dds::DataReader* link_r_ = nullptr;
   dds::DataReader* param_r_ = nullptr;
 
   std::mutex endpoints_mutex_;
@@ -636,6 +662,7 @@ class Client::Impl : public dds::DataReaderListener {
   SteadyClock::time_point last_info_change_;
   std::map<std::pair<std::string, std::string>, AxisState> states_;
   std::map<std::pair<std::string, std::string>, BusStatus> buses_;
+  std::map<std::pair<std::string, std::string>, AxisLink> links_;
   std::deque<AxisEvent> events_;
   std::uint64_t events_end_ = 0;  // number of events ever received
   std::map<std::uint64_t, std::deque<ReplyRecord>> replies_;
@@ -653,6 +680,10 @@ std::optional<AxisState> Client::state(std::string_view axis, std::string_view g
   return impl_->state(axis, gateway);
 }
 std::vector<BusStatus> Client::buses() const { return impl_->buses(); }
+std::vector<AxisLink> Client::links() const { return impl_->links(); }
+std::optional<AxisLink> Client::link(std::string_view axis, std::string_view gateway) const {
+  return impl_->link(axis, gateway);
+}
 std::vector<AxisEvent> Client::events_since(std::uint64_t& cursor) const { return impl_->events_since(cursor); }
 bool Client::wait_until(const std::function<bool()>& condition, Millis timeout) const {
   return impl_->wait_until(condition, timeout);

@@ -85,6 +85,18 @@ struct AxisState {
   std::chrono::steady_clock::time_point received;
 };
 
+// Where an axis' link stands, why, and since when (topic axis_link, written when it changes).
+struct AxisLink {
+  std::string gateway;
+  std::string axis;
+  std::string bus;
+  std::string bus_type;       // "canopen", "sim", ...
+  std::uint32_t address = 0;  // on its bus (canopen: the node-ID)
+  std::string link;
+  std::string detail;         // the bus' words ("" when it says nothing)
+  std::int64_t since_ns = 0;  // gateway monotonic time the link entered its state (as AxisState::stamp_ns)
+};
+
 struct AxisEvent {
   std::string gateway;
   std::string axis;  // empty for bus events
@@ -210,6 +222,9 @@ class Client {
   [[nodiscard]] std::vector<AxisState> states() const;
   [[nodiscard]] std::optional<AxisState> state(std::string_view axis, std::string_view gateway = {}) const;
   [[nodiscard]] std::vector<BusStatus> buses() const;
+  // Empty when no gateway published the axis' link (or this identity may not read axis_link).
+  [[nodiscard]] std::vector<AxisLink> links() const;
+  [[nodiscard]] std::optional<AxisLink> link(std::string_view axis, std::string_view gateway = {}) const;
 
   // Events in arrival order. `cursor` starts at 0 and is advanced past the returned events; at most
   // the newest 1000 are kept.

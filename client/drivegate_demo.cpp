@@ -144,7 +144,7 @@ class Demo {
     auto states = client_.states();
     std::lock_guard lock(mutex_);
     std::string out = kAnsiClearHome;
-    out += format_status_table(states, SteadyClock::now());
+    out += format_status_table(states, client_.links(), SteadyClock::now());
     out += "\nsteps:\n";
     for (const auto& s : steps_) out += "  " + s + "\n";
     std::cout << out << std::flush;

@@ -3,6 +3,7 @@
 #include <cctype>
 #include <chrono>
 #include <cstdio>
+#include <ctime>
 #include <iostream>
 #include <string>
 #include <thread>
@@ -12,6 +13,7 @@
 #include "client/discovery.hpp"
 #include "client/interrupt.hpp"
 #include "client/json_writer.hpp"
+#include "client/node_ids.hpp"
 #include "client/status_table.hpp"
 
 namespace {
@@ -31,8 +33,11 @@ struct CommandHelp {
 constexpr std::size_t kAny = 64;
 
 constexpr CommandHelp kCommands[] = {
-    {"list", "list", "gateways and their axes (bus, device, unit, modes)", 0, 0},
-    {"status", "status [AXIS...] [--watch]", "axis table; --watch redraws it at 10 Hz until Ctrl-C", 0, kAny},
+    {"list", "list", "gateways and their axes (bus, address, device, unit, modes)", 0, 0},
+    {"status", "status [AXIS...] [--watch]",
+     "axis table; with AXIS also why each one's link is in its state and since when; --watch redraws\n"
+     "      the table at 10 Hz until Ctrl-C",
+     0, kAny},
     {"enable", "enable AXIS", "walk the axis to operation enabled", 1, 1},
     {"disable", "disable AXIS", "disable the drive (power stage off)", 1, 1},
     {"stop", "stop AXIS", "bring the axis to standstill, keep it enabled", 1, 1},
@@ -157,8 +162,23 @@ CommandRequest request(const Context& ctx, std::string kind) {
   return req;
 }
 
+// Waits (within the timeout) until the link of every axis of `names` (gateway, axis) arrived.
+void wait_links(const Context& ctx, const std::vector<std::pair<std::string, std::string>>& names) {
+  ctx.client.wait_until(
+      [&] {
+        return std::all_of(names.begin(), names.end(),
+                           [&](const auto& n) { return ctx.client.link(n.second, n.first).has_value(); });
+      },
+      ctx.timeout);
+}
+
 int cmd_list(Context& ctx) {
   expect_words(ctx, 0);
+  std::vector<std::pair<std::string, std::string>> names;
+  for (const auto& g : ctx.client.gateways())
+    if (ctx.gateway.empty() || g.name == ctx.gateway)
+      for (const auto& a : g.axes) names.emplace_back(g.name, a.name);
+  wait_links(ctx, names);
   for (const auto& g : ctx.client.gateways()) {
     if (!ctx.gateway.empty() && g.name != ctx.gateway) continue;
     if (ctx.json) {
@@ -166,10 +186,10 @@ int cmd_list(Context& ctx) {
       w.begin_object().field("gateway", std::string_view(g.name)).field("host", std::string_view(g.host));
       w.field("pid", static_cast<std::uint64_t>(g.pid)).key("axes").begin_array();
       for (const auto& a : g.axes) {
-        w.begin_object()
-            .field("name", std::string_view(a.name))
-            .field("bus", std::string_view(a.bus))
-            .field("device", std::string_view(a.device))
+        w.begin_object().field("name", std::string_view(a.name)).field("bus", std::string_view(a.bus));
+        if (const auto l = ctx.client.link(a.name, g.name))
+          w.field("bus_type", std::string_view(l->bus_type)).field("address", static_cast<std::uint64_t>(l->address));
+        w.field("device", std::string_view(a.device))
             .field("unit", std::string_view(a.unit))
             .key("modes")
             .begin_array();
@@ -184,8 +204,10 @@ int cmd_list(Context& ctx) {
     for (const auto& a : g.axes) {
       std::string modes;
       for (const auto& m : a.modes) modes += (modes.empty() ? "" : ",") + m;
-      std::cout << "  " << a.name << "  bus=" << a.bus << "  device=" << a.device << "  unit=" << a.unit
-                << "  modes=" << modes << "\n";
+      const auto l = ctx.client.link(a.name, g.name);
+      std::cout << "  " << a.name << "  bus=" << a.bus
+                << (l ? "  address=" + format_address(l->bus_type, l->address) : std::string{})
+                << "  device=" << a.device << "  unit=" << a.unit << "  modes=" << modes << "\n";
     }
   }
   return 0;
@@ -200,14 +222,28 @@ std::vector<AxisState> selected_states(const Context& ctx) {
   return states;
 }
 
-void print_state_json(const AxisState& s) {
+// Seconds from `since_ns` to `stamp_ns` (gateway monotonic time), as text with 0.1 s.
+std::string seconds_between(std::int64_t since_ns, std::int64_t stamp_ns) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.1f s", static_cast<double>(std::max<std::int64_t>(0, stamp_ns - since_ns)) / 1e9);
+  return buf;
+}
+
+void print_state_json(const AxisState& s, const std::optional<AxisLink>& l) {
   JsonWriter w;
   w.begin_object()
       .field("gateway", std::string_view(s.gateway))
       .field("axis", std::string_view(s.axis))
       .field("state", std::string_view(s.state))
-      .field("link", std::string_view(s.link))
-      .field("mode", std::string_view(s.mode))
+      .field("link", std::string_view(s.link));
+  if (l) {
+    w.field("bus", std::string_view(l->bus))
+        .field("bus_type", std::string_view(l->bus_type))
+        .field("address", static_cast<std::uint64_t>(l->address))
+        .field("link_detail", std::string_view(l->detail))
+        .field("link_since_ns", l->since_ns);
+  }
+  w.field("mode", std::string_view(s.mode))
       .field("position", s.position)
       .field("velocity", s.velocity)
       .field("torque", s.torque)
@@ -219,8 +255,33 @@ void print_state_json(const AxisState& s) {
       .field("warning", s.warning)
       .field("stopping", s.stopping)
       .field("statusword", static_cast<std::uint64_t>(s.statusword))
+      .field("stamp_ns", s.stamp_ns)
       .end_object();
   std::cout << w.str() << "\n";
+}
+
+// `status AXIS`: why the link is in its state and since when, under the table.
+//   x: link offline for 2.4 s (since 14:03:07)
+//     node 35 (0x23): identity: 1018h:01 reads 0x0000006A, expected 0x00000059; ...
+void print_link_detail(const AxisState& s, const std::optional<AxisLink>& l) {
+  std::cout << "\n" << s.axis << ": link " << s.link;
+  if (!l) {
+    std::cout << " (the gateway publishes no link detail)\n";
+    return;
+  }
+  if (l->since_ns > 0 && l->link == s.link) {
+    // The state's stamp is the gateway's "now" (to within its status period).
+    const auto age = std::chrono::nanoseconds(std::max<std::int64_t>(0, s.stamp_ns - l->since_ns));
+    const auto since = std::chrono::system_clock::to_time_t(
+        std::chrono::system_clock::now() - std::chrono::duration_cast<std::chrono::system_clock::duration>(age));
+    char clock[16] = "";
+    std::tm local{};
+    if (::localtime_r(&since, &local) != nullptr) std::strftime(clock, sizeof clock, "%H:%M:%S", &local);
+    std::cout << " for " << seconds_between(l->since_ns, s.stamp_ns) << " (since " << clock << ")";
+  }
+  std::cout << "\n";
+  if (!l->detail.empty())
+    std::cout << "  " << (l->bus_type == "canopen" ? annotate_node_ids(l->detail) : l->detail) << "\n";
 }
 
 int cmd_status(Context& ctx) {
@@ -238,21 +299,26 @@ int cmd_status(Context& ctx) {
   if (ctx.args.flag("watch")) {
     while (!interrupted()) {
       const auto states = selected_states(ctx);
-      std::cout << kAnsiClearHome << format_status_table(states, SteadyClock::now())
+      std::cout << kAnsiClearHome << format_status_table(states, ctx.client.links(), SteadyClock::now())
                 << "\n(refreshing at 10 Hz, Ctrl-C to quit)" << std::flush;
       std::this_thread::sleep_for(Millis(100));  // display pacing, not synchronisation
     }
     std::cout << "\n";
     return 0;
   }
+  std::vector<std::pair<std::string, std::string>> names;
+  for (const auto& s : selected_states(ctx)) names.emplace_back(s.gateway, s.axis);
+  wait_links(ctx, names);
   const auto states = selected_states(ctx);
   for (const auto& name : ctx.words)
     if (std::none_of(states.begin(), states.end(), [&](const AxisState& s) { return s.axis == name; }))
       return fail("no state for axis '" + name + "'");
   if (ctx.json) {
-    for (const auto& s : states) print_state_json(s);
+    for (const auto& s : states) print_state_json(s, ctx.client.link(s.axis, s.gateway));
   } else {
-    std::cout << format_status_table(states, SteadyClock::now());
+    std::cout << format_status_table(states, ctx.client.links(), SteadyClock::now());
+    if (!ctx.words.empty())
+      for (const auto& s : states) print_link_detail(s, ctx.client.link(s.axis, s.gateway));
   }
   return 0;
 }
@@ -329,6 +395,19 @@ int cmd_home(Context& ctx) {
   return report(ctx, "home", ctx.client.send(req, true, ctx.timeout));
 }
 
+// Whether the event comes from a canopen bus (its texts name nodes): by its axis' link, else by
+// its bus' status.
+bool on_canopen(const Context& ctx, const AxisEvent& e) {
+  if (!e.axis.empty()) {
+    const auto l = ctx.client.link(e.axis, e.gateway);
+    return l && l->bus_type == "canopen";
+  }
+  const auto buses = ctx.client.buses();
+  return std::any_of(buses.begin(), buses.end(), [&](const BusStatus& b) {
+    return b.gateway == e.gateway && b.bus == e.bus && b.type == "canopen";
+  });
+}
+
 void print_event(const Context& ctx, const AxisEvent& e) {
   if (ctx.json) {
     JsonWriter w;
@@ -348,7 +427,8 @@ void print_event(const Context& ctx, const AxisEvent& e) {
   char code[16] = "";
   if (e.code != 0) std::snprintf(code, sizeof code, " 0x%04X", e.code);
   std::cout << e.gateway << "/" << (e.axis.empty() ? "bus:" + e.bus : e.axis) << "  " << e.kind << code << "  "
-            << e.text << (e.state.empty() || e.state == "unknown" ? "" : "  [" + e.state + "]") << std::endl;
+            << (on_canopen(ctx, e) ? annotate_node_ids(e.text) : e.text)
+            << (e.state.empty() || e.state == "unknown" ? "" : "  [" + e.state + "]") << std::endl;
 }
 
 int cmd_events(Context& ctx) {

@@ -4,11 +4,13 @@
 #include <array>
 #include <cstdio>
 
+#include "client/node_ids.hpp"
+
 namespace drivegate::client {
 
 namespace {
 
-constexpr std::size_t kColumns = 9;
+constexpr std::size_t kColumns = 10;
 using Row = std::array<std::string, kColumns>;
 
 std::string number(double v, const std::string& unit) {
@@ -19,11 +21,14 @@ std::string number(double v, const std::string& unit) {
 
 }  // namespace
 
-std::string format_status_table(const std::vector<AxisState>& states, std::chrono::steady_clock::time_point now,
-                                std::chrono::milliseconds stale_after) {
+std::string format_status_table(const std::vector<AxisState>& states, const std::vector<AxisLink>& links,
+                                std::chrono::steady_clock::time_point now, std::chrono::milliseconds stale_after) {
   std::vector<Row> rows;
-  rows.push_back({"GATEWAY", "AXIS", "LINK", "STATE", "MODE", "POSITION", "VELOCITY", "TORQUE", "FAULT"});
+  rows.push_back({"GATEWAY", "AXIS", "ADDRESS", "LINK", "STATE", "MODE", "POSITION", "VELOCITY", "TORQUE", "FAULT"});
   for (const auto& s : states) {
+    const auto link = std::find_if(links.begin(), links.end(),
+                                   [&](const AxisLink& l) { return l.gateway == s.gateway && l.axis == s.axis; });
+    const std::string address = link == links.end() ? "" : format_address(link->bus_type, link->address);
     std::string state = s.state;
     if (s.stopping) state += " (stopping)";
     if (now - s.received > stale_after) state += " (stale)";
@@ -36,7 +41,7 @@ std::string format_status_table(const std::vector<AxisState>& states, std::chron
       fault = "warning";
     }
     const std::string rate_unit = s.unit.empty() ? "" : s.unit + "/s";
-    rows.push_back({s.gateway, s.axis, s.link, state, s.mode, number(s.position, s.unit), number(s.velocity, rate_unit),
+    rows.push_back({s.gateway, s.axis, address, s.link, state, s.mode, number(s.position, s.unit), number(s.velocity, rate_unit),
                     number(s.torque, ""), fault});
   }
   std::array<std::size_t, kColumns> width{};

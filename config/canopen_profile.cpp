@@ -355,7 +355,8 @@ void read_canopen_device(const MapReader& root, DeviceProfile& p, bool cyclic_gi
   if (c.has("device_type_mask") && !c.has("device_type"))
     c.error("device_type_mask", "only with device_type (the value 1000h is compared with)");
   static const std::vector<std::string> kPersonas{"akd", "nord-sk500p", "stoeber-sd6", "generic",
-                                                    "generic-no-heartbeat", "generic-no-watch"};
+                                                    "generic-no-heartbeat", "generic-no-watch",
+                                                    "generic-fixed-heartbeat"};
   co.persona = c.choice("persona", Need::Optional, kPersonas).value_or(co.persona);
   // SDO channel k answers on 580h + 20h*(k-1) + node [stoeber-sd6-canopen.md §5.3]: at most 4.
   co.sdo_channels = static_cast<int>(c.integer("sdo_channels", Need::Optional, 1, 4).value_or(1));

@@ -180,6 +180,11 @@ bool AxisRunner::parameter(const ParamRequest& req, TimePoint now, RunnerOutput&
 void AxisRunner::observe_link(TimePoint now, LinkState link, std::string_view detail, RunnerOutput& out) noexcept {
   out_ = &out;
   now_ = now;
+  if (detail != link_detail_.view()) link_detail_.assign(detail);
+  if (!link_observed_ || link != last_link_) {
+    link_observed_ = true;
+    link_since_ns_ = to_ns(now);
+  }
   if (link != last_link_) {
     Text t;
     if (detail.empty())
@@ -319,6 +324,8 @@ void AxisRunner::build_snapshot(TimePoint now) noexcept {
   AxisSnapshot& s = snapshot_;
   s.axis = index_;
   s.link = last_link_;
+  s.link_detail = link_detail_;
+  s.link_since_ns = link_since_ns_;
   s.state = fb.valid ? fb.state : AxisState::Unknown;
   s.mode = fb.mode;
   s.position = u.position_to_user(fb.position);

@@ -105,11 +105,16 @@ struct DriveFeedback {
   bool stopping = false;  // ramping down (quick stop, halt, OFF1)
 };
 
+// Why a link is in its state, in the bus' words (Bus::link_detail()).
+using LinkDetail = FixedString<200>;
+
 // The axis as clients see it, in user units.
 struct AxisSnapshot {
   AxisIndex axis = kNoAxis;
   AxisState state = AxisState::Unknown;
   LinkState link = LinkState::Offline;
+  LinkDetail link_detail;        // why the link is in its state ("" when the bus says nothing)
+  std::int64_t link_since_ns = 0;  // monotonic time the link entered its state (as stamp_ns)
   Mode mode = Mode::None;
   double position = 0;
   double velocity = 0;

@@ -214,6 +214,8 @@ class DdsBridge::Impl : private dds::DataWriterListener, private dds::DataReader
   void collect_outbox(Clock::time_point now);
   void write_replies(Clock::time_point now);
   void publish_states();
+  // axis_link of the axis whose snapshot is `s`, when its link state or detail changed.
+  void publish_link(std::size_t axis_id, const core::AxisSnapshot& s);
   void publish_bus_status();
   void publish_gateway_info();
   // An event of this gateway (not of a bus); `axis` when it is about one of its axes.
@@ -255,6 +257,7 @@ class DdsBridge::Impl : private dds::DataWriterListener, private dds::DataReader
   dds::DataWriter* bus_w_ = nullptr;
   dds::DataWriter* param_w_ = nullptr;
   dds::DataWriter* info_w_ = nullptr;
+  dds::DataWriter* link_w_ = nullptr;  // null: DDS access control refused it (older permissions)
   dds::DataReader* cmd_r_ = nullptr;
   dds::DataReader* sp_r_ = nullptr;
   dds::DataReader* param_r_ = nullptr;
@@ -277,6 +280,13 @@ class DdsBridge::Impl : private dds::DataWriterListener, private dds::DataReader
   std::set<std::uint64_t> warned_instances_;                         // other instances of this gateway
   Outbox outbox_;
   std::uint64_t state_seq_ = 0;
+  // The link state and detail last written on axis_link, per axis.
+  struct PublishedLink {
+    bool written = false;
+    core::LinkState link = core::LinkState::Offline;
+    core::LinkDetail detail;
+  };
+  std::vector<PublishedLink> links_;
 
   // Traffic summary (instead of a line per command) and rate-limited warnings.
   LogLimiter warn_limit_;
@@ -324,6 +334,15 @@ void DdsBridge::Impl::start() {
   bus_w_ = &node_->writer(msg::TopicId::BusStatus);
   param_w_ = &node_->writer(msg::TopicId::ParamReply, this, dds::StatusMask::publication_matched());
   info_w_ = &node_->writer(msg::TopicId::GatewayInfo);
+  try {
+    link_w_ = &node_->writer(msg::TopicId::AxisLink);
+  } catch (const std::runtime_error& e) {
+    // Permissions made before axis_link existed: the gateway runs, without link details.
+    if (!node_->secure()) throw;
+    spdlog::warn("dds: axis_link is not published ({}); scripts/make-pki.sh makes permissions that allow it",
+                 e.what());
+  }
+  links_.assign(rt_.axes().size(), PublishedLink{});
   const auto arrival = dds::StatusMask::data_available();
   cmd_r_ = &node_->reader(msg::TopicId::AxisCommand, this, arrival);
   sp_r_ = &node_->reader(msg::TopicId::Setpoint, this, arrival);
@@ -871,8 +890,25 @@ void DdsBridge::Impl::publish_states() {
     out.stamp(s.stamp_ns);
     out.seq(state_seq_);
     state_w_->write(&out);
+    publish_link(i, s);
   }
   count([&](Stats& st) { st.states_published += axes.size(); });
+}
+
+void DdsBridge::Impl::publish_link(std::size_t axis_id, const core::AxisSnapshot& s) {
+  PublishedLink& last = links_[axis_id];
+  if (link_w_ == nullptr || (last.written && last.link == s.link && last.detail == s.link_detail.view())) return;
+  const AxisInfo& a = rt_.axes()[axis_id];
+  msg::AxisLink out;
+  out.gateway(gateway_);
+  out.axis(a.name);
+  out.bus(a.bus);
+  out.bus_type(a.bus_type);
+  out.address(a.address);
+  out.link(std::string(core::to_string(s.link)));
+  out.detail(s.link_detail.str());
+  out.since(s.link_since_ns);
+  if (link_w_->write(&out)) last = {true, s.link, s.link_detail};
 }
 
 void DdsBridge::Impl::publish_bus_status() {

@@ -45,6 +45,8 @@ Gateway::Gateway(const config::Plan& plan) : name_(plan.gateway.name) {
       AxisInfo info;
       info.name = ap.spec.name;
       info.bus = bp.name;
+      info.bus_type = bp.type;
+      info.address = static_cast<std::uint32_t>(ap.address);
       info.device = ap.device.name;
       info.unit = ap.spec.user_unit;
       info.modes = ap.spec.modes;

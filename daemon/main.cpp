@@ -416,6 +416,8 @@ int run(const Args& args) {
   while (bridge.stats().states_published < published + 2 * gateway->axes().size() &&
          std::chrono::steady_clock::now() < until)
     std::this_thread::sleep_for(5ms);
+  if (bridge.stats().states_published < published + 2 * gateway->axes().size())
+    spdlog::warn("the axis states after the stop were not all published within 1 s: clients may not see them");
   bridge.stop();
   gateway.reset();
   spdlog::info("stopped");

@@ -21,6 +21,8 @@ namespace drivegate::daemon {
 struct AxisInfo {
   std::string name;
   std::string bus;
+  std::string bus_type;        // "canopen", "sim", ...
+  std::uint32_t address = 0;   // on its bus (canopen: the node-ID)
   std::string device;
   std::string unit;  // user unit of positions
   core::ModeSet modes;

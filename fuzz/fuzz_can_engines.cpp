@@ -142,7 +142,7 @@ class Bus {
       case 0: request_ = sdo_.read(0, {0x1018, 1}, 4); break;
       case 1: request_ = sdo_.read(0, {0x1008, 0}); break;  // device name: a segmented upload
       case 2: request_ = sdo_.write(0, {0x6060, 0}, 3, 1); break;
-      default: request_ = sdo_.write_bytes(0, {0x2000, 0}, kName); break;
+      default: request_ = sdo_.write_from(0, {0x2000, 0}, kName); break;
     }
   }
 

@@ -37,7 +37,8 @@ namespace {
 // A reply written before the gateway's writer knew a client's reader would be lost to volatile
 // durability, so the gateway holds a client's replies until its reader is matched. State and
 // set-points are best effort, newest only; events transient-local so a late joiner sees recent
-// faults; gateway_info and bus_status transient-local so a CLI started now sees them at once.
+// faults; gateway_info, bus_status and axis_link transient-local so a CLI started now sees them at
+// once.
 constexpr std::array<TopicQos, kTopicCount> kQos{{
     {TopicId::AxisState, false, false, false, 1, "gateway, axis"},
     {TopicId::AxisCommand, true, false, true, 1024, ""},
@@ -48,6 +49,7 @@ constexpr std::array<TopicQos, kTopicCount> kQos{{
     {TopicId::ParamRequest, true, false, true, 1024, ""},
     {TopicId::ParamReply, true, false, false, 1024, "gateway, client"},
     {TopicId::GatewayInfo, true, true, false, 1, "gateway"},
+    {TopicId::AxisLink, true, true, false, 1, "gateway, axis"},
 }};
 
 // Clients (reply instances) a gateway keeps apart at once; memory grows with use, not up front.
@@ -100,6 +102,7 @@ dds::TopicDataType* make_type(TopicId t) {
     case TopicId::ParamRequest: return new ParameterRequestPubSubType();
     case TopicId::ParamReply: return new ParameterReplyPubSubType();
     case TopicId::GatewayInfo: return new GatewayInfoPubSubType();
+    case TopicId::AxisLink: return new AxisLinkPubSubType();
   }
   return nullptr;
 }
@@ -117,6 +120,7 @@ std::string_view topic_suffix(TopicId t) noexcept {
     case TopicId::ParamRequest: return "param_request";
     case TopicId::ParamReply: return "param_reply";
     case TopicId::GatewayInfo: return "gateway_info";
+    case TopicId::AxisLink: return "axis_link";
   }
   return "unknown";
 }

@@ -47,8 +47,9 @@ enum class TopicId : std::uint8_t {
   ParamRequest,
   ParamReply,
   GatewayInfo,
+  AxisLink,
 };
-inline constexpr std::size_t kTopicCount = 9;
+inline constexpr std::size_t kTopicCount = 10;
 
 // "axis_state", "axis_command", ... (the part after "<namespace>/").
 std::string_view topic_suffix(TopicId t) noexcept;

@@ -225,14 +225,14 @@ topics_publish() {
     observer) ;;
     operator) echo axis_command setpoint ;;
     engineer) echo axis_command setpoint param_request ;;
-    gateway) echo axis_state command_reply axis_event bus_status param_reply gateway_info ;;
+    gateway) echo axis_state command_reply axis_event bus_status param_reply gateway_info axis_link ;;
   esac
 }
 topics_subscribe() {
   case $1 in
-    observer) echo axis_state axis_event bus_status gateway_info ;;
-    operator) echo axis_state axis_event bus_status gateway_info command_reply ;;
-    engineer) echo axis_state axis_event bus_status gateway_info command_reply param_reply ;;
+    observer) echo axis_state axis_event bus_status gateway_info axis_link ;;
+    operator) echo axis_state axis_event bus_status gateway_info axis_link command_reply ;;
+    engineer) echo axis_state axis_event bus_status gateway_info axis_link command_reply param_reply ;;
     gateway) echo axis_command setpoint param_request gateway_info ;;
   esac
 }
@@ -303,9 +303,10 @@ EOF
   for t in axis_command setpoint command_reply param_request param_reply; do
     topic_rule "$t" ENCRYPT ENCRYPT
   done
-  # State, events, bus status, gateway info: nothing secret, but nobody may forge them. Signing
-  # the submessage covers its serialized payload too, so data protection on top adds nothing.
-  for t in axis_state axis_event bus_status gateway_info; do
+  # State, events, bus status, gateway info, link details: nothing secret, but nobody may forge
+  # them. Signing the submessage covers its serialized payload too, so data protection on top adds
+  # nothing.
+  for t in axis_state axis_event bus_status gateway_info axis_link; do
     topic_rule "$t" SIGN NONE
   done
   cat <<EOF

@@ -21,20 +21,20 @@ long long ms(core::Duration d) { return std::chrono::duration_cast<std::chrono::
 struct Steps {
   std::vector<BootStep> list;
   void write(std::string stage, ObjectDef def, std::int64_t value, bool optional = false, std::string why = {}) {
-    list.push_back({BootStep::Kind::Write, def, value, 0xFFFFFFFF, optional, std::move(stage), std::move(why), 0, 0, 0});
+    list.push_back({BootStep::Kind::Write, def, value, 0xFFFFFFFF, optional, std::move(stage), std::move(why), 0, 0, 0, 0});
   }
   void seed(ObjectDef def) {
-    list.push_back({BootStep::Kind::Seed, def, 0, 0xFFFFFFFF, true, "process image", {}, 0, 0, 0});
+    list.push_back({BootStep::Kind::Seed, def, 0, 0xFFFFFFFF, true, "process image", {}, 0, 0, 0, 0});
   }
   void expect(std::string stage, ObjectDef def, std::int64_t value, std::uint32_t mask = 0xFFFFFFFF,
               std::string why = {}) {
-    list.push_back({BootStep::Kind::Expect, def, value, mask, false, std::move(stage), std::move(why), 0, 0, 0});
+    list.push_back({BootStep::Kind::Expect, def, value, mask, false, std::move(stage), std::move(why), 0, 0, 0, 0});
   }
   void probe(std::string stage, ObjectDef def, std::uint8_t sets) {
-    list.push_back({BootStep::Kind::Probe, def, 0, 0xFFFFFFFF, true, std::move(stage), {}, sets, 0, 0});
+    list.push_back({BootStep::Kind::Probe, def, 0, 0xFFFFFFFF, true, std::move(stage), {}, sets, 0, 0, 0});
   }
   void fail(std::string stage, std::string why) {
-    list.push_back({BootStep::Kind::Fail, {}, 0, 0xFFFFFFFF, false, std::move(stage), std::move(why), 0, 0, 0});
+    list.push_back({BootStep::Kind::Fail, {}, 0, 0xFFFFFFFF, false, std::move(stage), std::move(why), 0, 0, 0, 0});
   }
 };
 
@@ -151,16 +151,20 @@ std::vector<BootStep> build_boot_steps(const config::AxisPlan& axis, const confi
       s.list.back().if_missing = if_missing;
     };
     s.probe("error control", u8(0x1016, 0), kFoundConsumerHeartbeat);
-    s.probe("error control", u16(0x100C, 0), kFoundGuardTime);
-    branch(0, kFoundConsumerHeartbeat);
-    s.probe("error control", u8(0x100D, 0), kFoundGuarding);
-    branch(kFoundGuardTime, kFoundConsumerHeartbeat);
-    // 1016h: heartbeat both ways.
+    // 1016h: heartbeat both ways. A drive may have 1016h and still refuse the gateway's entry
+    // (06010002h read-only: a fixed entry, 06090030h: a producer or time it does not take,
+    // 08000020h); it is then treated like a drive without 1016h.
     s.write("error control", u16(0x1017, 0), ms(opt.drive_heartbeat));
     branch(kFoundConsumerHeartbeat, 0);
     s.write("error control", u32(0x1016, 1), consumer_entry, false, kConsumerWhy);
     branch(kFoundConsumerHeartbeat, 0);
-    // No 1016h, but 100Ch and 100Dh: node guarding.
+    s.list.back().refused = kFoundConsumerHeartbeat;
+    s.list.back().sets = kConsumerHeartbeatRefused;
+    s.probe("error control", u16(0x100C, 0), kFoundGuardTime);
+    branch(0, kFoundConsumerHeartbeat);
+    s.probe("error control", u8(0x100D, 0), kFoundGuarding);
+    branch(kFoundGuardTime, kFoundConsumerHeartbeat);
+    // No usable 1016h, but 100Ch and 100Dh: node guarding.
     s.write("error control", u16(0x1017, 0), 0, true, "heartbeat off: guarding and heartbeat are exclusive");
     branch(kFoundGuarding, 0);
     s.write("error control", u16(0x100C, 0), ms(opt.guard_time));
@@ -168,14 +172,19 @@ std::vector<BootStep> build_boot_steps(const config::AxisPlan& axis, const confi
     s.write("error control", u8(0x100D, 0), opt.life_time_factor);
     branch(kFoundGuarding, 0);
     // Neither.
-    const std::string neither = "node " + std::to_string(axis.address) +
-                                " has neither 1016h (consumer heartbeat) nor 100Ch/100Dh (node guarding)";
+    const std::string who = "node " + std::to_string(axis.address);
+    const std::string no_guarding = " 100Ch/100Dh (node guarding), so it would not stop if the gateway died";
     if (watch == config::GatewayWatch::Required) {
-      s.fail("error control", neither + ", so it would not stop if the gateway died (gateway_watch: required)");
-      branch(0, kFoundConsumerHeartbeat | kFoundGuarding);
+      s.fail("error control", who + " has neither 1016h (consumer heartbeat) nor" + no_guarding +
+                                  " (gateway_watch: required)");
+      branch(0, kFoundConsumerHeartbeat | kFoundGuarding | kConsumerHeartbeatRefused);
+      s.fail("error control", who + " refused 1016h:01 (consumer heartbeat) and has no" + no_guarding +
+                                  " (gateway_watch: required)");
+      branch(kConsumerHeartbeatRefused, kFoundGuarding);
     } else {
+      // The drive's heartbeat (already on when only the 1016h:01 entry was refused).
       s.write("error control", u16(0x1017, 0), ms(opt.drive_heartbeat));
-      branch(0, kFoundConsumerHeartbeat | kFoundGuarding);
+      branch(0, kFoundConsumerHeartbeat | kFoundGuarding | kConsumerHeartbeatRefused);
     }
   }
   return std::move(s.list);

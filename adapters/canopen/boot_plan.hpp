@@ -12,10 +12,12 @@
 namespace drivegate::canopen {
 
 // What the error-control probes of a boot found (NodeBoot::found()), with gateway_watch required
-// or optional: the drive has 1016h, 100Ch, 100Ch and 100Dh.
+// or optional: the drive has 1016h (and took the gateway's entry in 1016h:01), 100Ch, 100Ch and
+// 100Dh; it has 1016h but refused the entry (the consumer-heartbeat bit is then clear).
 inline constexpr std::uint8_t kFoundConsumerHeartbeat = 1U << 0;
 inline constexpr std::uint8_t kFoundGuardTime = 1U << 1;
 inline constexpr std::uint8_t kFoundGuarding = 1U << 2;
+inline constexpr std::uint8_t kConsumerHeartbeatRefused = 1U << 3;
 
 // How the gateway and the drive watch each other after a boot that succeeded.
 enum class WatchOutcome : std::uint8_t {

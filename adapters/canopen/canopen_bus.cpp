@@ -292,9 +292,14 @@ bool CanopenBus::next_event(core::Event& out) noexcept {
     out = core::Event{};
     out.axis = static_cast<core::AxisIndex>(n->channel);
     out.kind = core::EventKind::Warning;
-    out.text.format("node %u has neither 1016h (consumer heartbeat) nor 100Ch/100Dh (node guarding): it will not stop "
-                    "by itself if the gateway dies (gateway_watch: optional)",
-                    unsigned{n->id});
+    if (const std::uint32_t code = n->boot.refusal(); code != 0)
+      out.text.format("node %u refused 1016h:01 (consumer heartbeat, abort 0x%08X) and has no 100Ch/100Dh (node "
+                      "guarding): it will not stop by itself if the gateway dies",
+                      unsigned{n->id}, code);
+    else
+      out.text.format("node %u has neither 1016h (consumer heartbeat) nor 100Ch/100Dh (node guarding): it will not "
+                      "stop by itself if the gateway dies (gateway_watch: optional)",
+                      unsigned{n->id});
     return true;
   }
   if (emcy_count_ == 0) return false;

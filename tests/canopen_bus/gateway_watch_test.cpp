@@ -116,6 +116,69 @@ TEST(GatewayWatch, GenericDriveWithConsumerHeartbeatStillUsesIt) {
   EXPECT_EQ(count_events(h, "neither 1016h"), 0U);
 }
 
+// A drive that has 1016h but refuses the gateway's entry in 1016h:01 is guarded when it has
+// 100Ch/100Dh, as if it had no 1016h.
+class ConsumerEntryRefused : public ::testing::TestWithParam<std::uint32_t> {};
+
+TEST_P(ConsumerEntryRefused, FallsBackToGuarding) {
+  BusHarness h(one_drive("generic-cia402"));
+  // Once the drive is configured (its communication reset has passed), 1016h:01 is still to come.
+  ASSERT_TRUE(h.run_until([&] { return h.bus->link_state(0) == core::LinkState::Configuring; }, 5s));
+  h.drive("x").inject_sdo_abort({0x1016, 1}, GetParam());
+  ASSERT_TRUE(h.run_until([&] { return h.all_up(); }, 5s)) << h.events_text() << h.bus->link_detail(0);
+  h.run_until([] { return false; }, 1s);
+  EXPECT_TRUE(h.all_up()) << h.bus->link_detail(0);
+  EXPECT_EQ(h.bus->boots(0), 1U);
+  EXPECT_EQ(h.drive("x").nmt().heartbeat_consumer(), 0U);
+  EXPECT_EQ(h.drive("x").nmt().guard_time(), 100U);
+  EXPECT_GT(h.drive("x").nmt().counters().guard_replies, 5U);
+  EXPECT_EQ(h.drive("x").nmt().heartbeat_period(), 0U);
+  EXPECT_EQ(count_events(h, "1016h"), 0U) << h.events_text();
+  gateway_dies(h, 2s);
+  EXPECT_GE(h.drive("x").counters().comm_losses, 1U) << "the drive's life guarding notices the dead gateway";
+}
+
+INSTANTIATE_TEST_SUITE_P(GatewayWatch, ConsumerEntryRefused,
+                         ::testing::Values(0x06090030U /* value range */, 0x08000020U /* cannot store */,
+                                           0x06010002U /* read-only */));
+
+constexpr const char* kRefusedUnwatched =
+    "node 5 refused 1016h:01 (consumer heartbeat, abort 0x06010002) and has no 100Ch/100Dh (node guarding): it will "
+    "not stop by itself if the gateway dies";
+
+TEST(GatewayWatch, RefusedConsumerEntryWithoutGuardingRunsWithOneWarning) {
+  BusHarness h(one_drive("generic-fixed-heartbeat"));
+  ASSERT_TRUE(h.run_until([&] { return h.all_up(); }, 5s)) << h.events_text() << h.bus->link_detail(0);
+  h.run_until([] { return false; }, 1s);
+  EXPECT_TRUE(h.all_up());
+  EXPECT_EQ(count_events(h, kRefusedUnwatched), 1U) << h.events_text();
+  EXPECT_EQ(count_events(h, "neither 1016h"), 0U) << h.events_text();
+  EXPECT_GT(h.drive("x").nmt().heartbeat_period(), 0U);  // the master still watches the drive
+  EXPECT_EQ(h.drive("x").nmt().counters().guard_replies, 0U);
+}
+
+TEST(GatewayWatch, RequiredRefusesADriveThatRefusesTheConsumerEntryAndHasNoGuarding) {
+  BusHarness h(one_drive("generic-fixed-heartbeat", "gateway_watch: required"));
+  h.run_until([] { return false; }, 3s);
+  EXPECT_NE(h.bus->link_state(0), core::LinkState::Operational);
+  const std::string detail(h.bus->link_detail(0));
+  EXPECT_NE(detail.find("node 5 refused 1016h:01 (consumer heartbeat) and has no 100Ch/100Dh (node guarding)"),
+            std::string::npos)
+      << detail;
+  EXPECT_NE(detail.find("gateway_watch: required"), std::string::npos) << detail;
+  EXPECT_NE(detail.find("abort 0x06010002"), std::string::npos) << detail;
+  EXPECT_EQ(count_events(h, kRefusedUnwatched), 0U);
+}
+
+TEST(GatewayWatch, HeartbeatDemandsThatTheDriveTakesTheConsumerEntry) {
+  BusHarness h(one_drive("generic-fixed-heartbeat", "gateway_watch: heartbeat"));
+  h.run_until([] { return false; }, 3s);
+  EXPECT_NE(h.bus->link_state(0), core::LinkState::Operational);
+  const std::string detail(h.bus->link_detail(0));
+  EXPECT_NE(detail.find("write 1016h:01"), std::string::npos) << detail;
+  EXPECT_NE(detail.find("0x06010002"), std::string::npos) << detail;
+}
+
 TEST(GatewayWatch, BadValueIsAConfigErrorNamingTheChoices) {
   try {
     (void)config::load_plan_from_string(one_drive("generic-no-watch", "gateway_watch: sometimes"), "t.yaml");

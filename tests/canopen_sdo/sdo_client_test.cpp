@@ -46,7 +46,8 @@ void play_client(SdoClient& c, const Conversation& conv, std::uint32_t rx, std::
 
 TEST(SdoClientVectors, Sd6Tv1SegmentedDownloadNode5) {
   SdoClient c = client_for(5);
-  const auto id = c.write_bytes(0, kTvObject, counting(16));
+  const Bytes payload = counting(16);  // write_from() sends from this buffer: it outlives the request
+  const auto id = c.write_from(0, kTvObject, payload);
   ASSERT_NE(id, kNoSdoRequest);
   play_client(c, sd6_tv1(), 0x605, 0x585);
   EXPECT_EQ(c.result(id).status, SdoStatus::Done);
@@ -312,7 +313,8 @@ TEST(SdoClientErrors, ToggleErrorInUploadAbortsWith05030000) {
 TEST(SdoClientErrors, ToggleErrorInDownloadAbortsWith05030000) {
   SdoClient c = client_for(5);
   TxQueue tx;
-  const auto id = c.write_bytes(0, kTvObject, counting(16));
+  const Bytes payload = counting(16);  // write_from() sends from this buffer: it outlives the request
+  const auto id = c.write_from(0, kTvObject, payload);
   poll(c, kT0, tx);
   c.on_frame(frame(0x585, {0x60, 0x00, 0x20, 0x01, 0, 0, 0, 0}), kT0);
   poll(c, kT0, tx);
@@ -391,23 +393,23 @@ TEST(SdoClientRequests, CancelWhileQueuedSkipsTheRequest) {
   EXPECT_EQ(c.pending(0), 0U);
 }
 
-// Cancelling the transfer in flight lets it finish on the wire (the drive is in the middle of it),
-// forgets its result, and then goes on with the queue.
+// Cancelling a transfer in flight into the client's own slot lets it finish on the wire (the drive
+// is in the middle of it), forgets its result, and then goes on with the queue.
 TEST(SdoClientRequests, CancelInFlightFinishesOnTheWireAndDropsTheResult) {
   SdoClient c = client_for(5);
   TxQueue tx;
-  const auto a = c.write_bytes(0, kTvObject, counting(16));
+  const auto a = c.read(0, kTvObject);
   const auto b = c.read(0, {0x1000, 0});
-  poll(c, kT0, tx);
-  c.on_frame(frame(0x585, {0x60, 0x00, 0x20, 0x01, 0, 0, 0, 0}), kT0);
+  EXPECT_EQ(poll(c, kT0, tx), (Frames{{0x605, {0x40, 0x00, 0x20, 0x01, 0, 0, 0, 0}}}));
+  c.on_frame(frame(0x585, {0x41, 0x00, 0x20, 0x01, 16, 0, 0, 0}), kT0);
   c.cancel(a);
   EXPECT_EQ(c.result(a).status, SdoStatus::Unknown);
-  EXPECT_EQ(poll(c, kT0, tx), (Frames{{0x605, {0x00, 1, 2, 3, 4, 5, 6, 7}}}));
-  c.on_frame(frame(0x585, {0x20, 0, 0, 0, 0, 0, 0, 0}), kT0);
-  EXPECT_EQ(poll(c, kT0, tx), (Frames{{0x605, {0x10, 8, 9, 10, 11, 12, 13, 14}}}));
-  c.on_frame(frame(0x585, {0x30, 0, 0, 0, 0, 0, 0, 0}), kT0);
-  EXPECT_EQ(poll(c, kT0, tx), (Frames{{0x605, {0x0B, 15, 16, 0, 0, 0, 0, 0}}}));
-  c.on_frame(frame(0x585, {0x20, 0, 0, 0, 0, 0, 0, 0}), kT0);
+  EXPECT_EQ(poll(c, kT0, tx), (Frames{{0x605, {0x60, 0, 0, 0, 0, 0, 0, 0}}}));
+  c.on_frame(frame(0x585, {0x00, 1, 2, 3, 4, 5, 6, 7}), kT0);
+  EXPECT_EQ(poll(c, kT0, tx), (Frames{{0x605, {0x70, 0, 0, 0, 0, 0, 0, 0}}}));
+  c.on_frame(frame(0x585, {0x10, 8, 9, 10, 11, 12, 13, 14}), kT0);
+  EXPECT_EQ(poll(c, kT0, tx), (Frames{{0x605, {0x60, 0, 0, 0, 0, 0, 0, 0}}}));
+  c.on_frame(frame(0x585, {0x0B, 15, 16, 0, 0, 0, 0, 0}), kT0);
   EXPECT_EQ(c.result(a).status, SdoStatus::Unknown);
   EXPECT_EQ(poll(c, kT0, tx), (Frames{{0x605, {0x40, 0x00, 0x10, 0x00, 0, 0, 0, 0}}}));
   EXPECT_EQ(c.result(b).status, SdoStatus::InFlight);
@@ -488,11 +490,11 @@ TEST(SdoClientRequests, QueueDepthAndUntakenResultsAreBounded) {
 
 TEST(SdoClientRequests, InvalidArgumentsAreRefused) {
   SdoClient c = client_for(5);
-  const std::array<std::uint8_t, SdoClient::kMaxData + 1> too_long{};
+  const Bytes too_long(SdoClient::kMaxBuffer + 1, 0);
   EXPECT_EQ(c.write(0, {0x2000, 0}, 1, 0), kNoSdoRequest);
   EXPECT_EQ(c.write(0, {0x2000, 0}, 1, 5), kNoSdoRequest);
-  EXPECT_EQ(c.write_bytes(0, {0x2000, 0}, {}), kNoSdoRequest);
-  EXPECT_EQ(c.write_bytes(0, {0x2000, 0}, too_long), kNoSdoRequest);
+  EXPECT_EQ(c.write_from(0, {0x2000, 0}, {}), kNoSdoRequest);
+  EXPECT_EQ(c.write_from(0, {0x2000, 0}, too_long), kNoSdoRequest);
   EXPECT_EQ(c.read(0, {0x2000, 0}, 5), kNoSdoRequest);
   EXPECT_EQ(c.read(1, {0x2000, 0}), kNoSdoRequest);
   EXPECT_EQ(c.read(-1, {0x2000, 0}), kNoSdoRequest);
@@ -642,7 +644,7 @@ TEST(SdoClientAllocation, CyclicPathAllocatesNothing) {
   {
     const drivegate::test::AllocationScope scope;
     const auto up_id = c.read(0, kTvObject);
-    const auto dn_id = c.write_bytes(1, kTvObject, payload);
+    const auto dn_id = c.write_from(1, kTvObject, payload);
     const auto gone = c.write(0, {0x6040, 0}, 6, 2);
     c.cancel(gone);
     core::TimePoint now = kT0;

@@ -84,7 +84,7 @@ TEST(SdoLoopback, EveryPayloadSizeBothDirectionsWithoutAllocation) {
     std::array<std::uint8_t, kMax> payload{};
     for (std::size_t n = 1; n <= kMax; ++n) {
       for (std::size_t i = 0; i < n; ++i) payload[i] = static_cast<std::uint8_t>(n * 7 + i);
-      const auto w = client.write_bytes(0, kObject, {payload.data(), n});
+      const auto w = client.write_from(0, kObject, {payload.data(), n});
       bus.run(kT0);
       write_frames[n] = bus.take_client_frames();
       written[n] = client.take(w).status == SdoStatus::Done;
@@ -161,9 +161,9 @@ TEST(SdoLoopback, SeveralChannelsInterleaved) {
   const Bytes a = counting(20);
   const Bytes b(33, 0x5A);
   const Bytes c = {0xC0, 0xFF, 0xEE};
-  const auto wa = client.write_bytes(0, kObject, a);
-  const auto wb = client.write_bytes(1, kObject, b);
-  const auto wc = client.write_bytes(2, kObject, c);
+  const auto wa = client.write_from(0, kObject, a);
+  const auto wb = client.write_from(1, kObject, b);
+  const auto wc = client.write_from(2, kObject, c);
   const auto ra = client.read(0, kObject);
   const auto rb = client.read(1, kObject);
   const auto rc = client.read(2, kObject);

@@ -326,7 +326,7 @@ TEST_F(CanopenProfileErrors, ScalarFields) {
   colour: red
 )" + kMaps);
   EXPECT_REPORTED(e, at(6, 21) + "canopen.device_type_mask: must be an integer in 1..4294967295, got \"0\"");
-  EXPECT_REPORTED(e, at(7, 12) + "canopen.persona: must be one of akd, nord-sk500p, stoeber-sd6, generic, generic-no-heartbeat, generic-no-watch, got \"akdd\", "
+  EXPECT_REPORTED(e, at(7, 12) + "canopen.persona: must be one of akd, nord-sk500p, stoeber-sd6, generic, generic-no-heartbeat, generic-no-watch, generic-fixed-heartbeat, got \"akdd\", "
                                  "did you mean \"akd\"?");
   EXPECT_REPORTED(e, at(8, 17) + "canopen.sdo_channels: must be an integer in 1..4, got \"5\"");
   EXPECT_REPORTED(e, at(9, 18) + "canopen.error_control: must be one of heartbeat, guarding, got \"polling\"");

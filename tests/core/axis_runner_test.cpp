@@ -133,6 +133,23 @@ TEST_F(RunnerFixture, ControllerRefusalBecomesRejectedWithItsReason) {
   EXPECT_EQ(out.replies[0].reason.view(), "axis is in fault: send fault_reset first");
 }
 
+// The snapshot says why the link is in its state and since when: the detail follows the bus
+// (also while the state stays), the time only changes with the state.
+TEST_F(RunnerFixture, SnapshotCarriesTheLinkDetailAndSinceWhen) {
+  EXPECT_EQ(runner.snapshot().link_since_ns, to_ns(now));
+  const TimePoint lost = now + 10ms;
+  runner.observe_link(lost, LinkState::Lost, "node 35 stopped answering (heartbeat timeout)", out);
+  runner.update(lost, out);
+  EXPECT_EQ(runner.snapshot().link, LinkState::Lost);
+  EXPECT_EQ(runner.snapshot().link_detail.view(), "node 35 stopped answering (heartbeat timeout)");
+  EXPECT_EQ(runner.snapshot().link_since_ns, to_ns(lost));
+  const TimePoint later = lost + 500ms;
+  runner.observe_link(later, LinkState::Lost, "node 35: asking it again after 500 ms (SDO read of 1000h)", out);
+  runner.update(later, out);
+  EXPECT_EQ(runner.snapshot().link_detail.view(), "node 35: asking it again after 500 ms (SDO read of 1000h)");
+  EXPECT_EQ(runner.snapshot().link_since_ns, to_ns(lost));
+}
+
 TEST_F(RunnerFixture, CommandsAreRejectedWhileTheLinkIsDown) {
   runner.update(now, LinkState::Lost, out);
   EXPECT_EQ(ctl.link_losses, 1);

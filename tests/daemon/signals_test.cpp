@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <regex>
@@ -73,6 +74,15 @@ class Signals : public ::testing::Test {
   void expect_orderly_stop(std::optional<int> rc) {
     ASSERT_TRUE(rc.has_value()) << process_->log();
     EXPECT_EQ(*rc, 0) << process_->log();
+    // The daemon wrote its last states before it exited, but this client takes them in on its own
+    // DDS threads, which a loaded machine may run well after the exit: wait for them to arrive.
+    const auto all_disabled = [&] {
+      const auto states = client_->states();
+      return !states.empty() && std::all_of(states.begin(), states.end(), [](const client::AxisState& s) {
+        return s.state == "switch_on_disabled";
+      });
+    };
+    client_->wait_until(all_disabled, 5s);
     for (const auto& s : client_->states())
       EXPECT_EQ(s.state, "switch_on_disabled") << s.axis << " ended in " << s.state << "\n" << process_->log();
     EXPECT_NE(process_->log().find("2 axes quick-stopped"), std::string::npos) << process_->log();

@@ -378,6 +378,39 @@ TEST(DdsBridge, StatesArriveAtAboutTheConfiguredRate) {
   EXPECT_EQ(c.buses()[0].cycles, 42U);
 }
 
+// axis_link: written when the link state or its detail changes, with the axis' bus, bus type and
+// address; a client that joins later gets the present one (transient-local).
+TEST(DdsBridge, LinkDetailIsPublishedWhenItChanges) {
+  FakeRuntime rt("gw1", {"x", "y"});
+  rt.set_link(0, core::LinkState::Configuring, "node 35 booted: configuring it", 1'000);
+  daemon::DdsBridge bridge(rt, bridge_options());
+  bridge.start();
+  Client c(client_options());
+  ASSERT_TRUE(c.wait_until([&] { return c.link("x").has_value() && c.link("y").has_value(); }, kTimeout));
+  auto x = *c.link("x");
+  EXPECT_EQ(x.gateway, "gw1");
+  EXPECT_EQ(x.bus, "can0");
+  EXPECT_EQ(x.bus_type, "canopen");
+  EXPECT_EQ(x.address, 35U);
+  EXPECT_EQ(x.link, "configuring");
+  EXPECT_EQ(x.detail, "node 35 booted: configuring it");
+  EXPECT_EQ(x.since_ns, 1'000);
+  EXPECT_EQ(c.link("y")->link, "operational");
+
+  const std::string failed = "node 35: identity: 1018h:01 reads 0x0000006A, expected 0x00000059";
+  rt.set_link(0, core::LinkState::Offline, failed, 2'000);
+  ASSERT_TRUE(c.wait_until([&] { return c.link("x")->detail == failed; }, kTimeout));
+  EXPECT_EQ(c.link("x")->link, "offline");
+  EXPECT_EQ(c.link("x")->since_ns, 2'000);
+  // The detail alone changes: published too.
+  rt.set_link(0, core::LinkState::Offline, "node 35: asking it again after 1000 ms (SDO read of 1000h)", 2'000);
+  ASSERT_TRUE(c.wait_until([&] { return c.link("x")->detail.find("asking it again") != std::string::npos; }, kTimeout));
+
+  Client late(client_options());
+  ASSERT_TRUE(late.wait_until([&] { return late.link("x").has_value(); }, kTimeout));
+  EXPECT_NE(late.link("x")->detail.find("asking it again"), std::string::npos);
+}
+
 TEST(DdsBridge, ParameterGetAndSetRoundTrip) {
   FakeRuntime rt("gw1", {"x", "y"});
   rt.set_object(1, 0x6060, 0, core::ParamType::I8, "1");

@@ -88,9 +88,9 @@ TEST_F(Drivegatectl, ListStatusAndParam) {
   r = ctl("status x");
   EXPECT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("switch_on_disabled"), std::string::npos) << r.output;
-  // The link has a column of its own.
-  EXPECT_NE(r.output.find("GATEWAY  AXIS  LINK         STATE"), std::string::npos) << r.output;
-  EXPECT_NE(r.output.find("x     operational  switch_on_disabled"), std::string::npos) << r.output;
+  // The address (a CANopen node-ID in decimal and hex) and the link have columns of their own.
+  EXPECT_NE(r.output.find("GATEWAY  AXIS  ADDRESS    LINK         STATE"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("x     35 (0x23)  operational  switch_on_disabled"), std::string::npos) << r.output;
   rt_.set_object(0, 0x6061, 0, core::ParamType::I8, "-3");
   r = ctl("param get x 6061h:0");
   EXPECT_EQ(r.status, 0) << r.output;
@@ -100,6 +100,52 @@ TEST_F(Drivegatectl, ListStatusAndParam) {
   EXPECT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("x 6081h:00 = 70000 (0x00011170, UNSIGNED32) written"), std::string::npos) << r.output;
   EXPECT_EQ(rt_.object(0, 0x6081, 0), (std::vector<std::uint8_t>{0x70, 0x11, 0x01, 0x00}));
+}
+
+// list shows each axis' address; JSON keeps the number.
+TEST_F(Drivegatectl, ListShowsNodeIdsInDecimalAndHex) {
+  CtlRun r = ctl("list");
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("x  bus=can0  address=35 (0x23)  device=sim"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("y  bus=can0  address=36 (0x24)  device=sim"), std::string::npos) << r.output;
+  r = ctl("--json list");
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find(R"("name":"x","bus":"can0","bus_type":"canopen","address":35,)"), std::string::npos)
+      << r.output;
+}
+
+// status AXIS says why the link is in its state (node-IDs in hex too) and since when; --json
+// carries the detail as the gateway wrote it and the numbers.
+TEST_F(Drivegatectl, StatusOfAnAxisShowsWhyItsLinkIsInItsState) {
+  const std::string why =
+      "node 35: identity: 1018h:01 reads 0x0000006A, expected 0x00000059; vendor-ID (1018h:01) of a generic-cia402";
+  rt_.set_link(0, core::LinkState::Offline, why, FakeRuntime::kStampNs - 2'400'000'000);
+  CtlRun r = ctl("status x");
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("x     35 (0x23)  offline"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("x: link offline for 2.4 s (since "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("  node 35 (0x23): identity: 1018h:01 reads 0x0000006A, expected 0x00000059; vendor-ID"),
+            std::string::npos)
+      << r.output;
+  EXPECT_EQ(r.output.find("y: link"), std::string::npos) << "only the axes asked for: " << r.output;
+
+  r = ctl("--json status x");
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find(R"("link":"offline","bus":"can0","bus_type":"canopen","address":35,)"), std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find(R"("link_detail":")" + why + R"(")"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(R"("link_since_ns":97600000000,)"), std::string::npos) << r.output;
+
+}
+
+// Event texts of a canopen axis show node-IDs in hex too.
+TEST_F(Drivegatectl, EventsShowNodeIdsInDecimalAndHex) {
+  rt_.push_event(0, core::EventKind::LinkChanged, "link operational -> lost: node 35 stopped answering (heartbeat)");
+  const CtlRun r = ctl("events x");
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("link_changed  link operational -> lost: node 35 (0x23) stopped answering"),
+            std::string::npos)
+      << r.output;
 }
 
 // Every type prints the way people read it: identity in hex first, strings quoted, long byte

@@ -10,6 +10,8 @@ FakeRuntime::FakeRuntime(std::string gateway, std::vector<std::string> axis_name
     daemon::AxisInfo a;
     a.name = std::move(name);
     a.bus = "can0";
+    a.bus_type = "canopen";
+    a.address = static_cast<std::uint32_t>(35 + axes_.size());  // x: node 35 (0x23), y: 36 (0x24)
     a.device = "sim";
     a.unit = "mm";
     a.modes.add(core::Mode::ProfilePosition);
@@ -107,10 +109,27 @@ core::AxisSnapshot FakeRuntime::snapshot(std::size_t axis_id) const {
   core::AxisSnapshot s;
   s.axis = static_cast<core::AxisIndex>(axis_id);
   s.state = core::AxisState::SwitchOnDisabled;
-  s.link = core::LinkState::Operational;
   s.mode = core::Mode::ProfilePosition;
   s.position = 10.0 * static_cast<double>(axis_id) + 1.5;
+  s.stamp_ns = kStampNs;
+  std::lock_guard lock(mutex_);
+  const auto it = links_.find(axis_id);
+  if (it == links_.end()) {
+    s.link = core::LinkState::Operational;
+  } else {
+    s.link = it->second.link;
+    s.link_detail = it->second.link_detail;
+    s.link_since_ns = it->second.link_since_ns;
+  }
   return s;
+}
+
+void FakeRuntime::set_link(std::size_t axis_id, core::LinkState link, std::string_view detail, std::int64_t since_ns) {
+  std::lock_guard lock(mutex_);
+  core::AxisSnapshot& s = links_[axis_id];
+  s.link = link;
+  s.link_detail.assign(detail);
+  s.link_since_ns = since_ns;
 }
 
 daemon::BusStatus FakeRuntime::bus_status(std::size_t /*bus*/) const {

@@ -39,6 +39,10 @@ class FakeRuntime final : public daemon::Runtime {
   // Parameter names lookup_parameter() knows (for every axis).
   void add_name(std::string name, daemon::ParameterLookup object);
   void push_event(std::size_t axis_id, core::EventKind kind, std::string_view text);
+  // The axis' link from now on (default: operational, no detail, since 0 = not known).
+  void set_link(std::size_t axis_id, core::LinkState link, std::string_view detail, std::int64_t since_ns);
+  // The stamp of every snapshot: 100 s of gateway monotonic time.
+  static constexpr std::int64_t kStampNs = 100'000'000'000;
   struct Received {
     std::size_t axis_id;
     core::Command command;
@@ -64,6 +68,7 @@ class FakeRuntime final : public daemon::Runtime {
   std::map<std::tuple<std::size_t, std::uint16_t, std::uint8_t>, Object> objects_;
   daemon::Outbox pending_;
   daemon::WakeSignal signal_;  // notified whenever pending_ grows, as the gateway's cycle threads do
+  std::map<std::size_t, core::AxisSnapshot> links_;  // link, link_detail, link_since_ns per axis
 };
 
 }  // namespace drivegate::dds_test

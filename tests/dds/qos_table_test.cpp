@@ -65,7 +65,8 @@ TEST(QosTable, KeysMatchTheIdl) {
   const std::map<std::string, std::string> type_of{
       {"axis_state", "AxisState"},       {"axis_command", "AxisCommand"}, {"command_reply", "CommandReply"},
       {"setpoint", "Setpoint"},          {"axis_event", "AxisEvent"},     {"bus_status", "BusStatus"},
-      {"param_request", "ParameterRequest"}, {"param_reply", "ParameterReply"},   {"gateway_info", "GatewayInfo"}};
+      {"param_request", "ParameterRequest"},  {"param_reply", "ParameterReply"},   {"gateway_info", "GatewayInfo"},
+      {"axis_link", "AxisLink"}};
   for (const auto& q : msg::qos_table()) {
     const std::string type = type_of.at(std::string(msg::topic_suffix(q.topic)));
     const auto at = idl.find("struct " + type + " {");

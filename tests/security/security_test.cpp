@@ -151,6 +151,10 @@ TEST_F(Security, AnObserverReadsStateButCannotCommand) {
   const std::string status = ctl("observer", "status x");
   EXPECT_EQ(status.rfind("0:", 0), 0u) << status;
   EXPECT_NE(status.find("switch_on_disabled"), std::string::npos) << status;
+  // The link detail (axis_link) is the observer's to read as well.
+  EXPECT_NE(status.find("x: link operational for "), std::string::npos) << status;
+  ASSERT_TRUE(obs.wait_until([&] { return obs.link("x").has_value(); }, 5s));
+  EXPECT_EQ(obs.link("x")->link, "operational");
 }
 
 // No identity, a certificate of another CA, an expired one: nothing to see, nothing to command.

@@ -17,6 +17,7 @@ void NodeBoot::start() noexcept {
   status_ = steps_.empty() ? Status::Done : Status::Running;
   next_ = 0;
   found_ = 0;
+  refusal_ = 0;
   request_ = kNoSdoRequest;
   failure_.assign("");
 }
@@ -50,7 +51,10 @@ NodeBoot::Status NodeBoot::step(SdoClient& sdo, ProcessImage& image) noexcept {
   if ((found_ & s.if_found) != s.if_found || (found_ & s.if_missing) != 0) return advance();
   if (s.kind == BootStep::Kind::Fail) {
     status_ = Status::Failed;
-    failure_.format("%s: %s", s.stage.c_str(), s.why.c_str());
+    if (refusal_ != 0)
+      failure_.format("%s: %s (abort 0x%08X)", s.stage.c_str(), s.why.c_str(), refusal_);
+    else
+      failure_.format("%s: %s", s.stage.c_str(), s.why.c_str());
     return status_;
   }
   const auto size = cia402::size_of(s.def.type);
@@ -70,7 +74,11 @@ NodeBoot::Status NodeBoot::step(SdoClient& sdo, ProcessImage& image) noexcept {
   if (r.status == SdoStatus::Failed) {
     // A seed the drive cannot answer leaves the image value as it is (0 at first).
     const bool missing = missing_object(r.abort_code);
-    if (s.kind != BootStep::Kind::Seed && !(s.kind == BootStep::Kind::Probe && missing) && !(s.optional && missing)) {
+    if (s.kind == BootStep::Kind::Write && s.refused != 0 && r.abort_code != sdo_abort_code::kTimeout) {
+      found_ = static_cast<std::uint8_t>((found_ & ~s.refused) | s.sets);
+      refusal_ = r.abort_code;
+    } else if (s.kind != BootStep::Kind::Seed && !(s.kind == BootStep::Kind::Probe && missing) &&
+               !(s.optional && missing)) {
       fail_abort(s, r.abort_code);
       return status_;
     }

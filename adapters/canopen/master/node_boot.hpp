@@ -42,6 +42,11 @@ struct BootStep {
   std::uint8_t sets = 0;
   std::uint8_t if_found = 0;
   std::uint8_t if_missing = 0;
+  // Write: non-zero makes a refusal (any abort from the drive; a timeout still fails the boot)
+  // a finding instead of a failure: found() loses these bits and gains `sets`, and refusal()
+  // keeps the abort code. Later steps branch on it (a drive whose 1016h:01 takes no entry is
+  // guarded instead).
+  std::uint8_t refused = 0;
 };
 
 class NodeBoot {
@@ -62,8 +67,11 @@ class NodeBoot {
   [[nodiscard]] std::size_t position() const noexcept { return next_; }
   [[nodiscard]] std::size_t size() const noexcept { return steps_.size(); }
   [[nodiscard]] const core::FixedString<200>& failure() const noexcept { return failure_; }
-  // The bits the Probe steps of this run set (what the drive turned out to have).
+  // The bits the Probe steps (and refused Write steps) of this run set: what the drive turned out
+  // to have.
   [[nodiscard]] std::uint8_t found() const noexcept { return found_; }
+  // The abort code of the last refused Write this run took as a finding (BootStep::refused), 0: none.
+  [[nodiscard]] std::uint32_t refusal() const noexcept { return refusal_; }
   [[nodiscard]] const std::vector<BootStep>& steps() const noexcept { return steps_; }
 
  private:
@@ -74,6 +82,7 @@ class NodeBoot {
   Status status_ = Status::Idle;
   std::size_t next_ = 0;
   std::uint8_t found_ = 0;
+  std::uint32_t refusal_ = 0;
   SdoRequestId request_ = kNoSdoRequest;
   core::FixedString<200> failure_;
 };

@@ -74,11 +74,6 @@ SdoRequestId SdoClient::write(int channel, ObjectId object, std::uint32_t value,
   return submit(channel, Kind::Download, object, 0, {bytes.data(), size});
 }
 
-SdoRequestId SdoClient::write_bytes(int channel, ObjectId object, std::span<const std::uint8_t> data) noexcept {
-  if (data.empty() || data.size() > kMaxData) return kNoSdoRequest;
-  return submit(channel, Kind::Download, object, 0, data);
-}
-
 SdoRequestId SdoClient::read_into(int channel, ObjectId object, std::span<std::uint8_t> into,
                                   std::uint8_t expected_size) noexcept {
   if (expected_size > 4 || into.empty() || into.size() > kMaxBuffer) return kNoSdoRequest;

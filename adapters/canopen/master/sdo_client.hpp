@@ -96,8 +96,6 @@ class SdoClient {
   SdoRequestId read(int channel, ObjectId object, std::uint8_t expected_size = 0) noexcept;
   // Download (write) of 1..4 bytes (expedited).
   SdoRequestId write(int channel, ObjectId object, std::uint32_t value, std::uint8_t size) noexcept;
-  // Download of up to kMaxData bytes (expedited when <= 4, else segmented).
-  SdoRequestId write_bytes(int channel, ObjectId object, std::span<const std::uint8_t> data) noexcept;
   // Upload into / download from the caller's buffer (up to kMaxBuffer bytes), which stays in use
   // until take() or cancel(). `expected_size` as for read().
   SdoRequestId read_into(int channel, ObjectId object, std::span<std::uint8_t> into,

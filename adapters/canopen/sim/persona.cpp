@@ -5,6 +5,7 @@
 #include <string>
 
 #include "adapters/canopen/wire/pdo_mapping.hpp"
+#include "adapters/canopen/wire/sdo_codec.hpp"
 
 namespace drivegate::canopen::sim {
 namespace {
@@ -305,8 +306,16 @@ constexpr Persona generic_without(std::string_view name, bool heartbeat_consumer
 }
 constexpr Persona kGenericNoHeartbeat = generic_without("generic-no-heartbeat", false, true);
 constexpr Persona kGenericNoWatch = generic_without("generic-no-watch", false, false);
+// A drive whose 1016h:01 entry is fixed (read-only): it has 1016h but takes no gateway entry.
+constexpr Persona fixed_heartbeat() {
+  Persona p = generic_without("generic-fixed-heartbeat", true, false);
+  p.heartbeat_consumer_abort = sdo_abort_code::kReadOnly;
+  return p;
+}
+constexpr Persona kGenericFixedHeartbeat = fixed_heartbeat();
 
-constexpr std::array<const Persona*, 6> kAll{&kAkd, &kNord, &kSd6, &kGeneric, &kGenericNoHeartbeat, &kGenericNoWatch};
+constexpr std::array<const Persona*, 7> kAll{
+    &kAkd, &kNord, &kSd6, &kGeneric, &kGenericNoHeartbeat, &kGenericNoWatch, &kGenericFixedHeartbeat};
 
 }  // namespace
 

@@ -8,6 +8,8 @@
 //   generic      a drive that follows CiA 301/402 to the letter
 //   generic-no-heartbeat  the same without 1016h: it can watch the gateway by node guarding only
 //   generic-no-watch      the same without 1016h, 100Ch and 100Dh: it cannot watch the gateway
+//   generic-fixed-heartbeat  1016h with a fixed entry (writes of 1016h:01 refused with 06010002h)
+//                         and no 100Ch/100Dh: it cannot watch the gateway either
 #include <array>
 #include <cstdint>
 #include <optional>
@@ -81,6 +83,7 @@ struct Persona {
   int sdo_channels = 1;               // SDO servers; channels 2..4 use the SD6 COB-ID scheme (wire/cob_id.hpp)
   bool upload_without_size = false;   // expedited uploads answered with 42h
   bool heartbeat_consumer = true;     // 1016h with one entry
+  std::uint32_t heartbeat_consumer_abort = 0;  // non-zero: every write of 1016h:01 is refused with it
   bool node_guarding = true;          // 100Ch guard time and 100Dh life time factor
   bool emcy_inhibit = true;           // 1015h
   bool emcy_cob_writable = true;      // 1014h (only its valid bit: the EMCY always goes to 80h + node-ID)

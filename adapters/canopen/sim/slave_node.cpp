@@ -613,6 +613,7 @@ std::optional<std::uint32_t> SlaveNode::write_comm(ObjectId id, std::uint32_t ra
       if (!p.heartbeat_consumer) break;
       if (id.sub == 0) return abort::kReadOnly;
       if ((code = check(1, 4)) != 0) return code;
+      if (p.heartbeat_consumer_abort != 0) return p.heartbeat_consumer_abort;
       if ((raw >> 24) != 0) return abort::kValueRange;  // bits 31..24 reserved (AKD part 1 §11.2)
       nmt_.set_heartbeat_consumer(raw);
       return 0;
