@@ -30,7 +30,7 @@
 #include "adapters/canopen/canopen_bus.hpp"
 #include "adapters/canopen/sim/sim_network.hpp"
 #include "adapters/sim/sim_bus.hpp"
-#include "config/canopen_load.hpp"
+#include "config/canopen/load.hpp"
 #include "config/loader.hpp"
 #include "core/bus_runner.hpp"
 #include "tests/support/alloc_counter.hpp"

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <limits>
 
-#include "config/canopen_axis.hpp"
+#include "config/canopen/axis_section.hpp"
 #include "config/text_util.hpp"
 
 namespace drivegate::config {

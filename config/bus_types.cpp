@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include "config/canopen_bus.hpp"
+#include "config/canopen/bus_options.hpp"
 
 namespace drivegate::config {
 

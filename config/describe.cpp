@@ -4,8 +4,8 @@
 #include <cstdio>
 #include <sstream>
 
-#include "config/canopen_bus.hpp"
-#include "config/canopen_load.hpp"
+#include "config/canopen/bus_options.hpp"
+#include "config/canopen/load.hpp"
 #include "config/object_text.hpp"
 #include "config/scalars.hpp"
 #include "config/text_util.hpp"

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <set>
 
-#include "config/canopen_profile.hpp"
+#include "config/canopen/device_section.hpp"
 #include "config/object_text.hpp"
 #include "config/scalars.hpp"
 #include "config/text_util.hpp"

@@ -7,8 +7,8 @@
 #include <thread>
 
 #include "config/axis_reader.hpp"
-#include "config/canopen_bus.hpp"
-#include "config/canopen_load.hpp"
+#include "config/canopen/bus_options.hpp"
+#include "config/canopen/load.hpp"
 #include "config/text_util.hpp"
 #include "config/yaml_reader.hpp"
 

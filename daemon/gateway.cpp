@@ -6,8 +6,8 @@
 #include <sstream>
 #include <thread>
 
-#include "config/eds.hpp"
-#include "config/parameter_names.hpp"
+#include "config/canopen/eds.hpp"
+#include "config/canopen/parameter_names.hpp"
 #include "daemon/bus_factory.hpp"
 #include "profiles/cia402/standard_types.hpp"
 

@@ -8,7 +8,7 @@
 #include <cstdlib>
 #include <string_view>
 
-#include "config/eds.hpp"
+#include "config/canopen/eds.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace drivegate::config;

@@ -4,7 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "config/loader.hpp"
-#include "config/parameter_names.hpp"
+#include "config/canopen/parameter_names.hpp"
 #include "tests/canopen_sim/sim_test_support.hpp"
 
 namespace drivegate::canopen::sim::test {

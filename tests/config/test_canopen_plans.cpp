@@ -7,7 +7,7 @@
 #include <sstream>
 
 #include "config/describe.hpp"
-#include "config/eds.hpp"
+#include "config/canopen/eds.hpp"
 #include "tests/config/test_support.hpp"
 
 namespace drivegate::config {

@@ -1,4 +1,4 @@
-#include "config/canopen_profile.hpp"
+#include "config/canopen/device_section.hpp"
 
 #include <algorithm>
 #include <cstdio>
@@ -6,7 +6,7 @@
 #include <sstream>
 
 #include "config/object_text.hpp"
-#include "config/parameter_names.hpp"
+#include "config/canopen/parameter_names.hpp"
 #include "config/text_util.hpp"
 #include "profiles/cia402/standard_types.hpp"
 

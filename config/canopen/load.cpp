@@ -1,4 +1,4 @@
-#include "config/canopen_load.hpp"
+#include "config/canopen/load.hpp"
 
 #include <cstdio>
 

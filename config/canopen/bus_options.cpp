@@ -1,4 +1,4 @@
-#include "config/canopen_bus.hpp"
+#include "config/canopen/bus_options.hpp"
 
 #include <algorithm>
 #include <array>

@@ -1,9 +1,9 @@
-#include "config/canopen_axis.hpp"
+#include "config/canopen/axis_section.hpp"
 
 #include <algorithm>
 
-#include "config/canopen_profile.hpp"
-#include "config/eds.hpp"
+#include "config/canopen/device_section.hpp"
+#include "config/canopen/eds.hpp"
 #include "config/object_text.hpp"
 #include "config/scalars.hpp"
 #include "config/text_util.hpp"
