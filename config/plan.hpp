@@ -1,8 +1,12 @@
 #pragma once
 // The checked, compiled form of a configuration file: everything the daemon needs to build its
 // buses and axes, with every value validated and converted (see config/README.md for the file).
+// Only what every bus type shares is here; a bus type's own parts (its typed options, an axis' and
+// a device profile's section of that type) are Sections, defined in its folder (config/canopen/plan.hpp).
+#include <any>
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <variant>
@@ -11,12 +15,43 @@
 #include "core/axis_spec.hpp"
 #include "core/axis_types.hpp"
 #include "core/clock.hpp"
-#include "config/canopen/plan.hpp"
-#include "config/sim/plan.hpp"
 #include "core/units.hpp"
 #include "profiles/cia402/objects.hpp"
 
 namespace drivegate::config {
+
+struct BusTypeInfo;  // bus_types.hpp
+
+// The parts of a plan that belong to one bus type, each held by its type: a bus' typed options, an
+// axis' section, a device profile's section (CanopenBusOptions, SimAxisOptions, CanopenDeviceSpec).
+class Sections {
+ public:
+  // The part of type T, or nullptr.
+  template <typename T>
+  [[nodiscard]] const T* find() const noexcept {
+    for (const auto& p : parts_)
+      if (const T* t = std::any_cast<T>(&p)) return t;
+    return nullptr;
+  }
+  // The part of type T; a default-made T when there is none (a profile without that section).
+  template <typename T>
+  [[nodiscard]] const T& get() const {
+    if (const T* t = find<T>()) return *t;
+    static const T kAbsent{};
+    return kAbsent;
+  }
+  // The part of type T to fill in; added, default-made, when there is none. The reference holds
+  // until another part is added.
+  template <typename T>
+  T& edit() {
+    for (auto& p : parts_)
+      if (T* t = std::any_cast<T>(&p)) return *t;
+    return std::any_cast<T&>(parts_.emplace_back(std::in_place_type<T>));
+  }
+
+ private:
+  std::vector<std::any> parts_;
+};
 
 // DDS Security files of the gateway (absolute paths; idl/dds_security.hpp says what each is).
 struct SecurityPlan {
@@ -81,7 +116,11 @@ struct DeviceProfile {
   std::map<std::uint32_t, std::string> fault_texts;
   std::map<std::string, bool> quirks;  // only names from known_quirks()
   std::vector<cia402::ObjectId> cyclic_objects;
-  CanopenDeviceSpec canopen;
+  Sections sections;  // the sections of bus types (`canopen:`): CanopenDeviceSpec
+  template <typename T>
+  [[nodiscard]] const T& section() const {
+    return sections.get<T>();
+  }
   [[nodiscard]] bool quirk(const std::string& flag) const {
     const auto it = quirks.find(flag);
     return it != quirks.end() && it->second;
@@ -95,14 +134,12 @@ struct AxisPlan {
   core::Mechanics mechanics;
   core::NativeUnits native;
   double encoder_counts_per_rev = 0;
-  SimAxisOptions sim;  // meaningful for axes on a sim bus only
-  CanopenAxisOptions canopen;  // meaningful for axes on a canopen bus only
+  Sections sections;  // its bus type's section (`sim:`, `canopen:`): SimAxisOptions, CanopenAxisOptions
+  template <typename T>
+  [[nodiscard]] const T& section() const {
+    return sections.get<T>();
+  }
 };
-
-// The axis' gateway watch: its own option, else its device profile's.
-[[nodiscard]] inline GatewayWatch gateway_watch_of(const AxisPlan& a) noexcept {
-  return a.canopen.gateway_watch.value_or(a.device.canopen.gateway_watch);
-}
 
 // A bus-type option value after validation (see BusTypeRegistry for which keys a type takes).
 using OptionValue = std::variant<std::int64_t, double, bool, std::string, core::Duration>;
@@ -115,9 +152,14 @@ struct BusPlan {
   int priority = 0;  // SCHED_FIFO 1..99; 0 = normal scheduling
   int cpu = -1;      // CPU affinity; -1 = any
   std::map<std::string, OptionValue> options;  // every option of the type, defaults filled in
-  SimBusOptions sim;  // the typed view of `options` when type == "sim"
-  CanopenBusOptions canopen;  // the typed view of `options` when type == "canopen"
+  Sections sections;  // the typed view of `options`: SimBusOptions, CanopenBusOptions
   std::vector<AxisPlan> axes;
+  // The type it was read as: its readers, printout rows, factory (null when the type is unknown).
+  std::shared_ptr<const BusTypeInfo> type_info;
+  template <typename T>
+  [[nodiscard]] const T& section() const {
+    return sections.get<T>();
+  }
 };
 
 struct Plan {

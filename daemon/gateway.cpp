@@ -320,12 +320,12 @@ namespace {
 
 // The type the device profile gives an object: its PDO maps and start-up writes name types.
 std::optional<core::ParamType> device_profile_type(const config::AxisPlan& axis, cia402::ObjectId id) {
-  const auto& dev = axis.device.canopen;
+  const auto& dev = axis.device.section<config::CanopenDeviceSpec>();
   for (const auto* pdos : {&dev.rpdos, &dev.tpdos})
     for (const auto& pdo : *pdos)
       for (const auto& e : pdo.entries)
         if (e.object == id) return cia402::to_param_type(e.type);
-  for (const auto* writes : {&dev.startup_writes, &axis.canopen.startup_writes})
+  for (const auto* writes : {&dev.startup_writes, &axis.section<config::CanopenAxisOptions>().startup_writes})
     for (const auto& w : *writes)
       if (w.def.id == id) return cia402::to_param_type(w.def.type);
   return std::nullopt;
@@ -344,7 +344,8 @@ ParameterLookup Gateway::lookup_parameter(std::size_t axis_id, std::string_view 
   }
   const AxisRef ref = refs_[axis_id];
   const config::AxisPlan& axis = buses_[ref.bus].plan->axes[ref.axis];
-  const auto& eds = axis.canopen.eds_objects;
+  const auto& co = axis.section<config::CanopenAxisOptions>();
+  const auto& eds = co.eds_objects;
   const config::EdsObject* entry = nullptr;
   if (name.empty()) {
     out.ok = true;
@@ -355,7 +356,7 @@ ParameterLookup Gateway::lookup_parameter(std::size_t axis_id, std::string_view 
     out.ok = true;
     out.index = entry->id.index;
     out.sub = entry->id.sub;
-  } else if (const auto& naming = axis.device.canopen.parameter_naming) {
+  } else if (const auto& naming = axis.device.section<config::CanopenDeviceSpec>().parameter_naming) {
     const auto r = config::resolve_parameter_name(name, *naming);
     if (!r.id) {
       out.error = "'" + std::string(name) + "' is not a parameter of device " + axis.device.name + ": " + r.error;
@@ -367,7 +368,7 @@ ParameterLookup Gateway::lookup_parameter(std::size_t axis_id, std::string_view 
     entry = config::find_eds_object(eds, *r.id);
   } else {
     out.error = "axis '" + axis.spec.name + "' has no object named '" + std::string(name) + "'" +
-                (axis.canopen.eds.empty() ? " (give the axis an EDS file to use names, or use INDEX:SUB)"
+                (co.eds.empty() ? " (give the axis an EDS file to use names, or use INDEX:SUB)"
                                           : " in its EDS");
     return out;
   }

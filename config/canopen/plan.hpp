@@ -1,12 +1,15 @@
 #pragma once
-// The plan parts of the `canopen` bus type: the typed bus options, an axis' `canopen:` section and
-// a device profile's `canopen:` section (config/README.md "CANopen buses", profiles/devices/README.md).
+// The plan parts of the `canopen` bus type, held in the plan's Sections: the typed bus options
+// (BusPlan::section<CanopenBusOptions>()), an axis' `canopen:` section (CanopenAxisOptions) and a
+// device profile's `canopen:` section (CanopenDeviceSpec); config/README.md "CANopen buses",
+// profiles/devices/README.md.
 #include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "config/canopen/eds.hpp"
+#include "config/plan.hpp"
 #include "core/clock.hpp"
 #include "profiles/cia402/objects.hpp"
 
@@ -134,5 +137,10 @@ struct CanopenBusOptions {
   core::Duration boot_retry_max = std::chrono::seconds(10);  // back-off doubles up to this
   bool sync = true;                    // produce SYNC every cycle
 };
+
+// The axis' gateway watch: its own option, else its device profile's.
+[[nodiscard]] inline GatewayWatch gateway_watch_of(const AxisPlan& a) noexcept {
+  return a.section<CanopenAxisOptions>().gateway_watch.value_or(a.device.section<CanopenDeviceSpec>().gateway_watch);
+}
 
 }  // namespace drivegate::config

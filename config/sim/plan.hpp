@@ -1,6 +1,9 @@
 #pragma once
-// The plan parts of the `sim` bus type: its typed bus options and an axis' `sim:` section.
+// The plan parts of the `sim` bus type, held in the plan's Sections: its typed bus options
+// (BusPlan::section<SimBusOptions>()) and an axis' `sim:` section (SimAxisOptions).
 #include <optional>
+
+#include "config/plan.hpp"
 
 namespace drivegate::config {
 

@@ -19,7 +19,7 @@ axes:
 
 TEST(Sd6DigestSim, DeviceNamesOfD10AndD12) {
   const config::Plan plan = config::load_plan_from_string(kPlan, "sd6-digest.yaml");
-  const auto& naming = plan.buses.at(0).axes.at(0).device.canopen.parameter_naming;
+  const auto& naming = plan.buses.at(0).axes.at(0).device.section<config::CanopenDeviceSpec>().parameter_naming;
   ASSERT_TRUE(naming.has_value());
   EXPECT_EQ(config::parse_parameter_name("A245", *naming), (ObjectId{0x20F5, 0}));     // D-10
   EXPECT_EQ(config::parse_parameter_name("A246", *naming), (ObjectId{0x20F6, 0}));     // D-10
