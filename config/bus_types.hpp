@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -18,6 +19,8 @@
 #include "config/plan.hpp"
 #include "config/yaml_reader.hpp"
 #include "core/bus.hpp"
+#include "core/param_value.hpp"
+#include "profiles/cia402/objects.hpp"
 
 namespace drivegate::config {
 
@@ -42,6 +45,14 @@ struct BusEntry {
   const Source& source;
   YAML::Mark mark;
   std::string path;  // "buses[0]"
+};
+
+// A parameter of an axis as its bus type resolves it (a client's parameter request).
+struct ParameterRef {
+  std::optional<cia402::ObjectId> id;  // none: not a parameter of the axis (`error` says why)
+  core::ParamType type = core::ParamType::Unknown;  // Unknown: the bus type does not know it
+  std::string type_source;  // where `type` comes from ("the EDS", "device profile kollmorgen-akd")
+  std::string error;
 };
 
 // Looks for devices on a bus of this type: `target` is what follows "TYPE:" on the command line
@@ -79,6 +90,8 @@ struct BusTypeInfo {
   // The printout: a bus' rows after its options, in order; an axis' rows after the common ones.
   std::vector<std::function<void(const BusPlan& bus, DescribeRows& rows)>> describe_bus;
   std::function<void(const BusPlan& bus, const AxisPlan& axis, DescribeRows& rows)> describe_axis;
+  // A parameter of an axis on this bus type, by `name` when not empty, else by `id`.
+  std::function<ParameterRef(const AxisPlan& axis, std::string_view name, cia402::ObjectId id)> find_parameter;
   // What a bus holds on this machine, so a second gateway on it is refused ("canopen socketcan
   // can0"); empty: nothing.
   std::function<std::string(const BusPlan& bus)> resource;

@@ -4,6 +4,7 @@
 #include "config/canopen/bus_options.hpp"
 #include "config/canopen/describe.hpp"
 #include "config/canopen/device_section.hpp"
+#include "config/canopen/parameters.hpp"
 
 namespace drivegate::config {
 
@@ -63,6 +64,7 @@ BusTypeInfo canopen_bus_type() {
   t.check_bus = {check_realtime};
   t.describe_bus = {describe_canopen_bus};
   t.describe_axis = describe_canopen_axis;
+  t.find_parameter = find_canopen_parameter;
   t.resource = resource;
   return t;
 }
