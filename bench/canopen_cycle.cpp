@@ -28,9 +28,9 @@
 #include <vector>
 
 #include "adapters/canopen/canopen_bus.hpp"
+#include "adapters/canopen/plan_load.hpp"
 #include "adapters/canopen/sim/sim_network.hpp"
 #include "adapters/sim/sim_bus.hpp"
-#include "config/canopen_load.hpp"
 #include "config/loader.hpp"
 #include "core/bus_runner.hpp"
 #include "tests/support/alloc_counter.hpp"
@@ -170,7 +170,7 @@ class Rig {
       // heartbeats: with 64, sends are refused from 18 generic nodes on and links lost from 20
       // (measured with this program). 1024 is TxQueue's capacity (master/tx_queue.hpp).
       wire_ = std::make_unique<canopen::InprocBus>(
-          static_cast<std::uint32_t>(bp.canopen.bitrate),
+          static_cast<std::uint32_t>(bp.section<config::CanopenBusOptions>().bitrate),
           canopen::InprocBusOptions{.max_endpoints = 2, .tx_queue_capacity = 1024, .rx_queue_capacity = 4096});
       drives_end_ = wire_->connect();
       drives_end_->open();
@@ -392,9 +392,9 @@ std::optional<Row> run_node_count(const Options& o, int nodes, std::int64_t over
   Rig si(o, nodes, false);
   Row row;
   row.nodes = nodes;
-  const auto load = config::canopen_cycle_load(co.bus_plan());
+  const auto load = canopen::plan_cycle_load(co.bus_plan());
   row.load_estimate = load.fraction;
-  row.load_text = config::describe_canopen_load(co.bus_plan(), load);
+  row.load_text = canopen::describe_cycle_load(co.bus_plan(), load);
   if (!co.bring_up("canopen") || !si.bring_up("sim")) return std::nullopt;
   for (int i = 0; i < 50; ++i) {  // past the first moves' start
     co.cycle();

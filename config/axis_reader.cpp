@@ -4,7 +4,6 @@
 #include <cmath>
 #include <limits>
 
-#include "config/canopen_axis.hpp"
 #include "config/text_util.hpp"
 
 namespace drivegate::config {
@@ -58,7 +57,6 @@ const DeviceProfile* read_device(const MapReader& axis, AxisContext& ctx) {
 // no accepted value makes a conversion overflow or round every command to nothing.
 constexpr double kMaxCounts = 4294967296.0;  // 2^32 counts per motor revolution
 constexpr double kMaxRatio = 1e6;            // gear ratio and feed
-constexpr double kMaxUserValue = 1e12;       // positions, speeds and ramps in user units
 constexpr double kMaxTorque = 1e6;           // percent or Nm
 
 void read_mechanics(const MapReader& m, const DeviceProfile* device, AxisPlan& a) {
@@ -193,35 +191,6 @@ void read_homing(const MapReader& m, const DeviceProfile* device, AxisPlan& a) {
   h.timeout = m.duration("timeout", Need::Optional, 0ns, kMaxTimeout).value_or(h.timeout);
 }
 
-void read_sim(const MapReader& m, AxisPlan& a, bool scaled) {
-  m.check_keys({"start_position", "home_switch", "negative_limit_switch", "positive_limit_switch", "max_velocity",
-                "max_acceleration"});
-  const auto& u = a.spec.units;
-  auto& s = a.sim;
-  const NumberRule position = NumberRule::range(-kMaxUserValue, kMaxUserValue);
-  const NumberRule rate = NumberRule::positive_up_to(kMaxUserValue);
-  const auto start = m.number("start_position", Need::Optional, position);
-  const auto home = m.number("home_switch", Need::Optional, position);
-  const auto neg = m.number("negative_limit_switch", Need::Optional, position);
-  const auto pos = m.number("positive_limit_switch", Need::Optional, position);
-  const auto vmax = m.number("max_velocity", Need::Optional, rate);
-  const auto amax = m.number("max_acceleration", Need::Optional, rate);
-  if (neg && pos && *neg >= *pos)
-    m.error("negative_limit_switch", "must be less than positive_limit_switch (" + format_number(*pos) +
-                                         "), got " + format_number(*neg));
-  const auto outside = [&](double v) { return (neg && v <= *neg) || (pos && v >= *pos); };
-  if (home && outside(*home)) m.error("home_switch", "must lie between the limit switches");
-  if (start && outside(*start)) m.error("start_position", "must lie between the limit switches");
-  if (!scaled) return;
-  s.start_position = u.position_to_drive(start.value_or(0.0));
-  if (home) s.home_switch_position = u.position_to_drive(*home);
-  if (neg) s.negative_limit_switch_position = u.position_to_drive(*neg);
-  if (pos) s.positive_limit_switch_position = u.position_to_drive(*pos);
-  // Without settings the simulated motor tops out at 50 rev/s (3000 rpm) and 1000 rev/s^2.
-  s.max_velocity = vmax ? u.velocity_to_drive(*vmax) : 50.0 * a.native.velocity_per_rps;
-  s.max_acceleration = amax ? u.acceleration_to_drive(*amax) : 1000.0 * a.native.acceleration_per_rps2;
-}
-
 }  // namespace
 
 ReadAxis read_axis(const MapReader& axis, AxisContext& ctx) {
@@ -235,7 +204,7 @@ ReadAxis read_axis(const MapReader& axis, AxisContext& ctx) {
 
   a.spec.name = axis.name("name", Need::Required).value_or("");
 
-  const BusTypeInfo* bus_type = nullptr;
+  const BusTypeInfo* bus_type = nullptr;  // null when the bus or its type is unknown
   if (const auto bus = axis.name("bus", Need::Required)) {
     const auto it = std::find_if(ctx.buses.begin(), ctx.buses.end(), [&](const BusPlan& b) { return b.name == *bus; });
     if (it == ctx.buses.end()) {
@@ -243,7 +212,7 @@ ReadAxis read_axis(const MapReader& axis, AxisContext& ctx) {
       axis.error("bus", "unknown bus " + in_quotes(*bus) + did_you_mean(*bus, known) + " (buses: " + join(known) + ")");
     } else {
       out.bus = static_cast<std::size_t>(it - ctx.buses.begin());
-      bus_type = ctx.bus_types.find(it->type);
+      bus_type = it->type_info.get();
     }
   }
 
@@ -285,9 +254,7 @@ ReadAxis read_axis(const MapReader& axis, AxisContext& ctx) {
     if (bus_type && bus_type->axis_section != section)
       axis.error(section, "only allowed for axes on a " + section + " bus; bus is of type " + bus_type->name);
   }
-  if (bus_type && bus_type->axis_section == "sim") read_sim(axis.map("sim", Need::Optional), a, scaled);
-  if (bus_type && bus_type->axis_section == "canopen")
-    read_canopen_axis(axis, ctx.buses[*out.bus], device, ctx.base_dir, a);
+  if (bus_type && bus_type->read_axis) bus_type->read_axis(axis, ctx.buses[*out.bus], device, ctx.base_dir, a);
   return out;
 }
 

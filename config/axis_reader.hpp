@@ -12,6 +12,9 @@
 
 namespace drivegate::config {
 
+// Positions, speeds and ramps in user units are limited to this (config/README.md "Ranges").
+inline constexpr double kMaxUserValue = 1e12;
+
 struct AxisContext {
   const std::vector<BusPlan>& buses;
   const BusTypeRegistry& bus_types;

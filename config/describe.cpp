@@ -1,11 +1,9 @@
 #include "config/describe.hpp"
 
 #include <algorithm>
-#include <cstdio>
 #include <sstream>
 
-#include "config/canopen_bus.hpp"
-#include "config/canopen_load.hpp"
+#include "config/bus_types.hpp"
 #include "config/object_text.hpp"
 #include "config/scalars.hpp"
 #include "config/text_util.hpp"
@@ -18,6 +16,13 @@ namespace {
 class Printer {
  public:
   Printer(std::ostringstream& out, int indent, int width) : out_(out), indent_(indent), width_(width) {}
+  // The rows a bus type adds (BusTypeInfo::describe_bus, describe_axis).
+  template <typename Fn, typename... Args>
+  void rows(const Fn& rows_of, const Args&... args) const {
+    DescribeRows rows;
+    rows_of(args..., rows);
+    for (const auto& [label, value] : rows) row(label, value);
+  }
   void row(const std::string& label, const std::string& value) const {
     out_ << std::string(static_cast<std::size_t>(indent_), ' ') << label << ':'
          << std::string(static_cast<std::size_t>(std::max<int>(1, width_ - static_cast<int>(label.size()))), ' ')
@@ -54,87 +59,13 @@ std::string limit_text(double v, const std::string& unit) {
   return v > 0 ? format_number(v) + " " + unit : "none";
 }
 
-std::string pdo_text(const PdoSpec& pdo, bool receive) {
-  std::string t = pdo.synchronous() ? "sync (type " + std::to_string(pdo.transmission_type) + ")"
-                                    : "event (type " + std::to_string(pdo.transmission_type);
-  if (!pdo.synchronous()) {
-    if (pdo.inhibit_time_100us > 0)
-      t += ", inhibit " + format_duration(std::chrono::microseconds(100) * pdo.inhibit_time_100us);
-    if (pdo.event_timer_ms > 0) t += ", timer " + format_duration(std::chrono::milliseconds(pdo.event_timer_ms));
-    t += ")";
-  }
-  std::vector<std::string> entries;
-  for (const auto& e : pdo.entries) entries.push_back(object_text(e.object) + " " + std::string{to_string(e.type)});
-  t += ": " + join(entries) + " (" + std::to_string(pdo.mapped_bytes()) + " bytes";
-  if (receive && pdo.dlc > 0) t += ", sent as " + std::to_string(pdo.dlc);
-  return t + ")";
-}
-
-// "5", "1048576 (0x100000)": registers and bit fields read better in hex as well.
-std::string value_text(std::int64_t v) {
-  if (v >= -9 && v <= 9) return std::to_string(v);
-  char buf[24];
-  std::snprintf(buf, sizeof buf, "0x%llX", static_cast<unsigned long long>(v));
-  return v < 0 ? std::to_string(v) : std::to_string(v) + " (" + buf + ")";
-}
-
-void describe_canopen_axis(const Printer& p, const AxisPlan& a, const CanopenBusOptions& bus) {
-  const auto& co = a.device.canopen;
-  if (co.device_type) {
-    char buf[64];
-    std::snprintf(buf, sizeof buf, "1000h = %08Xh under mask %08Xh", *co.device_type, co.device_type_mask);
-    p.row("device type", buf);
-  }
-  if (gateway_watch_of(a) != GatewayWatch::Guarding) {
-    std::string t = "heartbeat: drive sends every " + format_duration(bus.drive_heartbeat) + ", lost after " +
-                    std::to_string(bus.heartbeat_misses) + " silent periods";
-    if (gateway_watch_of(a) == GatewayWatch::Heartbeat)
-      t += "; drive watches the gateway's heartbeat (1016h, " +
-           format_duration(bus.heartbeat_period * bus.heartbeat_misses) + ")";
-    p.row("error control", t);
-  } else {
-    p.row("error control", "guarding every " + format_duration(bus.guard_time) + ", life time factor " +
-                               std::to_string(bus.life_time_factor) + " (drive stops after " +
-                               format_duration(bus.guard_time * bus.life_time_factor) + " without guarding)");
-  }
-  switch (gateway_watch_of(a)) {
-    case GatewayWatch::Heartbeat: p.row("gateway watch", "heartbeat: the drive must have 1016h"); break;
-    case GatewayWatch::Guarding: p.row("gateway watch", "guarding: the drive must have 100Ch/100Dh"); break;
-    case GatewayWatch::Required:
-      p.row("gateway watch", "required: 1016h, else node guarding; a drive with neither is not started");
-      break;
-    case GatewayWatch::Optional:
-      p.row("gateway watch", "optional: 1016h, else node guarding; a drive with neither runs unwatched (warning: it "
-                             "does not stop by itself if the gateway dies)");
-      break;
-  }
-  p.row("SDO channel", std::to_string(a.canopen.sdo_channel));
-  p.row("PDO maps", co.pdo_policy == PdoPolicy::Write
-                        ? std::string{"written at boot"} + (co.disable_unused_pdos ? ", unused PDOs disabled" : "")
-                        : "verified only (configured in the drive" +
-                              (co.fixed_mapping_count > 0
-                                   ? "; mapping count fixed at " + std::to_string(co.fixed_mapping_count) + ")"
-                                   : std::string{")"}));
-  for (const auto& pdo : co.rpdos) p.row("RPDO " + std::to_string(pdo.number), pdo_text(pdo, true));
-  for (const auto& pdo : co.tpdos) p.row("TPDO " + std::to_string(pdo.number), pdo_text(pdo, false));
-  for (const auto* writes : {&co.startup_writes, &a.canopen.startup_writes})
-    for (const auto& w : *writes)
-      p.row("start-up write", object_text(w.def.id) + " " + std::string{to_string(w.def.type)} + " = " +
-                                  value_text(w.value) + " -- " + w.why);
-  if (!a.canopen.eds.empty())
-    p.row("EDS", a.canopen.eds + " (" + std::to_string(a.canopen.eds_objects.size()) + " objects)");
-  if (bus.transport == CanTransportKind::Simulated) p.row("simulated drive", "persona " + co.persona);
-}
-
 void describe_axis(std::ostringstream& out, const AxisPlan& a, const BusPlan& bus) {
-  const bool simulated = bus.type == "sim";
-  const bool canopen = bus.type == "canopen";
   const auto& s = a.spec;
   const std::string& u = s.user_unit;
   const std::string torque_unit = a.mechanics.rated_torque > 0 ? "Nm" : "%";
   out << "    axis " << s.name << '\n';
   const Printer p{out, 6, 22};
-  p.row(canopen ? "node-ID" : "address", std::to_string(a.address));
+  p.row(bus.type_info ? bus.type_info->address_name : "address", std::to_string(a.address));
   p.row("device", a.device.name + (a.device.vendor.empty() ? "" : " (" + a.device.vendor + ")"));
   p.row("modes", modes_text(s.modes));
   p.row("default mode", s.default_mode == core::Mode::None ? "none" : std::string{core::to_string(s.default_mode)});
@@ -162,17 +93,7 @@ void describe_axis(std::ostringstream& out, const AxisPlan& a, const BusPlan& bu
   std::vector<std::string> objects;
   for (const auto& o : a.device.cyclic_objects) objects.push_back(object_text(o));
   p.row("cyclic objects", join(objects, " "));
-  if (simulated) {
-    // The simulated drive's settings are stored in drive units; shown in user units again.
-    const auto user = [&](const std::optional<double>& drive) {
-      return drive ? format_number(s.units.position_to_user(*drive)) + " " + u : std::string{"none"};
-    };
-    p.row("simulated drive", "start " + user(a.sim.start_position) + ", home switch " + user(a.sim.home_switch_position) +
-                                 ", limit switches " + user(a.sim.negative_limit_switch_position) + " / " +
-                                 user(a.sim.positive_limit_switch_position) + ", top speed " +
-                                 format_number(s.units.velocity_to_user(a.sim.max_velocity)) + " " + u + "/s");
-  }
-  if (canopen) describe_canopen_axis(p, a, bus.canopen);
+  if (bus.type_info && bus.type_info->describe_axis) p.rows(bus.type_info->describe_axis, bus, a);
 }
 
 }  // namespace
@@ -204,17 +125,8 @@ std::string describe_plan(const Plan& plan) {
     std::vector<std::string> opts;
     for (const auto& [name, value] : b.options) opts.push_back(name + "=" + option_text(value));
     if (!opts.empty()) bp.row("options", join(opts));
-    if (b.type == "canopen") {
-      const auto& c = b.canopen;
-      std::string link = std::string{to_string(c.transport)};
-      if (c.transport == CanTransportKind::SocketCan) link += " on " + c.interface;
-      if (c.transport == CanTransportKind::UdpMulticast)
-        link += " " + c.group + ":" + std::to_string(c.port) + " from " + c.interface;
-      bp.row("CAN", link + ", " + std::to_string(c.bitrate / 1000) + " kbit/s, gateway node-ID " +
-                        std::to_string(c.gateway_node_id));
-      bp.row("SYNC", c.sync ? "every " + format_duration(b.cycle_time) : std::string{"off"});
-      if (!b.axes.empty()) bp.row("load", describe_canopen_load(b, canopen_cycle_load(b)));
-    }
+    if (b.type_info)
+      for (const auto& rows_of : b.type_info->describe_bus) bp.rows(rows_of, b);
     bp.row("axes", std::to_string(b.axes.size()));
     for (const auto& a : b.axes) describe_axis(out, a, b);
   }

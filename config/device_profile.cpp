@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <set>
 
-#include "config/canopen_profile.hpp"
 #include "config/object_text.hpp"
 #include "config/scalars.hpp"
 #include "config/text_util.hpp"
@@ -42,8 +41,8 @@ namespace {
 // The cyclic image must carry what the profile drives every cycle: the controlword and statusword
 // always, and the target object of each cyclic mode the profile offers (without it the mode could
 // not follow set-points and would jump to a stale target when enabled). When the image was derived
-// from the canopen PDO maps, the maps are what is missing the object.
-void check_cyclic_image(const DeviceProfile& p, const MapReader& root, bool derived) {
+// from a bus type's section (the canopen PDO maps), that section is what is missing the object.
+void check_cyclic_image(const DeviceProfile& p, const MapReader& root, const std::string& derived_from) {
   struct Need {
     std::optional<core::Mode> mode;  // nullopt: needed whatever the modes
     cia402::ObjectId object;
@@ -61,16 +60,17 @@ void check_cyclic_image(const DeviceProfile& p, const MapReader& root, bool deri
     if (n.mode && !p.modes.contains(*n.mode)) continue;
     bool found = false;
     for (const auto& id : p.cyclic_objects) found = found || id == n.object;
-    if (!found && derived)
-      root.error("canopen", std::string("the PDO maps (the cyclic image) must include ") + n.what);
+    if (!found && !derived_from.empty())
+      root.error(derived_from, std::string("the PDO maps (the cyclic image) must include ") + n.what);
     else if (!found)
       root.error("cyclic_objects", std::string("must include ") + n.what);
   }
 }
 
-const std::vector<std::string> kProfileKeys{"name",           "vendor",      "description", "identity",
-                                            "modes",          "units",       "homing_methods", "fault_texts",
-                                            "quirks",         "cyclic_objects", "canopen"};
+// And the bus types' sections (BusTypeInfo::device_section).
+const std::vector<std::string> kProfileKeys{"name",        "vendor",         "description", "identity",
+                                            "modes",       "units",          "homing_methods", "fault_texts",
+                                            "quirks",      "cyclic_objects"};
 
 void read_units(const MapReader& units, NativeUnitsSpec& out) {
   units.check_keys({"position", "velocity", "acceleration", "torque"});
@@ -119,9 +119,12 @@ void read_units(const MapReader& units, NativeUnitsSpec& out) {
     out.torque_per_rated = *v;
 }
 
-void read_profile(const MapReader& root, const fs::path& file, DeviceProfile& p) {
+void read_profile(const MapReader& root, const fs::path& file, const BusTypeRegistry& types, DeviceProfile& p) {
   const Source& src = root.source();
-  root.check_keys(kProfileKeys);
+  std::vector<std::string> keys = kProfileKeys;
+  const auto sections = types.device_sections();
+  keys.insert(keys.end(), sections.begin(), sections.end());
+  root.check_keys(keys);
   if (const auto name = root.name("name", Need::Required)) {
     p.name = *name;
     if (*name != file.stem().string())
@@ -195,8 +198,14 @@ void read_profile(const MapReader& root, const fs::path& file, DeviceProfile& p)
     }
   }
   const bool cyclic_given = root.has("cyclic_objects");
-  read_canopen_device(root, p, cyclic_given);
-  check_cyclic_image(p, root, !cyclic_given && !p.cyclic_objects.empty());
+  std::string derived_from;  // the section that filled cyclic_objects
+  for (const auto& type : types.types()) {
+    if (!type->read_device || !root.has(type->device_section)) continue;
+    const bool had_cyclic = !p.cyclic_objects.empty();
+    type->read_device(root, p, cyclic_given);
+    if (!cyclic_given && !had_cyclic && !p.cyclic_objects.empty()) derived_from = type->device_section;
+  }
+  check_cyclic_image(p, root, derived_from);
 }
 
 }  // namespace
@@ -214,7 +223,8 @@ core::NativeUnits NativeUnitsSpec::resolve(double encoder_counts_per_rev) const 
   return n;
 }
 
-std::optional<DeviceProfile> parse_device_profile(const fs::path& file, Problems& problems) {
+std::optional<DeviceProfile> parse_device_profile(const fs::path& file, Problems& problems,
+                                                  const BusTypeRegistry& types) {
   const Source src{file.string(), &problems};
   const std::size_t errors_before = problems.errors().size();
   const auto text = read_text_file(file.string(), src);
@@ -223,14 +233,14 @@ std::optional<DeviceProfile> parse_device_profile(const fs::path& file, Problems
   if (!doc) return std::nullopt;
   DeviceProfile p;
   p.file = file.string();
-  read_profile(MapReader{*doc, "", src}, file, p);
+  read_profile(MapReader{*doc, "", src}, file, types, p);
   if (problems.errors().size() != errors_before) return std::nullopt;
   return p;
 }
 
-DeviceProfile load_device_profile(const fs::path& file) {
+DeviceProfile load_device_profile(const fs::path& file, const BusTypeRegistry& types) {
   Problems problems;
-  auto p = parse_device_profile(file, problems);
+  auto p = parse_device_profile(file, problems, types);
   problems.throw_if_errors();
   return std::move(*p);
 }
@@ -250,7 +260,7 @@ const DeviceProfile* DeviceCatalog::get(const std::string& name, Problems& probl
   if (it == cache_.end()) {
     const auto file = locate(name);
     std::optional<DeviceProfile> profile;
-    if (file) profile = parse_device_profile(*file, problems);
+    if (file) profile = parse_device_profile(*file, problems, types_);
     it = cache_.emplace(name, std::move(profile)).first;
   }
   return it->second ? &*it->second : nullptr;

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "config/bus_types.hpp"
 #include "config/config_error.hpp"
 #include "config/plan.hpp"
 
@@ -19,14 +20,19 @@ const std::vector<std::string>& known_quirks();
 // the build tree see current profiles) and the installed data directory.
 std::vector<std::filesystem::path> default_device_dirs();
 
-// Parses one profile; its problems go to `problems` and the result is nullopt if there were any.
-std::optional<DeviceProfile> parse_device_profile(const std::filesystem::path& file, Problems& problems);
+// Parses one profile, with the sections of the bus types in `types`; its problems go to `problems`
+// and the result is nullopt if there were any.
+std::optional<DeviceProfile> parse_device_profile(const std::filesystem::path& file, Problems& problems,
+                                                  const BusTypeRegistry& types = BusTypeRegistry::builtin());
 // The same, throwing ConfigError.
-DeviceProfile load_device_profile(const std::filesystem::path& file);
+DeviceProfile load_device_profile(const std::filesystem::path& file,
+                                  const BusTypeRegistry& types = BusTypeRegistry::builtin());
 
 class DeviceCatalog {
  public:
-  explicit DeviceCatalog(std::vector<std::filesystem::path> dirs) : dirs_(std::move(dirs)) {}
+  // `types` must outlive the catalog.
+  DeviceCatalog(std::vector<std::filesystem::path> dirs, const BusTypeRegistry& types)
+      : dirs_(std::move(dirs)), types_(types) {}
   // The first <dir>/<name>.yaml in search order, if any.
   [[nodiscard]] std::optional<std::filesystem::path> locate(const std::string& name) const;
   // Loads (once) and returns the profile; nullptr when it is not found or broken. A broken file's
@@ -38,6 +44,7 @@ class DeviceCatalog {
 
  private:
   std::vector<std::filesystem::path> dirs_;
+  const BusTypeRegistry& types_;
   std::map<std::string, std::optional<DeviceProfile>> cache_;
 };
 

@@ -7,8 +7,6 @@
 #include <thread>
 
 #include "config/axis_reader.hpp"
-#include "config/canopen_bus.hpp"
-#include "config/canopen_load.hpp"
 #include "config/text_util.hpp"
 #include "config/yaml_reader.hpp"
 
@@ -160,14 +158,12 @@ void read_options(const MapReader& m, const BusTypeInfo& type, BusPlan& bus) {
     }
     bus.options[o.name] = v;
   }
-  if (type.name == "sim")
-    bus.sim.acyclic_latency_cycles = static_cast<int>(std::get<std::int64_t>(bus.options["acyclic_latency_cycles"]));
 }
 
 void read_bus(const MapReader& b, const BusTypeRegistry& registry, BusPlan& bus) {
   b.check_keys({"name", "type", "cycle_time", "priority", "cpu", "options"});
   bus.name = b.name("name", Need::Required).value_or("");
-  const BusTypeInfo* type = nullptr;
+  std::shared_ptr<const BusTypeInfo> type;
   if (const auto t = b.string("type", Need::Required)) {
     type = registry.find(*t);
     const auto available = registry.available_names();
@@ -197,7 +193,8 @@ void read_bus(const MapReader& b, const BusTypeRegistry& registry, BusPlan& bus)
   if (!type) return;
   const MapReader options = b.map("options", Need::Optional);
   read_options(options, *type, bus);
-  if (type->name == "canopen") read_canopen_bus(b, options, bus);
+  if (type->read_bus) type->read_bus(b, options, bus);
+  bus.type_info = std::move(type);
 }
 
 struct Seen {
@@ -213,40 +210,6 @@ struct Seen {
     return added;
   }
 };
-
-// What the bus sends per SYNC cycle must fit on the wire at its bit rate, with room to spare for
-// SDO, EMCY and retries (estimate: adapters/canopen/wire/bus_load.hpp, worst-case stuffing).
-void check_canopen_load(const BusPlan& bus, const Source& src, const YAML::Mark& mark, const std::string& path) {
-  if (bus.axes.empty()) return;
-  const canopen::CycleLoad load = canopen_cycle_load(bus);
-  const std::string what = "bus load " + describe_canopen_load(bus, load);
-  if (load.fraction > 1.0)
-    src.error(mark, path, what + ": it cannot fit; lengthen cycle_time, raise the bit rate or map fewer PDOs");
-  else if (load.fraction > kCanopenLoadWarning)
-    src.warning(mark, path, what + ": little room is left for SDO transfers, EMCYs and retries");
-  if (load.unbounded > 0)
-    src.warning(mark, path,
-                std::to_string(load.unbounded) +
-                    " event-driven TPDO(s) without an inhibit time: their rate is bounded only by how often the "
-                    "drive's data changes; give them an inhibit_time_100us");
-}
-
-// Drives that watch the gateway (heartbeat consumer 1016h, node guarding) fault when its cycle
-// stalls: under load a normally scheduled cycle thread stalled for 390 ms and every drive faulted.
-// Simulated drives (transport sim) run in the same thread and cannot notice.
-void check_canopen_realtime(const BusPlan& bus, const Source& src, const YAML::Mark& mark, const std::string& path) {
-  if (bus.priority > 0 || bus.canopen.transport == CanTransportKind::Simulated) return;
-  for (const auto& a : bus.axes) {
-    const auto& dev = a.device.canopen;
-    if (dev.error_control != ErrorControl::Guarding && !dev.consumer_heartbeat) continue;
-    src.warning(mark, path,
-                "bus \"" + bus.name + "\" runs without real-time priority, but its drives watch the gateway (axis \"" +
-                    a.spec.name + "\": " + (dev.error_control == ErrorControl::Guarding ? "node guarding" : "heartbeat consumer 1016h") +
-                    "): a cycle stalled by load faults them; give the bus a priority (1..99) and run drivegated as the "
-                    "README's \"Deployment\" says");
-    return;
-  }
-}
 
 Plan compile(const std::string& text, const std::string& file, const LoadOptions& options) {
   Problems problems;
@@ -278,11 +241,11 @@ Plan compile(const std::string& text, const std::string& file, const LoadOptions
 
   std::vector<fs::path> dirs(plan.gateway.device_dirs.begin(), plan.gateway.device_dirs.end());
   dirs.insert(dirs.end(), options.device_dirs.begin(), options.device_dirs.end());
-  DeviceCatalog devices{dirs};
+  DeviceCatalog devices{dirs, options.bus_types};
   AxisContext ctx{plan.buses, options.bus_types, devices, base_dir};
   Seen axis_names{"axis name", {}};
   std::vector<Seen> addresses;
-  for (const auto& bus : plan.buses) addresses.push_back(Seen{bus.type == "canopen" ? "node-ID" : "address", {}});
+  for (const auto& bus : plan.buses) addresses.push_back(Seen{bus.type_info ? bus.type_info->address_name : "address", {}});
   std::vector<std::pair<std::size_t, AxisPlan>> axes;
   if (const auto list = root.list("axes", Need::Optional)) {
     for (std::size_t i = 0; i < list->size(); ++i) {
@@ -293,11 +256,10 @@ Plan compile(const std::string& text, const std::string& file, const LoadOptions
       if (!axis.bus) continue;
       if (axis.plan.address != 0) {
         const BusPlan& bus = plan.buses[*axis.bus];
-        // Two drives on one CANopen node-ID answer each other's SDOs and PDOs: name both axes.
-        const bool canopen = bus.type == "canopen";
+        const bool name_axes = bus.type_info && bus.type_info->reused_address_names_axes;
         addresses[*axis.bus].check(std::to_string(axis.plan.address), a, "address",
                                    std::to_string(axis.plan.address) + " on bus \"" + bus.name + "\"",
-                                   canopen ? "axis \"" + axis.plan.spec.name + "\"" : std::string{});
+                                   name_axes ? "axis \"" + axis.plan.spec.name + "\"" : std::string{});
       }
       axes.emplace_back(*axis.bus, std::move(axis.plan));
     }
@@ -307,10 +269,8 @@ Plan compile(const std::string& text, const std::string& file, const LoadOptions
     if (plan.buses[i].axes.empty() && !plan.buses[i].name.empty())
       src.warning(bus_marks[i], indexed("buses", i),
                   "bus \"" + plan.buses[i].name + "\" has no axes; it will run its cycle with nothing on it");
-    if (plan.buses[i].type == "canopen") {
-      check_canopen_load(plan.buses[i], src, bus_marks[i], indexed("buses", i));
-      check_canopen_realtime(plan.buses[i], src, bus_marks[i], indexed("buses", i));
-    }
+    if (const auto& type = plan.buses[i].type_info)
+      for (const auto& check : type->check_bus) check(plan.buses[i], BusEntry{src, bus_marks[i], indexed("buses", i)});
   }
 
   problems.throw_if_errors();

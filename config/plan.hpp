@@ -1,8 +1,12 @@
 #pragma once
 // The checked, compiled form of a configuration file: everything the daemon needs to build its
 // buses and axes, with every value validated and converted (see config/README.md for the file).
+// Only what every bus type shares is here; a bus type's own parts (its typed options, an axis' and
+// a device profile's section of that type) are Sections, defined in its folder (config/canopen/plan.hpp).
+#include <any>
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <variant>
@@ -11,11 +15,43 @@
 #include "core/axis_spec.hpp"
 #include "core/axis_types.hpp"
 #include "core/clock.hpp"
-#include "config/eds.hpp"
 #include "core/units.hpp"
 #include "profiles/cia402/objects.hpp"
 
 namespace drivegate::config {
+
+struct BusTypeInfo;  // bus_types.hpp
+
+// The parts of a plan that belong to one bus type, each held by its type: a bus' typed options, an
+// axis' section, a device profile's section (CanopenBusOptions, SimAxisOptions, CanopenDeviceSpec).
+class Sections {
+ public:
+  // The part of type T, or nullptr.
+  template <typename T>
+  [[nodiscard]] const T* find() const noexcept {
+    for (const auto& p : parts_)
+      if (const T* t = std::any_cast<T>(&p)) return t;
+    return nullptr;
+  }
+  // The part of type T; a default-made T when there is none (a profile without that section).
+  template <typename T>
+  [[nodiscard]] const T& get() const {
+    if (const T* t = find<T>()) return *t;
+    static const T kAbsent{};
+    return kAbsent;
+  }
+  // The part of type T to fill in; added, default-made, when there is none. The reference holds
+  // until another part is added.
+  template <typename T>
+  T& edit() {
+    for (auto& p : parts_)
+      if (T* t = std::any_cast<T>(&p)) return *t;
+    return std::any_cast<T&>(parts_.emplace_back(std::in_place_type<T>));
+  }
+
+ private:
+  std::vector<std::any> parts_;
+};
 
 // DDS Security files of the gateway (absolute paths; idl/dds_security.hpp says what each is).
 struct SecurityPlan {
@@ -68,98 +104,6 @@ struct DeviceIdentity {
   std::optional<std::uint32_t> product_code;
 };
 
-// The `canopen:` section of a device profile (profiles/devices/README.md): how a CANopen master
-// brings the drive up. Everything vendor-specific about CANopen is here as data.
-struct PdoEntrySpec {
-  cia402::ObjectId object;
-  std::uint8_t bits = 0;  // 8, 16 or 32
-  cia402::DataType type = cia402::DataType::U8;  // from the entry's type name (i8 u8 i16 u16 i32 u32)
-};
-
-struct PdoSpec {
-  int number = 1;  // 1..4: RPDO n (1400h+n-1 / 1600h+n-1) or TPDO n (1800h+n-1 / 1A00h+n-1)
-  std::vector<PdoEntrySpec> entries;  // at most 8 entries and 64 bits
-  int transmission_type = 1;          // 0..240 synchronous, 254/255 event-driven
-  int inhibit_time_100us = 0;         // TPDO only; 0 = none
-  int event_timer_ms = 0;             // TPDO only; 0 = none
-  int dlc = 0;                        // RPDO frame length to send; 0 = the mapped length (NORD pads
-                                      // RxPDO1 to 8 bytes: nord-sk500p-ds402.md §8.1)
-  [[nodiscard]] int mapped_bytes() const noexcept {
-    int bytes = 0;
-    for (const auto& e : entries) bytes += e.bits / 8;
-    return bytes;
-  }
-  [[nodiscard]] bool synchronous() const noexcept { return transmission_type <= 240; }
-};
-
-enum class PdoPolicy : std::uint8_t {
-  Write,   // disable, clear count, write entries, set count, enable [CiA 301; AKD part 1 §12.6]
-  Verify,  // read back and compare only; a mismatch fails the boot (SD6: fixed count, mapping
-           // needs save + restart: stoeber-sd6-canopen.md quirk 4)
-};
-
-enum class ErrorControl : std::uint8_t {
-  Heartbeat,  // drive produces 1017h; the master consumes and, if the drive has 1016h, the drive
-              // consumes the master's heartbeat
-  Guarding,   // master sends RTRs every guard time; the drive's life guarding notices a dead master
-              // (SD6: no consumer heartbeat, quirk 7)
-};
-
-// How the gateway makes sure the drive notices a dead gateway (DESIGN.md §4), per device profile
-// (`canopen.gateway_watch`) and per axis (`canopen: { gateway_watch: }`, which wins).
-enum class GatewayWatch : std::uint8_t {
-  Heartbeat,  // the drive must have 1016h: it consumes the gateway's heartbeat; the boot fails otherwise
-  Guarding,   // node guarding (100Ch/100Dh): the master guards the node with RTRs, the drive's life
-              // guarding notices a dead gateway
-  Required,   // whichever the drive has (1016h first, else 100Ch/100Dh); the boot fails if it has neither
-  Optional,   // as Required, but a drive with neither runs unwatched, with a warning event
-};
-
-struct StartupWrite {
-  cia402::ObjectDef def;
-  std::int64_t value = 0;
-  std::string why;  // shown when the write fails
-};
-
-// A vendor byte of the EMCY frame (bytes 3..7) with a name, shown with the fault text
-// ("event 52, cause 1"). SD6: byte 3 event (E82), byte 4 cause (E43).
-struct EmcyVendorField {
-  int byte = 3;
-  std::string name;
-};
-
-// Manufacturer parameters addressable by a name: <letter><line>[<element>] -> index
-// base + group * group_stride + line, sub-index element (SD6 digest §2.2: A83 -> 2053h:00).
-struct ParameterNaming {
-  std::uint16_t base = 0x2000;
-  std::uint16_t group_stride = 0x200;
-  int max_line = 511;
-};
-
-struct CanopenDeviceSpec {
-  bool present = false;                 // the profile has a canopen section
-  std::optional<std::uint32_t> device_type;  // 1000h expected value, compared under the mask
-  std::uint32_t device_type_mask = 0x00FFFFFF;  // AKD: upper "mode bits" may change (quirk 13)
-  std::vector<PdoSpec> rpdos;
-  std::vector<PdoSpec> tpdos;
-  PdoPolicy pdo_policy = PdoPolicy::Write;
-  bool disable_unused_pdos = true;      // switch off PDOs the maps do not use (AKD part 1 §16 step 7)
-  ErrorControl error_control = ErrorControl::Heartbeat;
-  bool consumer_heartbeat = true;       // the drive has 1016h (watches the master's heartbeat)
-  // Default: heartbeat with error_control heartbeat, guarding with error_control guarding.
-  GatewayWatch gateway_watch = GatewayWatch::Heartbeat;
-  std::vector<StartupWrite> startup_writes;
-  std::vector<EmcyVendorField> emcy_fields;
-  bool emcy_zero_needs_clear_register = true;  // EMCY 0000h means "no more errors" only with register 0
-  std::optional<ParameterNaming> parameter_naming;
-  int sdo_channels = 1;                 // SDO server channels (SD6: 4, channels 2..4 need node-ID <= 31)
-  std::string persona = "generic";      // simulator persona for this drive (akd, nord-sk500p, stoeber-sd6, generic)
-  int fixed_mapping_count = 0;          // PDO mapping sub 0 reads this constant and at most this many
-                                        // entries fit (SD6: 6, stoeber-sd6-canopen.md quirks 4, 5); 0 = none
-  std::vector<core::Duration> sync_periods;  // SYNC periods the drive supports; empty = any (SD6 A150: 1, 2,
-                                             // 4, 8 ms, stoeber-sd6-canopen.md §7)
-};
-
 struct DeviceProfile {
   std::string name;
   std::string vendor;
@@ -172,31 +116,15 @@ struct DeviceProfile {
   std::map<std::uint32_t, std::string> fault_texts;
   std::map<std::string, bool> quirks;  // only names from known_quirks()
   std::vector<cia402::ObjectId> cyclic_objects;
-  CanopenDeviceSpec canopen;
+  Sections sections;  // the sections of bus types (`canopen:`): CanopenDeviceSpec
+  template <typename T>
+  [[nodiscard]] const T& section() const {
+    return sections.get<T>();
+  }
   [[nodiscard]] bool quirk(const std::string& flag) const {
     const auto it = quirks.find(flag);
     return it != quirks.end() && it->second;
   }
-};
-
-// Settings of the built-in simulated drive for one axis (the `sim:` section), already converted
-// from user units to the drive's units so the drive model never sees user units.
-struct SimAxisOptions {
-  double start_position = 0;  // drive position units
-  std::optional<double> home_switch_position;            // drive position units; none = no switch
-  std::optional<double> negative_limit_switch_position;  // drive position units
-  std::optional<double> positive_limit_switch_position;  // drive position units
-  double max_velocity = 0;      // drive velocity units: the motor's top speed
-  double max_acceleration = 0;  // drive acceleration units
-};
-
-// The per-axis `canopen:` section (axes on a canopen bus; `address` is the node-ID).
-struct CanopenAxisOptions {
-  std::string eds;  // EDS file (made absolute); objects and mappings are checked against it
-  int sdo_channel = 1;  // SDO server channel the gateway uses (1..device sdo_channels)
-  std::vector<StartupWrite> startup_writes;  // after the device profile's
-  std::optional<GatewayWatch> gateway_watch;  // overrides the device profile's
-  std::vector<EdsObject> eds_objects;  // the EDS' objects (empty without an EDS); see find_eds_object()
 };
 
 struct AxisPlan {
@@ -206,44 +134,16 @@ struct AxisPlan {
   core::Mechanics mechanics;
   core::NativeUnits native;
   double encoder_counts_per_rev = 0;
-  SimAxisOptions sim;  // meaningful for axes on a sim bus only
-  CanopenAxisOptions canopen;  // meaningful for axes on a canopen bus only
+  Sections sections;  // its bus type's section (`sim:`, `canopen:`): SimAxisOptions, CanopenAxisOptions
+  template <typename T>
+  [[nodiscard]] const T& section() const {
+    return sections.get<T>();
+  }
 };
-
-// The axis' gateway watch: its own option, else its device profile's.
-[[nodiscard]] inline GatewayWatch gateway_watch_of(const AxisPlan& a) noexcept {
-  return a.canopen.gateway_watch.value_or(a.device.canopen.gateway_watch);
-}
 
 // A bus-type option value after validation (see BusTypeRegistry for which keys a type takes).
 using OptionValue = std::variant<std::int64_t, double, bool, std::string, core::Duration>;
 
-// Options of the `sim` bus type.
-struct SimBusOptions {
-  int acyclic_latency_cycles = 1;  // cycles before an acyclic request is answered
-};
-
-// Options of the `canopen` bus type, typed (the bus `cycle_time` is the SYNC period).
-enum class CanTransportKind : std::uint8_t { SocketCan, UdpMulticast, Simulated };
-
-struct CanopenBusOptions {
-  CanTransportKind transport = CanTransportKind::SocketCan;
-  std::string interface = "can0";      // socketcan: interface; udp-multicast: local IPv4 address
-  std::uint32_t bitrate = 500000;      // bit/s (for load estimates and the simulated wire)
-  std::string group = "239.74.163.2";  // udp-multicast group [python-can udp_multicast default]
-  int port = 43113;
-  int gateway_node_id = 127;           // the master's own heartbeat COB-ID 700h + this
-  core::Duration heartbeat_period = std::chrono::milliseconds(100);   // master's heartbeat
-  core::Duration drive_heartbeat = std::chrono::milliseconds(100);    // 1017h written to drives
-  int heartbeat_misses = 3;            // a drive is lost after this many periods of silence
-  core::Duration guard_time = std::chrono::milliseconds(100);         // 100Ch for guarding drives
-  int life_time_factor = 3;            // 100Dh
-  core::Duration sdo_timeout = std::chrono::milliseconds(100);
-  int sdo_retries = 2;
-  core::Duration boot_retry = std::chrono::seconds(1);       // first back-off after a failed boot
-  core::Duration boot_retry_max = std::chrono::seconds(10);  // back-off doubles up to this
-  bool sync = true;                    // produce SYNC every cycle
-};
 
 struct BusPlan {
   std::string name;
@@ -252,9 +152,14 @@ struct BusPlan {
   int priority = 0;  // SCHED_FIFO 1..99; 0 = normal scheduling
   int cpu = -1;      // CPU affinity; -1 = any
   std::map<std::string, OptionValue> options;  // every option of the type, defaults filled in
-  SimBusOptions sim;  // the typed view of `options` when type == "sim"
-  CanopenBusOptions canopen;  // the typed view of `options` when type == "canopen"
+  Sections sections;  // the typed view of `options`: SimBusOptions, CanopenBusOptions
   std::vector<AxisPlan> axes;
+  // The type it was read as: its readers, printout rows, factory (null when the type is unknown).
+  std::shared_ptr<const BusTypeInfo> type_info;
+  template <typename T>
+  [[nodiscard]] const T& section() const {
+    return sections.get<T>();
+  }
 };
 
 struct Plan {

@@ -1,6 +1,6 @@
 #pragma once
-// Builds the Bus implementation for a compiled bus plan. Each adapter registers its bus type here;
-// the config's BusTypeRegistry lists which types and options the file may use.
+// Builds the Bus implementation for a compiled bus plan, with the factory its bus type registered
+// (config/bus_types.hpp; the build's registry: daemon/bus_types.cpp).
 #include <memory>
 
 #include "config/plan.hpp"

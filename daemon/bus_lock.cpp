@@ -9,6 +9,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "config/bus_types.hpp"
 #include "core/bus.hpp"
 
 namespace drivegate::daemon {
@@ -51,13 +52,7 @@ std::string holder(const sockaddr_un& a, socklen_t len) {
 }  // namespace
 
 std::string bus_resource(const config::BusPlan& bus) {
-  if (bus.type != "canopen") return {};
-  const auto& c = bus.canopen;
-  switch (c.transport) {
-    case config::CanTransportKind::SocketCan: return "canopen socketcan " + c.interface;
-    case config::CanTransportKind::UdpMulticast: return "canopen udp-multicast " + c.group + ":" + std::to_string(c.port);
-    default: return {};
-  }
+  return bus.type_info && bus.type_info->resource ? bus.type_info->resource(bus) : std::string{};
 }
 
 BusLock::BusLock(const std::string& resource) {

@@ -6,8 +6,7 @@
 #include <sstream>
 #include <thread>
 
-#include "config/eds.hpp"
-#include "config/parameter_names.hpp"
+#include "config/bus_types.hpp"
 #include "daemon/bus_factory.hpp"
 #include "profiles/cia402/standard_types.hpp"
 
@@ -322,25 +321,8 @@ std::vector<std::string> Gateway::scheduling_notes() const {
   return notes;
 }
 
-namespace {
-
-// The type the device profile gives an object: its PDO maps and start-up writes name types.
-std::optional<core::ParamType> device_profile_type(const config::AxisPlan& axis, cia402::ObjectId id) {
-  const auto& dev = axis.device.canopen;
-  for (const auto* pdos : {&dev.rpdos, &dev.tpdos})
-    for (const auto& pdo : *pdos)
-      for (const auto& e : pdo.entries)
-        if (e.object == id) return cia402::to_param_type(e.type);
-  for (const auto* writes : {&dev.startup_writes, &axis.canopen.startup_writes})
-    for (const auto& w : *writes)
-      if (w.def.id == id) return cia402::to_param_type(w.def.type);
-  return std::nullopt;
-}
-
-}  // namespace
-
-// A name is an EDS ParameterName first, then the device's parameter naming (SD6 "A83"), so an
-// EDS can also name vendor parameters. The type comes from the EDS, else from the standards.
+// The axis' bus type resolves names and knows types from its own files (canopen: EDS, device
+// profile); else the standards give the type. A bus type without parameter names takes INDEX:SUB.
 ParameterLookup Gateway::lookup_parameter(std::size_t axis_id, std::string_view name, std::uint16_t index,
                                           std::uint8_t sub) const {
   ParameterLookup out;
@@ -349,41 +331,27 @@ ParameterLookup Gateway::lookup_parameter(std::size_t axis_id, std::string_view 
     return out;
   }
   const AxisRef ref = refs_[axis_id];
-  const config::AxisPlan& axis = buses_[ref.bus].plan->axes[ref.axis];
-  const auto& eds = axis.canopen.eds_objects;
-  const config::EdsObject* entry = nullptr;
-  if (name.empty()) {
-    out.ok = true;
-    out.index = index;
-    out.sub = sub;
-    entry = config::find_eds_object(eds, cia402::ObjectId{index, sub});
-  } else if ((entry = config::find_eds_object(eds, name)) != nullptr) {
-    out.ok = true;
-    out.index = entry->id.index;
-    out.sub = entry->id.sub;
-  } else if (const auto& naming = axis.device.canopen.parameter_naming) {
-    const auto r = config::resolve_parameter_name(name, *naming);
-    if (!r.id) {
-      out.error = "'" + std::string(name) + "' is not a parameter of device " + axis.device.name + ": " + r.error;
-      return out;
-    }
-    out.ok = true;
-    out.index = r.id->index;
-    out.sub = r.id->sub;
-    entry = config::find_eds_object(eds, *r.id);
-  } else {
-    out.error = "axis '" + axis.spec.name + "' has no object named '" + std::string(name) + "'" +
-                (axis.canopen.eds.empty() ? " (give the axis an EDS file to use names, or use INDEX:SUB)"
-                                          : " in its EDS");
+  const config::BusPlan& bus = *buses_[ref.bus].plan;
+  const config::AxisPlan& axis = bus.axes[ref.axis];
+  config::ParameterRef p;
+  if (bus.type_info && bus.type_info->find_parameter)
+    p = bus.type_info->find_parameter(axis, name, cia402::ObjectId{index, sub});
+  else if (name.empty())
+    p.id = cia402::ObjectId{index, sub};
+  else
+    p.error = "axis '" + axis.spec.name + "' has no object named '" + std::string(name) +
+              "' (give the axis an EDS file to use names, or use INDEX:SUB)";
+  if (!p.id) {
+    out.error = std::move(p.error);
     return out;
   }
-  if (entry != nullptr && core::param_type_from_cia(entry->data_type) != core::ParamType::Unknown) {
-    out.type = core::param_type_from_cia(entry->data_type);
-    out.type_source = "the EDS";
-  } else if (const auto from_profile = device_profile_type(axis, {out.index, out.sub})) {
-    out.type = *from_profile;
-    out.type_source = "device profile " + axis.device.name;
-  } else if (const auto t = cia402::standard_param_type({out.index, out.sub}); t != core::ParamType::Unknown) {
+  out.ok = true;
+  out.index = p.id->index;
+  out.sub = p.id->sub;
+  if (p.type != core::ParamType::Unknown) {
+    out.type = p.type;
+    out.type_source = std::move(p.type_source);
+  } else if (const auto t = cia402::standard_param_type(*p.id); t != core::ParamType::Unknown) {
     out.type = t;
     out.type_source = out.index < 0x2000 ? "CiA 301" : "CiA 402";
   }

@@ -1,4 +1,4 @@
-// The EDS parser (config/eds.hpp) on arbitrary file text: vendor files are INI text of uneven
+// The EDS parser (config/canopen/eds.hpp) on arbitrary file text: vendor files are INI text of uneven
 // quality. Invariants: a parse either returns objects and no errors, or nullopt and at least one
 // error; objects are sorted with each index and sub-index once, and each can be found again by its
 // index and sub-index; a limit's text parses again to the value stored for it. Problems are the
@@ -8,7 +8,7 @@
 #include <cstdlib>
 #include <string_view>
 
-#include "config/eds.hpp"
+#include "config/canopen/eds.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace drivegate::config;

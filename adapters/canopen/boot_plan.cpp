@@ -89,9 +89,9 @@ void pdo_steps(Steps& s, const config::CanopenDeviceSpec& dev, bool transmit, No
 
 std::vector<BootStep> build_boot_steps(const config::AxisPlan& axis, const config::BusPlan& bus) {
   Steps s;
-  const auto& dev = axis.device.canopen;
+  const auto& dev = axis.device.section<config::CanopenDeviceSpec>();
   const auto node = static_cast<NodeId>(axis.address);
-  const auto& opt = bus.canopen;
+  const auto& opt = bus.section<config::CanopenBusOptions>();
 
   // Identity (AKD part 1 §16 step 4, SD6 gateway step B3).
   if (dev.device_type)
@@ -105,7 +105,8 @@ std::vector<BootStep> build_boot_steps(const config::AxisPlan& axis, const confi
              "product code (1018h:02) of a " + axis.device.name);
 
   for (const auto& w : dev.startup_writes) s.write("start-up write", w.def, w.value, false, w.why);
-  for (const auto& w : axis.canopen.startup_writes) s.write("start-up write (axis)", w.def, w.value, false, w.why);
+  for (const auto& w : axis.section<config::CanopenAxisOptions>().startup_writes)
+    s.write("start-up write (axis)", w.def, w.value, false, w.why);
 
   pdo_steps(s, dev, false, node);
   pdo_steps(s, dev, true, node);
@@ -204,7 +205,7 @@ WatchOutcome watch_outcome(config::GatewayWatch watch, std::uint8_t found) noexc
 NodePdoConfig build_pdo_config(const config::AxisPlan& axis) {
   NodePdoConfig out;
   const auto node = static_cast<NodeId>(axis.address);
-  const auto& dev = axis.device.canopen;
+  const auto& dev = axis.device.section<config::CanopenDeviceSpec>();
   auto layout_of = [](const config::PdoSpec& p) {
     PdoLayout l;
     for (const auto& e : p.entries) (void)l.add({e.object, e.type}, e.bits);

@@ -7,7 +7,7 @@
 
 #include "adapters/canopen/master/node_boot.hpp"
 #include "adapters/canopen/master/pdo.hpp"
-#include "config/plan.hpp"
+#include "config/canopen/plan.hpp"
 
 namespace drivegate::canopen {
 

@@ -24,7 +24,7 @@ std::vector<SdoChannelConfig> sdo_channels_for(const config::BusPlan& plan) {
   std::vector<SdoChannelConfig> out;
   for (const auto& a : plan.axes) {
     const auto node = static_cast<NodeId>(a.address);
-    const int ch = a.canopen.sdo_channel;
+    const int ch = a.section<config::CanopenAxisOptions>().sdo_channel;
     out.push_back({node, ch, cob::sdo_rx(ch, node), cob::sdo_tx(ch, node)});
   }
   return out;
@@ -32,7 +32,7 @@ std::vector<SdoChannelConfig> sdo_channels_for(const config::BusPlan& plan) {
 
 std::vector<NmtNodeConfig> nmt_nodes_for(const config::BusPlan& plan) {
   std::vector<NmtNodeConfig> out;
-  const auto& o = plan.canopen;
+  const auto& o = plan.section<config::CanopenBusOptions>();
   for (const auto& a : plan.axes) {
     NmtNodeConfig c;
     c.node = static_cast<NodeId>(a.address);
@@ -62,7 +62,7 @@ void seed_mode_object(const config::AxisPlan& a, ProcessImage& image) {
 CanopenBus::CanopenBus(const config::BusPlan& plan, std::unique_ptr<Transport> transport,
                        std::unique_ptr<CyclePeer> peer)
     : name_(plan.name),
-      options_(plan.canopen),
+      options_(plan.section<config::CanopenBusOptions>()),
       cycle_time_(plan.cycle_time),
       transport_(std::move(transport)),
       peer_(std::move(peer)),
@@ -71,21 +71,21 @@ CanopenBus::CanopenBus(const config::BusPlan& plan, std::unique_ptr<Transport> t
         for (const auto& a : plan.axes) {
           Tables x;
           for (const auto& [code, text] : a.device.fault_texts) x.faults.push_back({static_cast<std::uint16_t>(code), text});
-          for (const auto& f : a.device.canopen.emcy_fields) x.fields.push_back({static_cast<std::uint8_t>(f.byte), f.name});
+          for (const auto& f : a.device.section<config::CanopenDeviceSpec>().emcy_fields)
+            x.fields.push_back({static_cast<std::uint8_t>(f.byte), f.name});
           t.push_back(std::move(x));
         }
         return t;
       }()),
       nmt_nodes_(nmt_nodes_for(plan)),
       // The engines copy their node configurations; only nmt_nodes_ is looked at again.
-      sdo_(sdo_channels_for(plan), SdoTiming{plan.canopen.sdo_timeout, plan.canopen.sdo_retries}),
-      nmt_(NmtMasterConfig{static_cast<NodeId>(plan.canopen.gateway_node_id), plan.canopen.heartbeat_period},
-           nmt_nodes_),
+      sdo_(sdo_channels_for(plan), SdoTiming{options_.sdo_timeout, options_.sdo_retries}),
+      nmt_(NmtMasterConfig{static_cast<NodeId>(options_.gateway_node_id), options_.heartbeat_period}, nmt_nodes_),
       emcy_([&] {
         std::vector<EmcyNodeConfig> e;
         for (std::size_t i = 0; i < plan.axes.size(); ++i)
           e.push_back({static_cast<NodeId>(plan.axes[i].address), tables_[i].faults, tables_[i].fields,
-                       plan.axes[i].device.canopen.emcy_zero_needs_clear_register});
+                       plan.axes[i].device.section<config::CanopenDeviceSpec>().emcy_zero_needs_clear_register});
         return e;
       }()),
       sync_(cob::kSync, plan.cycle_time) {

@@ -57,7 +57,7 @@
 #include "adapters/canopen/master/tx_queue.hpp"
 #include "adapters/canopen/node_access.hpp"
 #include "adapters/canopen/transport/transport.hpp"
-#include "config/plan.hpp"
+#include "config/canopen/plan.hpp"
 #include "core/bus.hpp"
 #include "profiles/cia402/cia402_master.hpp"
 

@@ -10,7 +10,7 @@
 namespace drivegate::canopen {
 
 std::unique_ptr<Transport> make_transport(const config::BusPlan& plan) {
-  const auto& o = plan.canopen;
+  const auto& o = plan.section<config::CanopenBusOptions>();
   switch (o.transport) {
     case config::CanTransportKind::SocketCan: {
       SocketCanOptions s;
@@ -21,7 +21,8 @@ std::unique_ptr<Transport> make_transport(const config::BusPlan& plan) {
       for (const auto& a : plan.axes) {
         const auto node = static_cast<NodeId>(a.address);
         s.filters.push_back({node, 0x7F, false});
-        if (a.canopen.sdo_channel > 1) s.filters.push_back({cob::sdo_tx(a.canopen.sdo_channel, node), kMaxStandardId, false});
+        const int ch = a.section<config::CanopenAxisOptions>().sdo_channel;
+        if (ch > 1) s.filters.push_back({cob::sdo_tx(ch, node), kMaxStandardId, false});
       }
       return std::make_unique<SocketCanTransport>(std::move(s));
     }
@@ -42,7 +43,7 @@ std::unique_ptr<Transport> make_transport(const config::BusPlan& plan) {
 namespace drivegate::canopen {
 
 std::unique_ptr<CanopenBus> make_canopen_bus(const config::BusPlan& plan) {
-  if (plan.canopen.transport == config::CanTransportKind::Simulated) {
+  if (plan.section<config::CanopenBusOptions>().transport == config::CanTransportKind::Simulated) {
     auto wiring = sim::SimPeer::wire(plan);
     return std::make_unique<CanopenBus>(plan, std::move(wiring.gateway), std::move(wiring.peer));
   }

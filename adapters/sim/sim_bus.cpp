@@ -25,18 +25,18 @@ cia402::sim::DriveModelConfig drive_config_for(const config::AxisPlan& axis) {
   // The model takes velocities in position units per second unless told otherwise.
   c.velocity_units_per_rps =
       axis.native.velocity_per_rps == axis.native.position_per_rev ? 0.0 : axis.native.velocity_per_rps;
-  if (axis.sim.max_velocity > 0) c.max_velocity_rps = axis.sim.max_velocity / axis.native.velocity_per_rps;
+  const auto& sim = axis.section<config::SimAxisOptions>();
+  if (sim.max_velocity > 0) c.max_velocity_rps = sim.max_velocity / axis.native.velocity_per_rps;
   // The motor's acceleration capability is what it reaches at rated torque.
-  if (axis.sim.max_acceleration > 0)
-    c.torque_acceleration_rps2 = axis.sim.max_acceleration / axis.native.acceleration_per_rps2;
+  if (sim.max_acceleration > 0) c.torque_acceleration_rps2 = sim.max_acceleration / axis.native.acceleration_per_rps2;
   // Following-error window: a tenth of a motor revolution.
   c.following_error_window = static_cast<std::uint32_t>(std::max(1.0, axis.native.position_per_rev / 10));
   c.position_window = static_cast<std::uint32_t>(std::max(1.0, axis.native.position_per_rev / 10000));
   c.velocity_window = static_cast<std::uint16_t>(std::clamp(axis.native.velocity_per_rps / 100, 1.0, 65535.0));
-  c.start_position = axis.sim.start_position;
-  c.home_switch_position = axis.sim.home_switch_position;
-  c.negative_limit_position = axis.sim.negative_limit_switch_position;
-  c.positive_limit_position = axis.sim.positive_limit_switch_position;
+  c.start_position = sim.start_position;
+  c.home_switch_position = sim.home_switch_position;
+  c.negative_limit_position = sim.negative_limit_switch_position;
+  c.positive_limit_position = sim.positive_limit_switch_position;
   return c;
 }
 
@@ -47,7 +47,7 @@ SimBus::SimBus(const config::BusPlan& plan) : name_(plan.name), cycle_time_(plan
     n.model = std::make_unique<cia402::sim::DriveModel>(drive_config_for(axis));
     n.mapped = axis.device.cyclic_objects;
     n.io = std::make_unique<cia402::sim::DirectObjectAccess>(
-        *n.model, n.mapped, static_cast<unsigned>(plan.sim.acyclic_latency_cycles));
+        *n.model, n.mapped, static_cast<unsigned>(plan.section<config::SimBusOptions>().acyclic_latency_cycles));
     for (const auto& [code, text] : axis.device.fault_texts)
       n.faults.push_back({static_cast<std::uint16_t>(code), text});
     n.master = std::make_unique<cia402::Cia402Master>(*n.io, cia402::settings_from(axis.spec));

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "config/plan.hpp"
+#include "config/sim/plan.hpp"
 #include "core/bus.hpp"
 #include "profiles/cia402/cia402_master.hpp"
 #include "profiles/cia402/error_codes.hpp"

@@ -12,7 +12,7 @@ namespace drivegate::cia402 {
 
 [[nodiscard]] core::ParamType standard_param_type(ObjectId id) noexcept;
 // The CiA 402 type of a device profile object: every object of objects.hpp and the few more in
-// the table; nullopt for others. Device profiles are checked against it (config/canopen_profile.cpp).
+// the table; nullopt for others. Device profiles are checked against it (config/canopen/device_section.cpp).
 [[nodiscard]] std::optional<DataType> profile_object_type(ObjectId id) noexcept;
 [[nodiscard]] core::ParamType to_param_type(DataType t) noexcept;
 

@@ -81,5 +81,25 @@ TEST(ParameterNames, TypesFromEdsProfileAndStandards) {
   }
 }
 
+// A bus type without parameter names of its own (sim): objects by index:sub, typed by the standards.
+TEST(ParameterNames, ABusTypeWithoutNamesTakesIndexAndSub) {
+  const config::Plan plan = config::load_plan_from_string(R"(gateway: { name: names }
+buses:
+  - { name: sim0, type: sim, cycle_time: 1ms }
+axes:
+  - { name: x, bus: sim0, address: 1, device: sim-servo, mechanics: { encoder_counts_per_rev: 4096 } }
+)",
+                                                          "names.yaml");
+  daemon::Gateway gw(plan);
+  auto p = gw.lookup_parameter(0, "", 0x6064, 0);
+  ASSERT_TRUE(p.ok) << p.error;
+  EXPECT_EQ(p.type, core::ParamType::I32);
+  EXPECT_EQ(p.type_source, "CiA 402");
+  p = gw.lookup_parameter(0, "Position actual value", 0, 0);
+  EXPECT_FALSE(p.ok);
+  EXPECT_EQ(p.error, "axis 'x' has no object named 'Position actual value' (give the axis an EDS file to use names, "
+                     "or use INDEX:SUB)");
+}
+
 }  // namespace
 }  // namespace drivegate::canopen::test

@@ -4,7 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "config/loader.hpp"
-#include "config/parameter_names.hpp"
+#include "config/canopen/parameter_names.hpp"
 #include "tests/canopen_sim/sim_test_support.hpp"
 
 namespace drivegate::canopen::sim::test {
@@ -19,7 +19,7 @@ axes:
 
 TEST(Sd6DigestSim, DeviceNamesOfD10AndD12) {
   const config::Plan plan = config::load_plan_from_string(kPlan, "sd6-digest.yaml");
-  const auto& naming = plan.buses.at(0).axes.at(0).device.canopen.parameter_naming;
+  const auto& naming = plan.buses.at(0).axes.at(0).device.section<config::CanopenDeviceSpec>().parameter_naming;
   ASSERT_TRUE(naming.has_value());
   EXPECT_EQ(config::parse_parameter_name("A245", *naming), (ObjectId{0x20F5, 0}));     // D-10
   EXPECT_EQ(config::parse_parameter_name("A246", *naming), (ObjectId{0x20F6, 0}));     // D-10

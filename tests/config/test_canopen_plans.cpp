@@ -6,8 +6,9 @@
 #include <fstream>
 #include <sstream>
 
+#include "config/canopen/plan.hpp"
 #include "config/describe.hpp"
-#include "config/eds.hpp"
+#include "config/canopen/eds.hpp"
 #include "tests/config/test_support.hpp"
 
 namespace drivegate::config {
@@ -76,7 +77,7 @@ TEST(CanopenPlans, BusOptionsAreTyped) {
   const BusPlan& b = plan.buses[0];
   EXPECT_EQ(b.type, "canopen");
   EXPECT_EQ(b.cycle_time, core::Duration{4ms});
-  const CanopenBusOptions& c = b.canopen;
+  const CanopenBusOptions& c = b.section<CanopenBusOptions>();
   EXPECT_EQ(c.transport, CanTransportKind::UdpMulticast);
   EXPECT_EQ(c.interface, "127.0.0.1");
   EXPECT_EQ(c.bitrate, 1000000U);
@@ -104,7 +105,7 @@ buses: [{ name: can0, type: canopen, cycle_time: 4ms }]
 axes: [{ name: x, bus: can0, address: 1, device: kollmorgen-akd }]
 )",
                                           "d.yaml", test_options());
-  const CanopenBusOptions& c = plan.buses[0].canopen;
+  const CanopenBusOptions& c = plan.buses[0].section<CanopenBusOptions>();
   EXPECT_EQ(c.transport, CanTransportKind::SocketCan);
   EXPECT_EQ(c.interface, "can0");
   EXPECT_EQ(std::get<std::string>(plan.buses[0].options.at("interface")), "can0");  // resolved for --check-config
@@ -118,19 +119,19 @@ axes: [{ name: x, bus: can0, address: 1, device: kollmorgen-akd }]
   EXPECT_EQ(c.boot_retry_max, core::Duration{10s});
   EXPECT_TRUE(c.sync);
   const AxisPlan& x = plan.buses[0].axes[0];
-  EXPECT_EQ(x.canopen.sdo_channel, 1);
-  EXPECT_TRUE(x.canopen.eds.empty());
-  EXPECT_TRUE(x.canopen.eds_objects.empty());
-  EXPECT_TRUE(x.canopen.startup_writes.empty());
+  EXPECT_EQ(x.section<CanopenAxisOptions>().sdo_channel, 1);
+  EXPECT_TRUE(x.section<CanopenAxisOptions>().eds.empty());
+  EXPECT_TRUE(x.section<CanopenAxisOptions>().eds_objects.empty());
+  EXPECT_TRUE(x.section<CanopenAxisOptions>().startup_writes.empty());
   // No encoder resolution needed: the AKD profile fixes 2^20 position units per motor rev.
   EXPECT_DOUBLE_EQ(x.spec.units.position_factor(), 1048576.0);
   const Plan udp = load_plan_from_string(R"(gateway: { name: g }
 buses: [{ name: can0, type: canopen, cycle_time: 4ms, options: { transport: udp-multicast } }]
 )",
                                          "d.yaml", test_options());
-  EXPECT_EQ(udp.buses[0].canopen.interface, "0.0.0.0");  // any local address
-  EXPECT_EQ(udp.buses[0].canopen.group, "239.74.163.2");
-  EXPECT_EQ(udp.buses[0].canopen.port, 43113);
+  EXPECT_EQ(udp.buses[0].section<CanopenBusOptions>().interface, "0.0.0.0");  // any local address
+  EXPECT_EQ(udp.buses[0].section<CanopenBusOptions>().group, "239.74.163.2");
+  EXPECT_EQ(udp.buses[0].section<CanopenBusOptions>().port, 43113);
 }
 
 TEST(CanopenPlans, AxesCarryTheirCanopenSection) {
@@ -138,20 +139,20 @@ TEST(CanopenPlans, AxesCarryTheirCanopenSection) {
   const AxisPlan& x = axis(plan, "x");
   EXPECT_EQ(x.address, 5);
   EXPECT_EQ(x.spec.default_mode, core::Mode::CyclicPosition);
-  EXPECT_TRUE(x.device.canopen.present);
-  EXPECT_EQ(x.device.canopen.rpdos.size(), 3U);
+  EXPECT_TRUE(x.device.section<CanopenDeviceSpec>().present);
+  EXPECT_EQ(x.device.section<CanopenDeviceSpec>().rpdos.size(), 3U);
   // 2^20 units per motor rev over a 5 mm feed.
   EXPECT_DOUBLE_EQ(x.spec.units.position_factor(), 1048576.0 / 5.0);
   EXPECT_DOUBLE_EQ(x.spec.units.velocity_factor(), 60000.0 / 5.0);
-  EXPECT_NE(x.canopen.eds.find("tests/config/devices/akd-canopen.eds"), std::string::npos) << x.canopen.eds;
-  EXPECT_EQ(x.canopen.eds.find(".."), std::string::npos) << x.canopen.eds;
-  ASSERT_FALSE(x.canopen.eds_objects.empty());
-  const EdsObject* target = find_eds_object(x.canopen.eds_objects, "target POSITION");
+  EXPECT_NE(x.section<CanopenAxisOptions>().eds.find("tests/config/devices/akd-canopen.eds"), std::string::npos) << x.section<CanopenAxisOptions>().eds;
+  EXPECT_EQ(x.section<CanopenAxisOptions>().eds.find(".."), std::string::npos) << x.section<CanopenAxisOptions>().eds;
+  ASSERT_FALSE(x.section<CanopenAxisOptions>().eds_objects.empty());
+  const EdsObject* target = find_eds_object(x.section<CanopenAxisOptions>().eds_objects, "target POSITION");
   ASSERT_NE(target, nullptr);
   EXPECT_EQ(target->id, (ObjectId{0x607A, 0}));
-  ASSERT_EQ(x.canopen.startup_writes.size(), 1U);
-  EXPECT_EQ(x.canopen.startup_writes[0].def.id, (ObjectId{0x36E8, 0}));
-  EXPECT_EQ(x.canopen.startup_writes[0].value, 0);
+  ASSERT_EQ(x.section<CanopenAxisOptions>().startup_writes.size(), 1U);
+  EXPECT_EQ(x.section<CanopenAxisOptions>().startup_writes[0].def.id, (ObjectId{0x36E8, 0}));
+  EXPECT_EQ(x.section<CanopenAxisOptions>().startup_writes[0].value, 0);
 
   const AxisPlan& y = axis(plan, "y");
   EXPECT_EQ(y.spec.default_mode, core::Mode::Velocity);
@@ -160,10 +161,10 @@ TEST(CanopenPlans, AxesCarryTheirCanopenSection) {
   EXPECT_EQ(y.device.cyclic_objects.size(), 15U);          // derived from NORD's maps
 
   const AxisPlan& z = axis(plan, "z");
-  EXPECT_EQ(z.canopen.sdo_channel, 4);
-  ASSERT_EQ(z.canopen.startup_writes.size(), 1U);
-  EXPECT_EQ(z.canopen.startup_writes[0].def.id, (ObjectId{0x2053, 0}));  // A83 by the SD6 naming
-  EXPECT_EQ(z.device.canopen.error_control, ErrorControl::Guarding);
+  EXPECT_EQ(z.section<CanopenAxisOptions>().sdo_channel, 4);
+  ASSERT_EQ(z.section<CanopenAxisOptions>().startup_writes.size(), 1U);
+  EXPECT_EQ(z.section<CanopenAxisOptions>().startup_writes[0].def.id, (ObjectId{0x2053, 0}));  // A83 by the SD6 naming
+  EXPECT_EQ(z.device.section<CanopenDeviceSpec>().error_control, ErrorControl::Guarding);
   EXPECT_EQ(gateway_watch_of(z), GatewayWatch::Guarding);
   EXPECT_EQ(gateway_watch_of(x), GatewayWatch::Heartbeat);
 }
@@ -221,7 +222,7 @@ axes:
   - { name: y, bus: can0, address: 2, device: generic-cia402, mechanics: { encoder_counts_per_rev: 4096 } }
 )",
                                           "s.yaml", test_options());
-  EXPECT_EQ(plan.buses[0].canopen.transport, CanTransportKind::Simulated);
+  EXPECT_EQ(plan.buses[0].section<CanopenBusOptions>().transport, CanTransportKind::Simulated);
   const std::string text = describe_plan(plan);
   EXPECT_NE(text.find("simulated drive:       persona akd"), std::string::npos) << text;
   EXPECT_NE(text.find("simulated drive:       persona generic"), std::string::npos) << text;
@@ -348,7 +349,7 @@ TEST(CanopenPlanErrors, GatewayWatchIsOneOfFourChoices) {
                  std::string("    mechanics: { encoder_counts_per_rev: 100 }\n    canopen: { gateway_watch: ") + v +
                      " }\n"),
         "t.yaml", test_options());
-    ASSERT_TRUE(plan.buses[0].axes[0].canopen.gateway_watch.has_value()) << v;
+    ASSERT_TRUE(plan.buses[0].axes[0].section<CanopenAxisOptions>().gateway_watch.has_value()) << v;
   }
   // Defaults: the profile's (generic-cia402: optional; AKD: heartbeat; SD6: guarding).
   const Plan plan = load_plan_from_string(one_axis("", "generic-cia402", 5,
@@ -499,7 +500,7 @@ axes:
                               ":1: [2FFF].PDOMapping: should be 0 or 1, got \"yes\"; read as 1 (mappable)";
   EXPECT_EQ(std::count(plan.warnings.begin(), plan.warnings.end(), warning), 1) << testing::PrintToString(plan.warnings);
   EXPECT_NE(describe_plan(plan).find("warnings\n  " + warning + "\n"), std::string::npos) << describe_plan(plan);
-  const EdsObject* vendor = find_eds_object(plan.buses[0].axes[0].canopen.eds_objects, "vendor thing");
+  const EdsObject* vendor = find_eds_object(plan.buses[0].axes[0].section<CanopenAxisOptions>().eds_objects, "vendor thing");
   ASSERT_NE(vendor, nullptr);
   EXPECT_EQ(eds_type_name(vendor->data_type), "0x0040 (vendor-defined)");
 }

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 
+#include "config/canopen/plan.hpp"
 #include "config/device_profile.hpp"
 #include "config/object_text.hpp"
 #include "tests/config/test_support.hpp"
@@ -31,21 +32,21 @@ bool lists(const DeviceProfile& p, ObjectId id) {
 }
 
 bool has_write(const DeviceProfile& p, ObjectId id) {
-  for (const auto& w : p.canopen.startup_writes)
+  for (const auto& w : p.section<CanopenDeviceSpec>().startup_writes)
     if (w.def.id == id) return true;
   return false;
 }
 // The profile's start-up write of `id` (an empty one when there is none: has_write() says).
 const StartupWrite& write_of(const DeviceProfile& p, ObjectId id) {
   static const StartupWrite kNone{};
-  for (const auto& w : p.canopen.startup_writes)
+  for (const auto& w : p.section<CanopenDeviceSpec>().startup_writes)
     if (w.def.id == id) return w;
   return kNone;
 }
 
 TEST(CanopenProfiles, KollmorgenAkd) {
   const DeviceProfile p = load("kollmorgen-akd");
-  const auto& co = p.canopen;
+  const auto& co = p.section<CanopenDeviceSpec>();
   ASSERT_TRUE(co.present);
   EXPECT_EQ(p.identity.vendor_id, 0x6AU);
   EXPECT_EQ(co.device_type, 0x00020192U);
@@ -97,7 +98,7 @@ TEST(CanopenProfiles, KollmorgenAkd) {
 
 TEST(CanopenProfiles, NordSk500p) {
   const DeviceProfile p = load("nord-sk500p");
-  const auto& co = p.canopen;
+  const auto& co = p.section<CanopenDeviceSpec>();
   for (const auto m : {core::Mode::ProfilePosition, core::Mode::Velocity, core::Mode::ProfileVelocity,
                        core::Mode::ProfileTorque, core::Mode::Homing})
     EXPECT_TRUE(p.modes.contains(m));
@@ -133,7 +134,7 @@ TEST(CanopenProfiles, NordSk500p) {
 
 TEST(CanopenProfiles, StoeberSd6) {
   const DeviceProfile p = load("stoeber-sd6");
-  const auto& co = p.canopen;
+  const auto& co = p.section<CanopenDeviceSpec>();
   EXPECT_EQ(p.identity.vendor_id, 0xB9U);
   EXPECT_EQ(co.device_type, 0x00020192U);
   EXPECT_EQ(co.pdo_policy, PdoPolicy::Verify);
@@ -164,11 +165,11 @@ TEST(CanopenProfiles, StoeberSd6) {
 
 TEST(CanopenProfiles, GenericMapsEqualItsCyclicObjects) {
   const DeviceProfile p = load("generic-cia402");
-  ASSERT_TRUE(p.canopen.present);
-  EXPECT_EQ(p.canopen.persona, "generic");
-  EXPECT_EQ(p.canopen.device_type_mask, 0x0000FFFFU);
+  ASSERT_TRUE(p.section<CanopenDeviceSpec>().present);
+  EXPECT_EQ(p.section<CanopenDeviceSpec>().persona, "generic");
+  EXPECT_EQ(p.section<CanopenDeviceSpec>().device_type_mask, 0x0000FFFFU);
   std::size_t mapped = 0;
-  for (const auto* pdos : {&p.canopen.rpdos, &p.canopen.tpdos})
+  for (const auto* pdos : {&p.section<CanopenDeviceSpec>().rpdos, &p.section<CanopenDeviceSpec>().tpdos})
     for (const auto& pdo : *pdos)
       for (const auto& e : pdo.entries) {
         EXPECT_TRUE(lists(p, e.object)) << object_text(e.object);
@@ -195,7 +196,7 @@ TEST(CanopenProfiles, TypeLimits) {
   EXPECT_EQ(data_type_names(), (Strings{"i8", "u8", "i16", "u16", "i32", "u32"}));
 }
 
-TEST(CanopenProfiles, SimServoHasNoCanopenSection) { EXPECT_FALSE(load("sim-servo").canopen.present); }
+TEST(CanopenProfiles, SimServoHasNoCanopenSection) { EXPECT_FALSE(load("sim-servo").section<CanopenDeviceSpec>().present); }
 
 class CanopenProfileErrors : public test::TempDir {
  protected:
@@ -227,8 +228,8 @@ TEST_F(CanopenProfileErrors, MinimalSectionLoadsAndDerivesTheCyclicImage) {
   EXPECT_EQ(errors_of("canopen:\n" + kMaps), "(loaded without error)");
   const DeviceProfile p = load_device_profile(dir_ / "drive.yaml");
   EXPECT_EQ(p.cyclic_objects, (std::vector<ObjectId>{{0x6040, 0}, {0x6060, 0}, {0x6041, 0}, {0x6061, 0}}));
-  EXPECT_EQ(p.canopen.rpdos[0].transmission_type, 1);  // default: every SYNC
-  EXPECT_EQ(p.canopen.persona, "generic");
+  EXPECT_EQ(p.section<CanopenDeviceSpec>().rpdos[0].transmission_type, 1);  // default: every SYNC
+  EXPECT_EQ(p.section<CanopenDeviceSpec>().persona, "generic");
 }
 
 TEST_F(CanopenProfileErrors, PdoSizeAndEntries) {
@@ -349,7 +350,7 @@ TEST_F(CanopenProfileErrors, ErrorControlMustLetTheDriveWatchTheGateway) {
   const std::string guard = errors_of("canopen:\n  error_control: guarding\n  consumer_heartbeat: true\n" + kMaps);
   EXPECT_REPORTED(guard, at(7, 23) + "canopen.consumer_heartbeat: only with error_control: heartbeat");
   EXPECT_EQ(errors_of("canopen:\n  error_control: guarding\n" + kMaps), "(loaded without error)");
-  EXPECT_FALSE(load_device_profile(dir_ / "drive.yaml").canopen.consumer_heartbeat);
+  EXPECT_FALSE(load_device_profile(dir_ / "drive.yaml").section<CanopenDeviceSpec>().consumer_heartbeat);
 }
 
 TEST_F(CanopenProfileErrors, GatewayWatch) {
@@ -359,9 +360,9 @@ TEST_F(CanopenProfileErrors, GatewayWatch) {
   const std::string guard = errors_of("canopen:\n  error_control: guarding\n  gateway_watch: optional\n" + kMaps);
   EXPECT_REPORTED(guard, at(7, 18) + "canopen.gateway_watch: only guarding with error_control: guarding");
   EXPECT_EQ(errors_of("canopen:\n  gateway_watch: optional\n" + kMaps), "(loaded without error)");
-  EXPECT_EQ(load_device_profile(dir_ / "drive.yaml").canopen.gateway_watch, GatewayWatch::Optional);
+  EXPECT_EQ(load_device_profile(dir_ / "drive.yaml").section<CanopenDeviceSpec>().gateway_watch, GatewayWatch::Optional);
   EXPECT_EQ(errors_of("canopen:\n  error_control: guarding\n" + kMaps), "(loaded without error)");
-  EXPECT_EQ(load_device_profile(dir_ / "drive.yaml").canopen.gateway_watch, GatewayWatch::Guarding);
+  EXPECT_EQ(load_device_profile(dir_ / "drive.yaml").section<CanopenDeviceSpec>().gateway_watch, GatewayWatch::Guarding);
 }
 
 TEST_F(CanopenProfileErrors, FixedMappingCountLimitsEntries) {
@@ -414,9 +415,9 @@ TEST_F(CanopenProfileErrors, ParameterNamesInStartupWrites) {
 )" + kMaps),
             "(loaded without error)");
   const DeviceProfile p = load_device_profile(dir_ / "drive.yaml");
-  ASSERT_EQ(p.canopen.startup_writes.size(), 2U);
-  EXPECT_EQ(p.canopen.startup_writes[0].def.id, (ObjectId{0x2053, 0}));
-  EXPECT_EQ(p.canopen.startup_writes[1].def.id, (ObjectId{0x28C8, 0}));
+  ASSERT_EQ(p.section<CanopenDeviceSpec>().startup_writes.size(), 2U);
+  EXPECT_EQ(p.section<CanopenDeviceSpec>().startup_writes[0].def.id, (ObjectId{0x2053, 0}));
+  EXPECT_EQ(p.section<CanopenDeviceSpec>().startup_writes[1].def.id, (ObjectId{0x28C8, 0}));
   const std::string e = errors_of(R"(canopen:
   parameter_names: { base: 0x2000, group_stride: 0x200, max_line: 511 }
   startup_writes: [{ object: A540, type: i8, value: 2, why: fault reaction }]

@@ -7,11 +7,26 @@
 #include <limits>
 #include <sstream>
 
-#include "config/eds.hpp"
+#include "config/canopen/eds.hpp"
+#include "core/param_value.hpp"
 #include "tests/config/test_support.hpp"
 
 namespace drivegate::config {
 namespace {
+
+// The objects of load_eds / load_eds_text; nullopt when the file has errors.
+std::optional<std::vector<EdsObject>> objects_of_file(const std::string& file, Problems& problems) {
+  auto eds = load_eds(file, problems);
+  if (!eds) return std::nullopt;
+  return std::move(eds->objects);
+}
+
+std::optional<std::vector<EdsObject>> objects_of_text(std::string_view text, const std::string& label,
+                                                      Problems& problems) {
+  auto eds = load_eds_text(text, label, problems);
+  if (!eds) return std::nullopt;
+  return std::move(eds->objects);
+}
 
 // Errors and warnings of parsing `text` as x.eds, one per line.
 struct Report {
@@ -23,7 +38,7 @@ struct Report {
 Report report_of(const std::string& text) {
   Problems problems;
   Report r;
-  r.objects = parse_eds_text(text, "x.eds", problems);
+  r.objects = objects_of_text(text, "x.eds", problems);
   EXPECT_EQ(r.objects.has_value(), !problems.has_errors());
   for (const auto& d : problems.errors()) r.errors += d.to_string() + "\n";
   for (const auto& d : problems.warnings()) r.warnings += d.to_string() + "\n";
@@ -48,23 +63,24 @@ std::optional<std::int64_t> high(const EdsObject* o) {
 }
 
 TEST(Eds, IntegerTypesOfParameterRequests) {
-  EXPECT_EQ(eds_integer_type(0x0001), cia402::DataType::U8);  // BOOLEAN travels as a byte
-  EXPECT_EQ(eds_integer_type(0x0002), cia402::DataType::I8);
-  EXPECT_EQ(eds_integer_type(0x0003), cia402::DataType::I16);
-  EXPECT_EQ(eds_integer_type(0x0004), cia402::DataType::I32);
-  EXPECT_EQ(eds_integer_type(0x0005), cia402::DataType::U8);
-  EXPECT_EQ(eds_integer_type(0x0006), cia402::DataType::U16);
-  EXPECT_EQ(eds_integer_type(0x0007), cia402::DataType::U32);
-  EXPECT_FALSE(eds_integer_type(0x0008));  // REAL32: 4 bytes, but not an integer
-  EXPECT_FALSE(eds_integer_type(0x0010));  // INTEGER24
-  EXPECT_FALSE(eds_integer_type(0x0015));  // INTEGER64
-  EXPECT_FALSE(eds_integer_type(0x001B));  // UNSIGNED64
-  EXPECT_FALSE(eds_integer_type(0x0040));  // vendor-defined
+  // A parameter request carries the type of the EDS object (core::param_type_from_cia), whatever its size.
+  EXPECT_EQ(core::param_type_from_cia(0x0001), core::ParamType::Bool);
+  EXPECT_EQ(core::param_type_from_cia(0x0002), core::ParamType::I8);
+  EXPECT_EQ(core::param_type_from_cia(0x0003), core::ParamType::I16);
+  EXPECT_EQ(core::param_type_from_cia(0x0004), core::ParamType::I32);
+  EXPECT_EQ(core::param_type_from_cia(0x0005), core::ParamType::U8);
+  EXPECT_EQ(core::param_type_from_cia(0x0006), core::ParamType::U16);
+  EXPECT_EQ(core::param_type_from_cia(0x0007), core::ParamType::U32);
+  EXPECT_EQ(core::param_type_from_cia(0x0008), core::ParamType::R32);
+  EXPECT_EQ(core::param_type_from_cia(0x0010), core::ParamType::I24);
+  EXPECT_EQ(core::param_type_from_cia(0x0015), core::ParamType::I64);
+  EXPECT_EQ(core::param_type_from_cia(0x001B), core::ParamType::U64);
+  EXPECT_EQ(core::param_type_from_cia(0x0040), core::ParamType::Unknown);  // vendor-defined
 }
 
 TEST(Eds, TheTestFileParses) {
   Problems problems;
-  const auto objects = parse_eds(DRIVEGATE_TEST_DEVICE_DIR "/akd-canopen.eds", problems);
+  const auto objects = objects_of_file(DRIVEGATE_TEST_DEVICE_DIR "/akd-canopen.eds", problems);
   ASSERT_TRUE(objects) << problems.errors().front().to_string();
   EXPECT_TRUE(problems.warnings().empty()) << warnings_text(problems);
   // VARs and the sub-indices of arrays/records; the ARRAY/RECORD headers themselves are not entries.
@@ -87,7 +103,7 @@ TEST(Eds, TheTestFileParses) {
 
 TEST(Eds, EntriesAndAttributes) {
   Problems problems;
-  const auto objects = parse_eds_text(R"(; comment
+  const auto objects = objects_of_text(R"(; comment
 [FileInfo]
 FileName=x.eds
 
@@ -141,7 +157,7 @@ ObjectType=0x9
   ASSERT_NE(vendor, nullptr);
   EXPECT_EQ(vendor->name, "Vendor-ID");
   EXPECT_EQ(vendor->data_type, 0x0007);
-  EXPECT_EQ(eds_integer_type(vendor->data_type), cia402::DataType::U32);
+  EXPECT_EQ(core::param_type_from_cia(vendor->data_type), core::ParamType::U32);
   EXPECT_EQ(vendor->access, EdsAccess::ReadOnly);  // keys and access values are case-insensitive
   EXPECT_FALSE(vendor->pdo_mapping);               // PDOMapping left out: not mappable
   EXPECT_EQ(vendor->default_value, "0x6A");
@@ -150,7 +166,7 @@ ObjectType=0x9
   ASSERT_NE(name, nullptr);  // ObjectType left out: a VAR
   EXPECT_EQ(eds_type_name(name->data_type), "VISIBLE_STRING");
   EXPECT_FALSE(eds_type_bits(name->data_type));
-  EXPECT_FALSE(eds_integer_type(name->data_type));  // no parameter request carries a string
+  EXPECT_EQ(core::param_type_from_cia(name->data_type), core::ParamType::VisibleString);
   EXPECT_FALSE(name->writable());
   const EdsObject* mode = find_eds_object(*objects, cia402::ObjectId{0x6060, 0});
   ASSERT_NE(mode, nullptr);
@@ -167,7 +183,7 @@ ObjectType=0x9
 
 TEST(Eds, LookupByNameIsCaseInsensitiveAndUnique) {
   Problems problems;
-  const auto objects = parse_eds(DRIVEGATE_TEST_DEVICE_DIR "/akd-canopen.eds", problems);
+  const auto objects = objects_of_file(DRIVEGATE_TEST_DEVICE_DIR "/akd-canopen.eds", problems);
   ASSERT_TRUE(objects);
   const EdsObject* sw = find_eds_object(*objects, "statusWORD");
   ASSERT_NE(sw, nullptr);
@@ -274,7 +290,7 @@ TEST(Eds, SkippedObjectsAreListed) {
 
 TEST(Eds, UnreadableFile) {
   Problems problems;
-  EXPECT_FALSE(parse_eds("/nonexistent/drive.eds", problems));
+  EXPECT_FALSE(objects_of_file("/nonexistent/drive.eds", problems));
   ASSERT_EQ(problems.errors().size(), 1U);
   EXPECT_NE(problems.errors()[0].to_string().find("/nonexistent/drive.eds: cannot open file"), std::string::npos);
 }
@@ -284,7 +300,7 @@ TEST(Eds, BinaryGarbageIsReportedNotFatal) {
   for (int i = 0; i < 256; ++i) junk += static_cast<char>(i);
   junk += "\n[\n]\n=\n[]\n[sub]\n[0000sub]\n";
   Problems problems;
-  EXPECT_FALSE(parse_eds_text(junk, "junk.eds", problems));
+  EXPECT_FALSE(objects_of_text(junk, "junk.eds", problems));
   EXPECT_TRUE(problems.has_errors());
 }
 
@@ -362,7 +378,7 @@ TEST(Eds, LimitsCompareAcrossRepresentations) {
 
 TEST(Eds, NumbersInEveryFieldAndForm) {
   Problems problems;
-  const auto objects = parse_eds(corpus("numbers.eds"), problems);
+  const auto objects = objects_of_file(corpus("numbers.eds"), problems);
   ASSERT_TRUE(objects) << problems.errors().front().to_string();
   EXPECT_TRUE(problems.warnings().empty()) << warnings_text(problems);
   const EdsObject* type = find_eds_object(*objects, cia402::ObjectId{0x1000, 0});
@@ -415,7 +431,7 @@ struct TypeRow {
 
 TEST(Eds, EveryStandardDataType) {
   Problems problems;
-  const auto objects = parse_eds(corpus("types.eds"), problems);
+  const auto objects = objects_of_file(corpus("types.eds"), problems);
   ASSERT_TRUE(objects) << problems.errors().front().to_string();
   EXPECT_TRUE(problems.warnings().empty()) << warnings_text(problems);
   using K = EdsTypeKind;
@@ -463,7 +479,7 @@ TEST(Eds, EveryStandardDataType) {
   EXPECT_EQ(eds_type_name(0x0040), "0x0040 (vendor-defined)");
   EXPECT_EQ(eds_type_kind(0x0040), EdsTypeKind::VendorDefined);
   EXPECT_FALSE(eds_type_bits(0x0040));
-  EXPECT_FALSE(eds_integer_type(0x0040));
+  EXPECT_EQ(core::param_type_from_cia(0x0040), core::ParamType::Unknown);
   EXPECT_EQ(find_eds_object(*objects, cia402::ObjectId{0x2002, 0})->data_type, 0x005F);
   EXPECT_EQ(eds_type_name(0x005F), "0x005F (vendor-defined)");
   EXPECT_EQ(find_eds_object(*objects, cia402::ObjectId{0x2003, 0})->data_type, 0x0060);
@@ -483,7 +499,7 @@ TEST(Eds, EveryStandardDataType) {
 
 TEST(Eds, IntegerAndRealLimitsSurvive) {
   Problems problems;
-  const auto objects = parse_eds(corpus("types.eds"), problems);
+  const auto objects = objects_of_file(corpus("types.eds"), problems);
   ASSERT_TRUE(objects);
   const auto at = [&](std::uint16_t index) { return find_eds_object(*objects, cia402::ObjectId{index, 0}); };
   const EdsObject* current = at(0x2100);  // REAL32 -1e3 .. 4.5
@@ -514,7 +530,7 @@ TEST(Eds, IntegerAndRealLimitsSurvive) {
 
 TEST(Eds, CompactSubObjArrays) {
   Problems problems;
-  const auto objects = parse_eds(corpus("compact.eds"), problems);
+  const auto objects = objects_of_file(corpus("compact.eds"), problems);
   ASSERT_TRUE(objects) << problems.errors().front().to_string();
   EXPECT_TRUE(problems.warnings().empty()) << warnings_text(problems);
   const auto at = [&](std::uint16_t index, std::uint8_t sub) { return find_eds_object(*objects, cia402::ObjectId{index, sub}); };
@@ -630,7 +646,7 @@ CompactSubObj=2
 TEST(Eds, InTheWildFileLoadsWithWarnings) {
   Problems problems;
   const std::string file = corpus("in-the-wild.eds");
-  const auto objects = parse_eds(file, problems);
+  const auto objects = objects_of_file(file, problems);
   ASSERT_TRUE(objects) << problems.errors().front().to_string();
   const auto w = [&file](const std::string& rest) { return file + ":" + rest + "\n"; };
   EXPECT_EQ(warnings_text(problems),
@@ -706,7 +722,7 @@ TEST(Eds, TooManyWarningsAreCounted) {
   std::string text = "[6040]\nParameterName=Controlword\nDataType=0x0006\nAccessType=rw\n";
   for (int i = 0; i < 60; ++i) text += "[Vendor" + std::to_string(i) + "]\n";
   Problems problems;
-  ASSERT_TRUE(parse_eds_text(text, "x.eds", problems));
+  ASSERT_TRUE(objects_of_text(text, "x.eds", problems));
   ASSERT_EQ(problems.warnings().size(), kMaxEdsWarnings + 1);
   EXPECT_EQ(problems.warnings().back().to_string(), "x.eds: 10 more warnings about this file not shown");
 }

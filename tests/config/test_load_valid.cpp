@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include "config/canopen/plan.hpp"
+#include "config/sim/plan.hpp"
 #include "config/describe.hpp"
 #include "config/loader.hpp"
 #include "tests/config/test_support.hpp"
@@ -61,7 +63,7 @@ TEST(LoadValid, GatewayAndBus) {
   EXPECT_EQ(bus.cycle_time, core::Duration{500us});
   EXPECT_EQ(bus.priority, 80);
   EXPECT_EQ(bus.cpu, 0);
-  EXPECT_EQ(bus.sim.acyclic_latency_cycles, 3);
+  EXPECT_EQ(bus.section<SimBusOptions>().acyclic_latency_cycles, 3);
   EXPECT_EQ(std::get<std::int64_t>(bus.options.at("acyclic_latency_cycles")), 3);
   ASSERT_EQ(bus.axes.size(), 2U);
   EXPECT_TRUE(plan.warnings.empty());
@@ -106,13 +108,13 @@ TEST(LoadValid, AxisSpecIsFilledWithHandComputedFactors) {
   EXPECT_EQ(s.timeout_stop, core::TimeoutStop::Halt);
   EXPECT_EQ(s.enable_step_timeout, core::Duration{1500ms});
   // Simulated drive settings arrive in drive units.
-  EXPECT_DOUBLE_EQ(x.sim.start_position, 786432.0);
-  ASSERT_TRUE(x.sim.home_switch_position.has_value());
-  EXPECT_DOUBLE_EQ(*x.sim.home_switch_position, 1572864.0);
-  EXPECT_DOUBLE_EQ(*x.sim.negative_limit_switch_position, -110 * 78643.2);
-  EXPECT_DOUBLE_EQ(*x.sim.positive_limit_switch_position, 510 * 78643.2);
-  EXPECT_DOUBLE_EQ(x.sim.max_velocity, 300 * 78643.2);
-  EXPECT_DOUBLE_EQ(x.sim.max_acceleration, 1000.0 * 131072.0);  // default: 1000 motor rev/s^2
+  EXPECT_DOUBLE_EQ(x.section<SimAxisOptions>().start_position, 786432.0);
+  ASSERT_TRUE(x.section<SimAxisOptions>().home_switch_position.has_value());
+  EXPECT_DOUBLE_EQ(*x.section<SimAxisOptions>().home_switch_position, 1572864.0);
+  EXPECT_DOUBLE_EQ(*x.section<SimAxisOptions>().negative_limit_switch_position, -110 * 78643.2);
+  EXPECT_DOUBLE_EQ(*x.section<SimAxisOptions>().positive_limit_switch_position, 510 * 78643.2);
+  EXPECT_DOUBLE_EQ(x.section<SimAxisOptions>().max_velocity, 300 * 78643.2);
+  EXPECT_DOUBLE_EQ(x.section<SimAxisOptions>().max_acceleration, 1000.0 * 131072.0);  // default: 1000 motor rev/s^2
   ASSERT_EQ(x.device.cyclic_objects.size(), 12U);
   EXPECT_EQ(x.device.cyclic_objects[0], (cia402::ObjectId{0x6040, 0}));
 }
@@ -134,7 +136,7 @@ TEST(LoadValid, FixedDeviceUnitsAndDefaults) {
   EXPECT_EQ(t.spec.homing.method, 35);
   EXPECT_TRUE(t.device.quirk("no_sync_producer"));
   EXPECT_FALSE(t.device.quirk("quick_stop_clears_setpoints"));
-  EXPECT_DOUBLE_EQ(t.sim.max_velocity, 50.0 * 60.0);  // default top speed 50 rev/s in rpm
+  EXPECT_DOUBLE_EQ(t.section<SimAxisOptions>().max_velocity, 50.0 * 60.0);  // default top speed 50 rev/s in rpm
 }
 
 TEST(LoadValid, DemoConfigLoads) {
@@ -162,13 +164,13 @@ TEST(LoadValid, DemoConfigLoads) {
   // The homing method must be one the simulated drive implements.
   const std::vector<std::int16_t> sim_methods{1, 2, 17, 18, 33, 34, 35, 37};
   EXPECT_NE(std::find(sim_methods.begin(), sim_methods.end(), table.spec.homing.method), sim_methods.end());
-  EXPECT_TRUE(table.sim.negative_limit_switch_position.has_value());
-  EXPECT_TRUE(table.sim.home_switch_position.has_value());
+  EXPECT_TRUE(table.section<SimAxisOptions>().negative_limit_switch_position.has_value());
+  EXPECT_TRUE(table.section<SimAxisOptions>().home_switch_position.has_value());
 
   // The CANopen bus: one simulated drive of each reference type.
   const BusPlan& can = plan.buses[1];
   EXPECT_EQ(can.type, "canopen");
-  EXPECT_EQ(can.canopen.transport, CanTransportKind::Simulated);
+  EXPECT_EQ(can.section<CanopenBusOptions>().transport, CanTransportKind::Simulated);
   ASSERT_EQ(can.axes.size(), 3U);
   EXPECT_EQ(can.axes[0].device.name, "kollmorgen-akd");
   EXPECT_EQ(can.axes[1].device.name, "nord-sk500p");

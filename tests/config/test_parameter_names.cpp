@@ -1,7 +1,7 @@
 // Manufacturer parameter names -> objects (STÖBER: stoeber-sd6-canopen.md §2.2).
 #include <gtest/gtest.h>
 
-#include "config/parameter_names.hpp"
+#include "config/canopen/parameter_names.hpp"
 
 namespace drivegate::config {
 namespace {

@@ -94,7 +94,7 @@ SimPeer::Wiring SimPeer::wire(const config::BusPlan& plan) {
   // error control, plus SYNC and NMT on the gateway side.
   InprocBusOptions options;
   options.tx_queue_capacity = std::max<std::size_t>(options.tx_queue_capacity, 8 * plan.axes.size() + 64);
-  auto bus = std::make_shared<InprocBus>(plan.canopen.bitrate, options);
+  auto bus = std::make_shared<InprocBus>(plan.section<config::CanopenBusOptions>().bitrate, options);
   auto endpoint = bus->connect();
   const InprocEndpoint* gateway_end = endpoint.get();
   auto gateway = std::make_unique<GatewayEndpoint>(bus, std::move(endpoint));

@@ -17,7 +17,7 @@
 #include "adapters/canopen/sim/slave_node.hpp"
 #include "adapters/canopen/transport/inproc_bus.hpp"
 #include "adapters/canopen/transport/transport.hpp"
-#include "config/plan.hpp"
+#include "config/canopen/plan.hpp"
 #include "core/clock.hpp"
 
 namespace drivegate::canopen::sim {

@@ -85,7 +85,7 @@ SlaveNodeConfig make_slave_config(NodeId node, const Persona& persona, cia402::s
 }
 
 SlaveNodeConfig slave_config_for(const config::AxisPlan& axis) {
-  const auto& dev = axis.device.canopen;
+  const auto& dev = axis.device.section<config::CanopenDeviceSpec>();
   auto drive = drivegate::sim::drive_config_for(axis);
   // The profile's expected device type is what a drive of that kind reports, unless the persona
   // is a drive with a type of its own.

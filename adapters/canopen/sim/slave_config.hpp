@@ -8,7 +8,7 @@
 #include "adapters/canopen/sim/persona.hpp"
 #include "adapters/canopen/sim/slave_pdo.hpp"
 #include "adapters/canopen/wire/cob_id.hpp"
-#include "config/plan.hpp"
+#include "config/canopen/plan.hpp"
 #include "profiles/cia402/sim/drive_model.hpp"
 
 namespace drivegate::canopen::sim {

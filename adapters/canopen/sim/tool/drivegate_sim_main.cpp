@@ -323,7 +323,8 @@ int run(int argc, char** argv) {
   std::vector<std::string> ready;
   for (const auto& bus : plan.buses) {
     if (bus.type != "canopen" || (!only.empty() && bus.name != only)) continue;
-    if (bus.canopen.transport != config::CanTransportKind::UdpMulticast) {
+    const auto& options = bus.section<config::CanopenBusOptions>();
+    if (options.transport != config::CanTransportKind::UdpMulticast) {
       if (!only.empty()) {
         std::fprintf(stderr, "drivegate-sim: bus '%s' is not on udp-multicast\n", bus.name.c_str());
         return 2;
@@ -335,7 +336,7 @@ int run(int argc, char** argv) {
     b.network = std::make_unique<SimNetwork>(*b.transport);
     for (const auto& axis : bus.axes) b.network->add(canopen::sim::slave_config_for(axis));
     ready.push_back("drivegate-sim: " + std::to_string(bus.axes.size()) + " nodes on udp-multicast " +
-                    bus.canopen.group + ":" + std::to_string(bus.canopen.port));
+                    options.group + ":" + std::to_string(options.port));
     buses.push_back(std::move(b));
   }
   if (buses.empty()) {

@@ -1,4 +1,4 @@
-#include "config/parameter_names.hpp"
+#include "config/canopen/parameter_names.hpp"
 
 #include <cctype>
 #include <charconv>

@@ -1,4 +1,4 @@
-#include "config/canopen_profile.hpp"
+#include "config/canopen/device_section.hpp"
 
 #include <algorithm>
 #include <cstdio>
@@ -6,7 +6,7 @@
 #include <sstream>
 
 #include "config/object_text.hpp"
-#include "config/parameter_names.hpp"
+#include "config/canopen/parameter_names.hpp"
 #include "config/text_util.hpp"
 #include "profiles/cia402/standard_types.hpp"
 
@@ -108,7 +108,8 @@ void read_pdos(const MapReader& c, const std::string& key, bool receive, const D
   const Source& src = c.source();
   const std::string what = receive ? "RPDO" : "TPDO";
   std::map<std::int64_t, std::string> numbers;
-  const int max_entries = p.canopen.fixed_mapping_count > 0 ? p.canopen.fixed_mapping_count : 8;
+  const int fixed = p.section<CanopenDeviceSpec>().fixed_mapping_count;
+  const int max_entries = fixed > 0 ? fixed : 8;
   for (std::size_t i = 0; i < list->size(); ++i) {
     const MapReader m{(*list)[i], indexed(c.field(key), i), src};
     if (!m.present()) continue;
@@ -178,7 +179,7 @@ bool maps(const std::vector<PdoSpec>& pdos, cia402::ObjectId id) {
 }
 
 void check_directions(const MapReader& c, const DeviceProfile& p) {
-  const auto& co = p.canopen;
+  const auto& co = p.section<CanopenDeviceSpec>();
   if (co.rpdos.empty() && co.tpdos.empty()) return;
   const auto need = [&](const std::vector<PdoSpec>& pdos, const char* key, cia402::ObjectId id, const std::string& why) {
     if (!maps(pdos, id)) c.error(key, "must map " + hex_text(id) + " " + why);
@@ -260,7 +261,8 @@ void read_sync_periods(const MapReader& c, CanopenDeviceSpec& co) {
 // list exactly those, so the two cannot drift apart.
 void reconcile_cyclic_objects(const MapReader& root, DeviceProfile& p, bool cyclic_given) {
   std::vector<cia402::ObjectId> mapped;
-  for (const auto* pdos : {&p.canopen.rpdos, &p.canopen.tpdos})
+  const auto& co = p.section<CanopenDeviceSpec>();
+  for (const auto* pdos : {&co.rpdos, &co.tpdos})
     for (const auto& pdo : *pdos)
       for (const auto& e : pdo.entries) mapped.push_back(e.object);
   if (mapped.empty()) return;
@@ -343,7 +345,7 @@ void read_canopen_device(const MapReader& root, DeviceProfile& p, bool cyclic_gi
   if (!root.has("canopen")) return;
   const MapReader c = root.map("canopen", Need::Optional);
   if (!c.present()) return;
-  auto& co = p.canopen;
+  auto& co = p.sections.edit<CanopenDeviceSpec>();
   co.present = true;
   c.check_keys({"device_type", "device_type_mask", "persona", "sdo_channels", "error_control", "consumer_heartbeat",
                 "gateway_watch",

@@ -5,6 +5,7 @@
 // produces the SYNC the device's synchronous PDOs need.
 #include <filesystem>
 
+#include "config/canopen/plan.hpp"
 #include "config/plan.hpp"
 #include "config/yaml_reader.hpp"
 

@@ -1,4 +1,4 @@
-#include "config/eds.hpp"
+#include "config/canopen/eds.hpp"
 
 #include <algorithm>
 #include <array>
@@ -924,19 +924,6 @@ std::optional<EdsDictionary> load_eds_text(std::string_view text, const std::str
   return Parser{label, problems}.run(text);
 }
 
-std::optional<std::vector<EdsObject>> parse_eds(const std::filesystem::path& file, Problems& problems) {
-  auto d = load_eds(file, problems);
-  if (!d) return std::nullopt;
-  return std::move(d->objects);
-}
-
-std::optional<std::vector<EdsObject>> parse_eds_text(std::string_view text, const std::string& label,
-                                                     Problems& problems) {
-  auto d = load_eds_text(text, label, problems);
-  if (!d) return std::nullopt;
-  return std::move(d->objects);
-}
-
 const EdsObject* find_eds_object(std::span<const EdsObject> objects, cia402::ObjectId id) noexcept {
   const auto it = std::find_if(objects.begin(), objects.end(), [id](const EdsObject& o) { return o.id == id; });
   return it == objects.end() ? nullptr : &*it;
@@ -992,19 +979,6 @@ std::optional<std::uint8_t> eds_type_bits(std::uint16_t data_type) noexcept {
   const TypeInfo* t = type_info(data_type);
   if (!t || t->bits == 0) return std::nullopt;
   return t->bits;
-}
-
-std::optional<cia402::DataType> eds_integer_type(std::uint16_t data_type) noexcept {
-  switch (data_type) {  // CiA 301 §7.4.7.1
-    case 0x0001: return cia402::DataType::U8;  // BOOLEAN
-    case 0x0002: return cia402::DataType::I8;
-    case 0x0003: return cia402::DataType::I16;
-    case 0x0004: return cia402::DataType::I32;
-    case 0x0005: return cia402::DataType::U8;
-    case 0x0006: return cia402::DataType::U16;
-    case 0x0007: return cia402::DataType::U32;
-    default: return std::nullopt;
-  }
 }
 
 std::string_view to_string(EdsAccess access) noexcept {

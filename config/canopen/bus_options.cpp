@@ -1,4 +1,4 @@
-#include "config/canopen_bus.hpp"
+#include "config/canopen/bus_options.hpp"
 
 #include <algorithm>
 #include <array>
@@ -58,20 +58,9 @@ void check_whole_ms(const MapReader& m, const BusPlan& bus, const char* name, co
 
 }  // namespace
 
-BusTypeInfo canopen_bus_type() {
-  BusTypeInfo t;
-  t.name = "canopen";
-  t.available = true;
-  t.min_address = 1;  // node-IDs 1..127 [CiA 301 §7.3.2]
-  t.max_address = 127;
-  t.axis_section = "canopen";
-  t.address_words = "a CANopen node-ID";
-  // SYNC period: 1 ms is the shortest cycle the reference drives run (SD6 A150: 1..8 ms,
-  // stoeber-sd6-canopen.md §7; AKD ip/csp whole milliseconds, akd part 2 §15.16).
-  t.min_cycle_time = 1ms;
-  t.max_cycle_time = 1s;
+std::vector<OptionSpec> canopen_options() {
   const auto ms = [](double v) { return v / 1000.0; };
-  t.options = {
+  return {
       {"transport", OptionKind::Choice, 0, 0, std::string{"socketcan"},
        "socketcan: a Linux CAN interface; udp-multicast: a virtual CAN bus shared over UDP (python-can "
        "udp_multicast); sim: in-process bus with simulated drives made from the axes' device profiles",
@@ -103,7 +92,6 @@ BusTypeInfo canopen_bus_type() {
       {"boot_retry_max", OptionKind::Duration, ms(10), 3600, core::Duration{10s}, "longest wait between boot retries", {}},
       {"sync", OptionKind::Boolean, 0, 0, true, "produce SYNC every cycle_time (needed by synchronous PDOs)", {}},
   };
-  return t;
 }
 
 const char* to_string(CanTransportKind kind) noexcept {
@@ -116,7 +104,7 @@ const char* to_string(CanTransportKind kind) noexcept {
 }
 
 void read_canopen_bus(const MapReader& b, const MapReader& m, BusPlan& bus) {
-  auto& c = bus.canopen;
+  auto& c = bus.sections.edit<CanopenBusOptions>();
   const std::string& transport = option<std::string>(bus, "transport");
   c.transport = transport == "udp-multicast" ? CanTransportKind::UdpMulticast
                 : transport == "sim"         ? CanTransportKind::Simulated

@@ -5,6 +5,7 @@
 #include <string_view>
 #include <vector>
 
+#include "config/canopen/plan.hpp"
 #include "config/plan.hpp"
 #include "config/yaml_reader.hpp"
 

@@ -7,7 +7,7 @@
 #include <string>
 #include <string_view>
 
-#include "config/plan.hpp"
+#include "config/canopen/plan.hpp"
 #include "profiles/cia402/objects.hpp"
 
 namespace drivegate::config {

@@ -1,9 +1,9 @@
-#include "config/canopen_axis.hpp"
+#include "config/canopen/axis_section.hpp"
 
 #include <algorithm>
 
-#include "config/canopen_profile.hpp"
-#include "config/eds.hpp"
+#include "config/canopen/device_section.hpp"
+#include "config/canopen/eds.hpp"
 #include "config/object_text.hpp"
 #include "config/scalars.hpp"
 #include "config/text_util.hpp"
@@ -40,8 +40,9 @@ std::string eds_text(const EdsObject& o) {
 void check_maps_against_eds(const MapReader& c, const DeviceProfile& device, const std::string& eds_name,
                             const EdsDictionary& eds) {
   const auto& objects = eds.objects;
+  const auto& co = device.section<CanopenDeviceSpec>();
   for (const bool receive : {true, false}) {
-    for (const auto& pdo : receive ? device.canopen.rpdos : device.canopen.tpdos) {
+    for (const auto& pdo : receive ? co.rpdos : co.tpdos) {
       for (const auto& e : pdo.entries) {
         const std::string what = "device \"" + device.name + "\" maps " + object_text(e.object) + " in " +
                                  pdo_name(receive, pdo) + ", ";
@@ -82,7 +83,7 @@ void check_writes_against_eds(const MapReader& c, const std::vector<StartupWrite
   }
 }
 
-void read_eds(const MapReader& c, const DeviceProfile* device, const fs::path& base_dir, AxisPlan& a) {
+void read_eds(const MapReader& c, const DeviceProfile* device, const fs::path& base_dir, CanopenAxisOptions& a) {
   const auto text = c.string("eds", Need::Optional);
   if (!text) return;
   const fs::path p{*text};
@@ -92,7 +93,7 @@ void read_eds(const MapReader& c, const DeviceProfile* device, const fs::path& b
     c.error("eds", "file \"" + file.string() + "\" does not exist (relative paths start at the config file's directory)");
     return;
   }
-  a.canopen.eds = file.string();
+  a.eds = file.string();
   // The EDS' warnings go to the same Problems, so into Plan::warnings and --check-config.
   auto objects = load_eds(file, *c.source().problems);
   if (!objects) {
@@ -102,16 +103,17 @@ void read_eds(const MapReader& c, const DeviceProfile* device, const fs::path& b
   const std::string eds_name = "EDS \"" + file.filename().string() + "\"";
   if (device) {
     check_maps_against_eds(c, *device, eds_name, *objects);
-    check_writes_against_eds(c, device->canopen.startup_writes, "device \"" + device->name + "\"", eds_name, *objects);
+    check_writes_against_eds(c, device->section<CanopenDeviceSpec>().startup_writes, "device \"" + device->name + "\"",
+                             eds_name, *objects);
   }
-  check_writes_against_eds(c, a.canopen.startup_writes, "axis", eds_name, *objects);
-  a.canopen.eds_objects = std::move(objects->objects);
+  check_writes_against_eds(c, a.startup_writes, "axis", eds_name, *objects);
+  a.eds_objects = std::move(objects->objects);
 }
 
 // Synchronous PDOs only move with SYNC; a bus without it would leave the drive's data stale.
 void check_sync(const MapReader& axis, const BusPlan& bus, const DeviceProfile& device) {
-  const auto& co = device.canopen;
-  if (!bus.canopen.sync) {
+  const auto& co = device.section<CanopenDeviceSpec>();
+  if (!bus.section<CanopenBusOptions>().sync) {
     for (const bool receive : {true, false})
       for (const auto& pdo : receive ? co.rpdos : co.tpdos)
         if (pdo.synchronous()) {
@@ -135,20 +137,21 @@ void check_sync(const MapReader& axis, const BusPlan& bus, const DeviceProfile& 
 
 void read_canopen_axis(const MapReader& axis, const BusPlan& bus, const DeviceProfile* device,
                        const fs::path& base_dir, AxisPlan& a) {
-  if (device && !device->canopen.present) {
+  if (device && !device->section<CanopenDeviceSpec>().present) {
     axis.error("device", "device profile \"" + device->name + "\" has no canopen section, which an axis on a "
                          "canopen bus needs (profiles/devices/README.md)");
     device = nullptr;
   }
-  if (a.address != 0 && a.address == bus.canopen.gateway_node_id)
+  if (a.address != 0 && a.address == bus.section<CanopenBusOptions>().gateway_node_id)
     axis.error("address", "node-ID " + std::to_string(a.address) + " is the gateway's own on bus \"" + bus.name +
                               "\" (option gateway_node_id); give the drive another node-ID or change gateway_node_id");
 
+  auto& co = a.sections.edit<CanopenAxisOptions>();
   const MapReader c = axis.map("canopen", Need::Optional);
   c.check_keys({"eds", "sdo_channel", "startup_writes", "gateway_watch"});
-  a.canopen.gateway_watch = read_gateway_watch(c);
+  co.gateway_watch = read_gateway_watch(c);
   if (const auto ch = c.integer("sdo_channel", Need::Optional, 1, 4)) {
-    const int channels = device ? device->canopen.sdo_channels : 4;
+    const int channels = device ? device->section<CanopenDeviceSpec>().sdo_channels : 4;
     if (*ch > channels)
       c.error("sdo_channel", "device \"" + device->name + "\" has " + std::to_string(channels) + " SDO channel" +
                                  (channels == 1 ? "" : "s") + ", got " + std::to_string(*ch));
@@ -158,11 +161,12 @@ void read_canopen_axis(const MapReader& axis, const BusPlan& bus, const DevicePr
       c.error("sdo_channel", "SDO channels 2..4 need node-ID <= 31 (their COB-IDs 580h + 20h x (channel - 1) + "
                              "node-ID overlap channel 1 above 31); axis node-ID is " + std::to_string(a.address));
     else
-      a.canopen.sdo_channel = static_cast<int>(*ch);
+      co.sdo_channel = static_cast<int>(*ch);
   }
-  const std::optional<ParameterNaming> naming = device ? device->canopen.parameter_naming : std::nullopt;
-  read_startup_writes(c, "startup_writes", naming, a.canopen.startup_writes);
-  read_eds(c, device, base_dir, a);
+  const std::optional<ParameterNaming> naming =
+      device ? device->section<CanopenDeviceSpec>().parameter_naming : std::nullopt;
+  read_startup_writes(c, "startup_writes", naming, co.startup_writes);
+  read_eds(c, device, base_dir, co);
   if (device) check_sync(axis, bus, *device);
 }
 

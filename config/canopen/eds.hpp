@@ -119,10 +119,6 @@ inline constexpr std::size_t kMaxEdsWarnings = 50;
 std::optional<EdsDictionary> load_eds(const std::filesystem::path& file, Problems& problems);
 // The same for text in memory; `label` names it in messages.
 std::optional<EdsDictionary> load_eds_text(std::string_view text, const std::string& label, Problems& problems);
-// load_eds / load_eds_text, objects only.
-std::optional<std::vector<EdsObject>> parse_eds(const std::filesystem::path& file, Problems& problems);
-std::optional<std::vector<EdsObject>> parse_eds_text(std::string_view text, const std::string& label,
-                                                     Problems& problems);
 
 // The entry with this index and sub-index, or nullptr.
 const EdsObject* find_eds_object(std::span<const EdsObject> objects, cia402::ObjectId id) noexcept;
@@ -156,9 +152,6 @@ std::string eds_type_name(std::uint16_t data_type);
 // Size in bits of a fixed-size basic type (BOOLEAN counts as 8: it is mapped as a byte here;
 // TIME_OF_DAY and TIME_DIFFERENCE 48); nullopt for strings, domains, complex and unknown types.
 std::optional<std::uint8_t> eds_type_bits(std::uint16_t data_type) noexcept;
-// The type an object of 1, 2 or 4 bytes is read and written as (BOOLEAN as u8); nullopt for
-// others (REAL32, strings, 24..64-bit integers), which a parameter request cannot carry.
-std::optional<cia402::DataType> eds_integer_type(std::uint16_t data_type) noexcept;
 // "ro", "rw", ... as written in an EDS.
 std::string_view to_string(EdsAccess access) noexcept;
 
