@@ -20,6 +20,7 @@
 #include "config/yaml_reader.hpp"
 #include "core/bus.hpp"
 #include "core/param_value.hpp"
+#include "core/scan.hpp"
 #include "profiles/cia402/objects.hpp"
 
 namespace drivegate::config {
@@ -55,9 +56,15 @@ struct ParameterRef {
   std::string error;
 };
 
-// Looks for devices on a bus of this type: `target` is what follows "TYPE:" on the command line
-// (`drivegated --scan canopen:...`); returns the report. Throws core::BusError.
-using BusScanner = std::function<std::string(std::string_view target)>;
+// Looks for devices on a bus of this type (`drivegated --scan TYPE:WHERE`, daemon/scan.hpp): `plan`
+// reads WHERE into a bus plan (through the type's own option reader, so a scan and a file agree);
+// the caller then holds the bus (`resource`, as a gateway does) and calls `run`, which only reads
+// from the devices. Both throw core::ScanError or core::BusError with one line a person can act on.
+struct BusScanner {
+  std::function<BusPlan(const core::ScanRequest& request)> plan;
+  std::function<core::ScanResult(const BusPlan& bus, const core::ScanRequest& request)> run;
+  [[nodiscard]] explicit operator bool() const noexcept { return plan && run; }
+};
 
 struct BusTypeInfo {
   std::string name;

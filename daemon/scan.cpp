@@ -11,7 +11,6 @@
 #include <ostream>
 #include <sstream>
 
-#include "adapters/canopen/scan.hpp"
 #include "config/scalars.hpp"
 #include "daemon/bus_lock.hpp"
 
@@ -53,31 +52,21 @@ std::string format_columns(const std::vector<std::vector<std::string>>& rows) {
 
 }  // namespace
 
-ScannerRegistry ScannerRegistry::builtin() {
-  ScannerRegistry r;
-  r.add("canopen", [](const core::ScanRequest& request) {
-    const config::BusPlan plan = canopen::scan_bus_plan(request);
-    // A gateway on this bus would see our requests as another master's (and its drives' answers
+core::ScanResult scan_bus(const core::ScanRequest& request, const config::BusTypeRegistry& types) {
+  const auto type = types.find(request.bus_type);
+  if (type != nullptr && type->scan) {
+    const config::BusPlan plan = type->scan.plan(request);
+    // A gateway on this bus would see our requests as another master's (and its devices' answers
     // would confuse both): refuse while one holds the bus, and hold it ourselves while scanning.
     const BusLock lock(bus_resource(plan));
-    return canopen::run_scan(plan, request);
-  });
-  return r;
-}
-
-void ScannerRegistry::add(std::string bus_type, ScanFunction scan) {
-  scanners_.emplace_back(std::move(bus_type), std::move(scan));
-}
-
-core::ScanResult ScannerRegistry::scan(const core::ScanRequest& request) const {
-  for (const auto& [type, scan] : scanners_)
-    if (type == request.bus_type) return scan(request);
-  std::string known;
-  for (const auto& [type, scan] : scanners_) known += (known.empty() ? "" : ", ") + type;
-  const auto types = config::BusTypeRegistry::builtin();
-  if (types.find(request.bus_type) != nullptr)
-    throw core::ScanError("cannot scan " + request.bus_type + ": no adapter in this build (scans: " + known + ")");
-  throw core::ScanError("cannot scan \"" + request.bus_type + "\": not a bus type; scans: " + known);
+    return type->scan.run(plan, request);
+  }
+  std::string scans;
+  for (const auto& t : types.types())
+    if (t->scan) scans += (scans.empty() ? "" : ", ") + t->name;
+  if (type != nullptr)
+    throw core::ScanError("cannot scan " + request.bus_type + ": no adapter in this build (scans: " + scans + ")");
+  throw core::ScanError("cannot scan \"" + request.bus_type + "\": not a bus type; scans: " + scans);
 }
 
 core::ScanRequest parse_scan_target(const std::string& target) {
@@ -238,7 +227,7 @@ int run_scan_command(const ScanCommand& command, std::ostream& out, std::ostream
     load.device_dirs = command.device_dirs;
     for (const auto& d : config::default_device_dirs()) load.device_dirs.push_back(d);
     request.device_dirs = load.device_dirs;
-    const core::ScanResult result = ScannerRegistry::builtin().scan(request);
+    const core::ScanResult result = scan_bus(request, load.bus_types);
     out << format_scan_table(result) << std::flush;
     if (!command.write_config.empty()) {
       write_skeleton(command.write_config, scan_skeleton(result, load), command.force);

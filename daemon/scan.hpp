@@ -3,7 +3,6 @@
 // found, and the configuration skeleton `--write-config FILE` writes. Bus-neutral: a scanner
 // fills a core::ScanResult (core/scan.hpp), everything here reads only that.
 #include <filesystem>
-#include <functional>
 #include <iosfwd>
 #include <string>
 #include <vector>
@@ -13,20 +12,10 @@
 
 namespace drivegate::daemon {
 
-// Runs one scan; throws core::ScanError (or core::BusError) with one line a person can act on.
-using ScanFunction = std::function<core::ScanResult(const core::ScanRequest&)>;
-
-class ScannerRegistry {
- public:
-  // canopen; the other bus types the configuration knows are refused as having no adapter.
-  static ScannerRegistry builtin();
-  void add(std::string bus_type, ScanFunction scan);
-  // The scanner of request.bus_type. Throws core::ScanError for a type without one.
-  [[nodiscard]] core::ScanResult scan(const core::ScanRequest& request) const;
-
- private:
-  std::vector<std::pair<std::string, ScanFunction>> scanners_;
-};
+// Runs the scanner of request.bus_type from `types` while holding the bus as a gateway would
+// (daemon/bus_lock.hpp). Throws core::ScanError (or core::BusError) with one line a person can act
+// on: for a type without a scanner, naming the types that have one.
+core::ScanResult scan_bus(const core::ScanRequest& request, const config::BusTypeRegistry& types);
 
 // "canopen:can0" -> bus_type "canopen", where "can0". Throws core::ScanError without a ':'.
 core::ScanRequest parse_scan_target(const std::string& target);

@@ -4,6 +4,7 @@
 
 #include "adapters/canopen/canopen_bus.hpp"
 #include "adapters/canopen/plan_load.hpp"
+#include "adapters/canopen/scan.hpp"
 #include "config/canopen/bus_type.hpp"
 
 namespace drivegate::canopen {
@@ -48,6 +49,7 @@ config::BusTypeInfo bus_type() {
   t.check_bus.insert(t.check_bus.begin(), check_load);
   t.describe_bus.push_back(describe_load);
   t.make_bus = make_bus;
+  t.scan = {.plan = scan_bus_plan, .run = run_scan};
   return t;
 }
 

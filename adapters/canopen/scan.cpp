@@ -11,7 +11,9 @@
 #include "adapters/canopen/canopen_bus.hpp"
 #include "adapters/canopen/wire/bit_timing.hpp"
 #include "adapters/canopen/wire/cob_id.hpp"
-#include "config/canopen_bus.hpp"
+#include "config/canopen/bus_options.hpp"
+#include "config/canopen/bus_type.hpp"
+#include "config/canopen/plan.hpp"
 #include "config/loader.hpp"
 #include "profiles/cia402/sdo_abort.hpp"
 
@@ -324,6 +326,21 @@ bool plain_value(const std::string& v) {
 
 }  // namespace
 
+namespace {
+
+// The canopen bus type as the configuration reads it: enough for the scan's bus plan and for the
+// canopen sections of device profiles (the adapter's own registration is the daemon's business).
+const config::BusTypeRegistry& scan_types() {
+  static const config::BusTypeRegistry types = [] {
+    config::BusTypeRegistry r;
+    r.add(config::canopen_bus_type());
+    return r;
+  }();
+  return types;
+}
+
+}  // namespace
+
 config::BusPlan scan_bus_plan(const core::ScanRequest& request) {
   const std::string& where = request.where;
   const auto q = where.find('?');
@@ -366,8 +383,7 @@ config::BusPlan scan_bus_plan(const core::ScanRequest& request) {
     y << "      " << key << ": " << value << "\n";
   }
   y << "axes: []\n";
-  config::LoadOptions load;
-  load.device_dirs = request.device_dirs;
+  const config::LoadOptions load{.device_dirs = request.device_dirs, .bus_types = scan_types()};
   try {
     auto plan = config::load_plan_from_string(y.str(), "scan", load);
     return std::move(plan.buses.at(0));
@@ -407,11 +423,11 @@ std::string device_type_text(std::uint32_t device_type) {
 
 std::vector<config::DeviceProfile> scan_profiles(const std::vector<std::filesystem::path>& dirs,
                                                  std::vector<std::string>& notes) {
-  config::DeviceCatalog catalog(dirs);
+  config::DeviceCatalog catalog(dirs, scan_types());
   std::vector<config::DeviceProfile> out;
   config::Problems problems;
   for (const auto& name : catalog.available())
-    if (const auto* p = catalog.get(name, problems); p != nullptr && p->canopen.present) out.push_back(*p);
+    if (const auto* p = catalog.get(name, problems); p != nullptr && p->section<config::CanopenDeviceSpec>().present) out.push_back(*p);
   for (const auto& e : problems.errors()) notes.push_back("device profile not used: " + e.to_string());
   return out;
 }
@@ -419,7 +435,7 @@ std::vector<config::DeviceProfile> scan_profiles(const std::vector<std::filesyst
 namespace {
 
 bool type_fits(const config::DeviceProfile& p, std::optional<std::uint32_t> device_type) {
-  const auto& c = p.canopen;
+  const auto& c = p.section<config::CanopenDeviceSpec>();
   return !c.device_type || (device_type && (*device_type & c.device_type_mask) == (*c.device_type & c.device_type_mask));
 }
 
@@ -448,18 +464,18 @@ void match_profile(core::FoundDevice& d, const std::vector<config::DeviceProfile
       if (!type_fits(p, d.device_type)) {
         d.notes.push_back(identity_words(id) + " is " + p.name + "'s, but its 1000h " +
                           (d.device_type ? hex32(*d.device_type) : std::string("(not read)")) + " is not the " +
-                          hex32(*p.canopen.device_type) + " that profile expects");
+                          hex32(*p.section<config::CanopenDeviceSpec>().device_type) + " that profile expects");
         continue;
       }
       fits.push_back({&p, pid.product_code ? 3 : 2});
-    } else if (p.canopen.device_type && type_fits(p, d.device_type)) {
+    } else if (p.section<config::CanopenDeviceSpec>().device_type && type_fits(p, d.device_type)) {
       fits.push_back({&p, 1});
     }
   }
   std::sort(fits.begin(), fits.end(), [](const Fit& a, const Fit& b) {
     if (a.score != b.score) return a.score > b.score;
-    const int ma = std::popcount(a.profile->canopen.device_type_mask);
-    const int mb = std::popcount(b.profile->canopen.device_type_mask);
+    const int ma = std::popcount(a.profile->section<config::CanopenDeviceSpec>().device_type_mask);
+    const int mb = std::popcount(b.profile->section<config::CanopenDeviceSpec>().device_type_mask);
     if (ma != mb) return ma < mb;
     return a.profile->name < b.profile->name;
   });
@@ -502,7 +518,7 @@ std::string conflict_words(NodeId node, const std::vector<core::FoundDevice>& ea
   for (const auto& d : earlier) {
     const int gap = node - d.address.number;
     const auto* p = profile_named(profiles, d.profile);
-    if (p == nullptr || gap % 32 != 0 || gap / 32 >= p->canopen.sdo_channels) continue;
+    if (p == nullptr || gap % 32 != 0 || gap / 32 >= p->section<config::CanopenDeviceSpec>().sdo_channels) continue;
     std::snprintf(b, sizeof b, ", or another drive's extra SDO channel: node %d is a %s whose SDO channel %d is node-ID %d",
                   d.address.number, d.profile.c_str(), gap / 32 + 1, node);
     s += b;
@@ -530,7 +546,7 @@ void fold_extra_channels(std::vector<core::FoundDevice>& devices, const std::vec
     for (std::size_t j = 0; j < i; ++j) {
       const int gap = devices[i].address.number - devices[j].address.number;
       const auto* p = profile_named(profiles, devices[j].profile);
-      if (heard[i] || !devices[i].conflict.empty() || drop[j] || gap % 32 != 0 || p == nullptr || gap / 32 >= p->canopen.sdo_channels ||
+      if (heard[i] || !devices[i].conflict.empty() || drop[j] || gap % 32 != 0 || p == nullptr || gap / 32 >= p->section<config::CanopenDeviceSpec>().sdo_channels ||
           !same_device(devices[i], devices[j]))
         continue;
       char b[96];
@@ -554,7 +570,7 @@ void fold_extra_channels(std::vector<core::FoundDevice>& devices, const std::vec
 
 core::ScanResult scan_result(const CanopenScan& scan, const config::BusPlan& plan,
                              const std::vector<config::DeviceProfile>& profiles) {
-  const auto& c = plan.canopen;
+  const auto& c = plan.section<config::CanopenBusOptions>();
   core::ScanResult r;
   r.bus_type = "canopen";
   r.bus_options.emplace_back("transport", config::to_string(c.transport));
@@ -634,7 +650,7 @@ core::ScanResult run_scan(const config::BusPlan& plan, const core::ScanRequest& 
   CanopenScanSettings settings;
   settings.listen = request.listen;
   settings.answer_timeout = request.answer_timeout;
-  settings.bitrate = plan.canopen.bitrate;
+  settings.bitrate = plan.section<config::CanopenBusOptions>().bitrate;
   CanopenScan scan(settings, start);
   TxQueue out;
   std::uint64_t not_sent = 0;

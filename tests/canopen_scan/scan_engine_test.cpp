@@ -12,6 +12,7 @@
 #include "adapters/canopen/sim/sim_network.hpp"
 #include "adapters/canopen/transport/inproc_bus.hpp"
 #include "adapters/canopen/wire/sdo_codec.hpp"
+#include "config/canopen/plan.hpp"
 #include "config/device_profile.hpp"
 #include "tests/canopen_sim/sim_test_support.hpp"
 
@@ -418,17 +419,17 @@ TEST(ScanBusPlan, TakesAnInterfaceOrUdpMulticastWithOptions) {
   r.device_dirs = config::default_device_dirs();
   r.where = "can1";
   auto p = scan_bus_plan(r);
-  EXPECT_EQ(p.canopen.transport, config::CanTransportKind::SocketCan);
-  EXPECT_EQ(p.canopen.interface, "can1");
+  EXPECT_EQ(p.section<config::CanopenBusOptions>().transport, config::CanTransportKind::SocketCan);
+  EXPECT_EQ(p.section<config::CanopenBusOptions>().interface, "can1");
   r.where = "socketcan?interface=vcan0&bitrate=250000";
   p = scan_bus_plan(r);
-  EXPECT_EQ(p.canopen.interface, "vcan0");
-  EXPECT_EQ(p.canopen.bitrate, 250000U);
+  EXPECT_EQ(p.section<config::CanopenBusOptions>().interface, "vcan0");
+  EXPECT_EQ(p.section<config::CanopenBusOptions>().bitrate, 250000U);
   r.where = "udp-multicast?group=239.1.2.3&port=17000&interface=127.0.0.1";
   p = scan_bus_plan(r);
-  EXPECT_EQ(p.canopen.transport, config::CanTransportKind::UdpMulticast);
-  EXPECT_EQ(p.canopen.group, "239.1.2.3");
-  EXPECT_EQ(p.canopen.port, 17000);
+  EXPECT_EQ(p.section<config::CanopenBusOptions>().transport, config::CanTransportKind::UdpMulticast);
+  EXPECT_EQ(p.section<config::CanopenBusOptions>().group, "239.1.2.3");
+  EXPECT_EQ(p.section<config::CanopenBusOptions>().port, 17000);
 }
 
 TEST(ScanBusPlan, RefusesWhatTheConfigurationWouldRefuse) {

@@ -8,6 +8,7 @@
 #include <sstream>
 #include <string>
 
+#include "config/canopen/plan.hpp"
 #include "config/loader.hpp"
 #include "daemon/scan.hpp"
 
@@ -103,8 +104,8 @@ TEST(ScanSkeleton, TheLoaderAcceptsItWithAnAxisPerDrive) {
   const std::string text = scan_skeleton(two_devices(), load);
   const auto plan = config::load_plan_from_string(text, "skeleton.yaml", load);
   ASSERT_EQ(plan.buses.size(), 1U);
-  EXPECT_EQ(plan.buses[0].canopen.group, "239.1.2.3");
-  EXPECT_EQ(plan.buses[0].canopen.port, 17000);
+  EXPECT_EQ(plan.buses[0].section<config::CanopenBusOptions>().group, "239.1.2.3");
+  EXPECT_EQ(plan.buses[0].section<config::CanopenBusOptions>().port, 17000);
   EXPECT_EQ(plan.buses[0].cycle_time, 4ms);
   ASSERT_EQ(plan.buses[0].axes.size(), 1U);
   EXPECT_EQ(plan.buses[0].axes[0].address, 5);
@@ -156,18 +157,18 @@ TEST(WriteSkeleton, KeepsAnExistingFileUnlessForced) {
   std::filesystem::remove_all(dir);
 }
 
-TEST(ScannerRegistry, RefusesBusTypesWithoutAScanner) {
-  const auto registry = ScannerRegistry::builtin();
+TEST(ScanBus, RefusesBusTypesWithoutAScanner) {
+  const auto registry = config::BusTypeRegistry::builtin();
   core::ScanRequest r;
   r.bus_type = "ethercat";
   try {
-    (void)registry.scan(r);
+    (void)scan_bus(r, registry);
     FAIL() << "scanned ethercat";
   } catch (const core::ScanError& e) {
     EXPECT_STREQ(e.what(), "cannot scan ethercat: no adapter in this build (scans: canopen)");
   }
   r.bus_type = "canbus";
-  EXPECT_THROW((void)registry.scan(r), core::ScanError);
+  EXPECT_THROW((void)scan_bus(r, registry), core::ScanError);
 }
 
 }  // namespace
