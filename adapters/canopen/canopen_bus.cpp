@@ -621,7 +621,8 @@ void CanopenBus::serve_until(core::TimePoint deadline) noexcept {
   for (;;) {
     const core::TimePoint now = clock_.now();
     if (now >= stop) return;
-    // The next segment request, a retry or a queued request goes out now, not at the next cycle.
+    // The next segment request, a retry or a queued request goes out now, not at the next cycle
+    // (with any frame of the last cycle the transport had no room for: it was due already).
     sdo_.poll(now, tx_);
     flush(now);
     const core::TimePoint due = sdo_.next_deadline();

@@ -101,11 +101,13 @@ TEST(ServeBetweenCycles, UploadTakesFarFewerCyclesThanSegments) {
   ServedBus s;
   s.start();
   const auto t0 = std::chrono::steady_clock::now();
-  const std::uint64_t first = s.cycles();
+  const daemon::TimingSnapshot before = s.thread->timing();
   ASSERT_TRUE(s.push_upload(1));
   core::ParamReply r;
   ASSERT_TRUE(wait_for([&] { return s.reply(r); }, 10000ms));
-  const std::uint64_t used = s.cycles() - first;
+  const daemon::TimingSnapshot after = s.thread->timing();
+  const auto elapsed = std::chrono::steady_clock::now() - t0;
+  const std::uint64_t used = after.cycles - before.cycles;
   ASSERT_TRUE(r.ok) << r.error.c_str();
   ASSERT_EQ(r.size, kDomainSize);
   for (std::size_t i = 0; i < kDomainSize; ++i) ASSERT_EQ(r.data[i], static_cast<std::uint8_t>(i * 7 + 1)) << i;
@@ -113,10 +115,8 @@ TEST(ServeBetweenCycles, UploadTakesFarFewerCyclesThanSegments) {
   EXPECT_LT(used, kSegments / 5) << "cycles for " << kSegments << " segments";
 
   // The cycle's bookkeeping is as without serving: every period is a cycle or a skipped slot.
-  const auto elapsed = std::chrono::steady_clock::now() - t0;
-  const auto t = s.thread->timing();
-  const auto periods = static_cast<std::uint64_t>(elapsed / s.plan.buses[0].cycle_time);
-  EXPECT_NEAR(static_cast<double>(used + t.skipped_slots), static_cast<double>(periods), 3.0);
+  const auto periods = static_cast<double>(elapsed / s.plan.buses[0].cycle_time);
+  EXPECT_NEAR(static_cast<double>(used + after.skipped_slots - before.skipped_slots), periods, 3.0);
   s.thread->stop();
   const auto& c = s.bus.serve_counters();
   EXPECT_GT(c.sdo_frames, kSegments / 2);  // most responses were handled between cycles
@@ -136,7 +136,7 @@ TEST(ServeBetweenCycles, IdleBusDoesNotWakePerFrame) {
   const std::uint64_t frames = s.bus.counters().frames_received;
   from = s.cycles();
   ASSERT_TRUE(wait_for([&] { return s.cycles() >= from + 50; }, 2000ms));
-  EXPECT_GT(s.bus.counters().frames_received - frames, 100U);  // 2 TPDOs per cycle and heartbeats
+  EXPECT_GT(s.bus.counters().frames_received - frames, 80U);  // 2 TPDOs per cycle, heartbeats
   EXPECT_EQ(s.waits.load() - waits, 0U);
   EXPECT_EQ(s.held.load() - held, 0U);
 }

@@ -60,7 +60,7 @@ class GatewayEnd final : public Transport {
     const std::lock_guard lock(shared_->mutex);
     const std::size_t got = shared_->gateway_end->receive(out, now);
     if (shared_->gateway_signalled && shared_->gateway_end->available() == 0) {
-      drain(shared_->gateway_ready);
+      drain(shared_->gateway_ready.get());
       shared_->gateway_signalled = false;
     }
     return got;
@@ -68,7 +68,7 @@ class GatewayEnd final : public Transport {
   SendResult send(const CanFrame& frame, core::TimePoint now) noexcept override {
     const std::lock_guard lock(shared_->mutex);
     const SendResult r = shared_->gateway_end->send(frame, now);
-    if (r == SendResult::Sent) signal(shared_->wire_changed);
+    if (r == SendResult::Sent) signal(shared_->wire_changed.get());
     return r;
   }
   [[nodiscard]] ControllerState controller_state() const noexcept override {
@@ -79,7 +79,7 @@ class GatewayEnd final : public Transport {
   [[nodiscard]] std::string describe() const override {
     return shared_->gateway_end->describe() + " (simulated drives in their own thread)";
   }
-  [[nodiscard]] int wait_fd() const noexcept override { return shared_->gateway_ready; }
+  [[nodiscard]] int wait_fd() const noexcept override { return shared_->gateway_ready.get(); }
 
  private:
   std::shared_ptr<ThreadedSimWire::Shared> shared_;
@@ -98,11 +98,6 @@ ThreadedSimWire::Shared::Shared(const config::BusPlan& plan)
   for (const auto& axis : plan.axes) network.add(slave_config_for(axis));
 }
 
-ThreadedSimWire::Shared::~Shared() {
-  ::close(gateway_ready);
-  ::close(wire_changed);
-}
-
 ThreadedSimWire::ThreadedSimWire(const config::BusPlan& plan, core::Duration step)
     : shared_(std::make_shared<Shared>(plan)), gateway_(std::make_unique<GatewayEnd>(shared_)), step_(step) {}
 
@@ -118,7 +113,7 @@ void ThreadedSimWire::start() {
 
 void ThreadedSimWire::stop() noexcept {
   stop_.store(true, std::memory_order_release);
-  signal(shared_->wire_changed);
+  signal(shared_->wire_changed.get());
   if (thread_.joinable()) thread_.join();
 }
 
@@ -143,7 +138,7 @@ void ThreadedSimWire::run() noexcept {
         if (tick) next_step = now + step_;
       }
       if (!s.gateway_signalled && s.gateway_end->available() > 0) {
-        signal(s.gateway_ready);
+        signal(s.gateway_ready.get());
         s.gateway_signalled = true;
       }
       wake = std::min(s.bus.next_change(), next_step);
@@ -152,8 +147,8 @@ void ThreadedSimWire::run() noexcept {
     timespec ts{};
     ts.tv_sec = static_cast<time_t>(std::chrono::duration_cast<std::chrono::seconds>(wait).count());
     ts.tv_nsec = static_cast<long>((wait - std::chrono::seconds(ts.tv_sec)).count());
-    pollfd p{s.wire_changed, POLLIN, 0};
-    if (::ppoll(&p, 1, &ts, nullptr) > 0) drain(s.wire_changed);
+    pollfd p{s.wire_changed.get(), POLLIN, 0};
+    if (::ppoll(&p, 1, &ts, nullptr) > 0) drain(s.wire_changed.get());
   }
 }
 

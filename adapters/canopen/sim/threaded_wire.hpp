@@ -18,6 +18,7 @@
 #include <thread>
 
 #include "adapters/canopen/sim/sim_network.hpp"
+#include "adapters/canopen/transport/fd_guard.hpp"
 #include "adapters/canopen/transport/inproc_bus.hpp"
 #include "config/plan.hpp"
 
@@ -51,14 +52,13 @@ class ThreadedSimWire {
   // The wire, both ends and the drives, shared with the gateway's end.
   struct Shared {
     explicit Shared(const config::BusPlan& plan);
-    ~Shared();
     std::mutex mutex;
     InprocBus bus;
     std::unique_ptr<InprocEndpoint> drives_end;
     std::unique_ptr<InprocEndpoint> gateway_end;
     SimNetwork network;
-    int gateway_ready = -1;  // eventfd: readable while the gateway's end has frames
-    int wire_changed = -1;   // eventfd: the gateway sent a frame (wakes the drive thread)
+    FdGuard gateway_ready;  // eventfd: readable while the gateway's end has frames
+    FdGuard wire_changed;   // eventfd: the gateway sent a frame (wakes the drive thread)
     bool gateway_signalled = false;
   };
 
