@@ -3,10 +3,10 @@
 #include <poll.h>
 
 #include <algorithm>
-#include <cerrno>
 #include <thread>
 
 #include "adapters/canopen/boot_plan.hpp"
+#include "adapters/canopen/wire/bit_timing.hpp"
 #include "profiles/cia402/master_settings.hpp"
 #include "profiles/cia402/op_modes.hpp"
 #include "profiles/cia402/sdo_abort.hpp"
@@ -91,7 +91,8 @@ CanopenBus::CanopenBus(const config::BusPlan& plan, std::unique_ptr<Transport> t
                        plan.axes[i].device.canopen.emcy_zero_needs_clear_register});
         return e;
       }()),
-      sync_(cob::kSync, plan.cycle_time) {
+      sync_(cob::kSync, plan.cycle_time),
+      serve_quiet_(kServeGuard + 2 * frame_time(8, plan.canopen.bitrate)) {
   for (std::size_t i = 0; i < plan.axes.size(); ++i) {
     const auto& a = plan.axes[i];
     auto steps = build_boot_steps(a, plan);
@@ -617,7 +618,7 @@ void CanopenBus::transmit(core::TimePoint now) noexcept {
 void CanopenBus::serve_until(core::TimePoint deadline) noexcept {
   const int fd = transport_->wait_fd();
   if (!open_ || fd < 0 || controller_ == ControllerState::BusOff) return;
-  const core::TimePoint stop = deadline - kServeGuard;
+  const core::TimePoint stop = deadline - serve_quiet_;
   for (;;) {
     const core::TimePoint now = clock_.now();
     if (now >= stop) return;

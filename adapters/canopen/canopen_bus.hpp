@@ -109,8 +109,10 @@ class CanopenBus final : public core::Bus {
   // EMCY events per node: this many at once, then one per kEmcyRefill.
   static constexpr std::uint32_t kEmcyBurst = 8;
   static constexpr core::Duration kEmcyRefill = std::chrono::seconds(1);
-  // serve_until() stops waiting this long before the next cycle, so that a frame handled at the
-  // last moment cannot delay the cycle's start.
+  // serve_until() ends this long plus one SDO exchange on the wire (request and response, two
+  // 8-byte frames at the bus' bit rate) before the next cycle: a frame handled at the last moment
+  // cannot delay the cycle's start, and an exchange it starts is off the wire when the SYNC is due
+  // (CAN does not preempt a frame on the wire).
   static constexpr core::Duration kServeGuard = std::chrono::microseconds(100);
   // Frames serve_until() holds for the next receive(); when full, it stops reading.
   static constexpr std::size_t kHeldFrames = 256;
@@ -217,6 +219,7 @@ class CanopenBus final : public core::Bus {
   std::size_t held_count_ = 0;
   ServeCounters serve_;
   const core::SteadyClock clock_;  // serve_until()'s time line: the cycle thread's monotonic clock
+  const core::Duration serve_quiet_;  // kServeGuard + one SDO exchange at the bit rate
   bool open_ = false;
   core::TimePoint last_now_{};  // the last cycle's time
   ControllerState controller_ = ControllerState::Active;
