@@ -121,6 +121,10 @@ TEST(ServeBetweenCycles, UploadTakesFarFewerCyclesThanSegments) {
   const auto& c = s.bus.serve_counters();
   EXPECT_GT(c.sdo_frames, kSegments / 2);  // most responses were handled between cycles
   EXPECT_EQ(c.held_full, 0U);
+  // The TPDOs that came in meanwhile were held and handled by their cycle as before: none missed.
+  EXPECT_GT(c.held_frames, used);
+  EXPECT_EQ(s.bus.pdos(0).counters().missed, 0U);
+  EXPECT_EQ(s.bus.unexpected_frames(), 0U);
 }
 
 // Without SDO work the thread sleeps through the period: no wait on the fd, no frame read

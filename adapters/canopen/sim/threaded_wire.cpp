@@ -31,13 +31,6 @@ void drain(int fd) noexcept {
   [[maybe_unused]] const auto n = ::read(fd, &count, sizeof count);
 }
 
-InprocBusOptions options_for(const config::BusPlan& plan) {
-  // As SimPeer::wire(): each end may queue a whole cycle's frames at once.
-  InprocBusOptions options;
-  options.tx_queue_capacity = std::max<std::size_t>(options.tx_queue_capacity, 8 * plan.axes.size() + 64);
-  return options;
-}
-
 // The gateway's end: the in-process endpoint under the shared lock, with an fd that is readable
 // while frames wait for it.
 class GatewayEnd final : public Transport {
@@ -88,7 +81,7 @@ class GatewayEnd final : public Transport {
 }  // namespace
 
 ThreadedSimWire::Shared::Shared(const config::BusPlan& plan)
-    : bus(plan.canopen.bitrate, options_for(plan)),
+    : bus(plan.canopen.bitrate, sim_wire_options(plan)),
       drives_end(bus.connect()),
       gateway_end(bus.connect()),
       network(*drives_end),
