@@ -139,6 +139,9 @@ void CanopenBus::open(core::TimePoint now) {
 
 void CanopenBus::close() noexcept {
   if (!open_) return;
+  // A transfer the profile still has in flight (a 4 KiB upload takes a while) must not hold up the
+  // watchdog writes on its channel: it is aborted.
+  for (auto& n : nodes_) n->io->cancel_requests();
   release_watchdogs();
   // Leave the drives pre-operational (SD6 gateway step B15: before guarding and SYNC stop, so a
   // life-guarding fault is not raised), then release the transport.

@@ -146,7 +146,8 @@ TEST(ServeBetweenCycles, IdleBusDoesNotWakePerFrame) {
 }
 
 // The bus thread stops while a transfer is in flight: stop() returns within about a period, the
-// transfer simply stays unfinished, and the bus closes.
+// transfer stays unfinished, and closing the bus still releases the drive's watch on the gateway
+// (1016h:01 := 0) instead of queueing that write behind the rest of the upload.
 TEST(ServeBetweenCycles, StopsWithTransferInFlight) {
   ServedBus s;
   s.start();
@@ -161,6 +162,12 @@ TEST(ServeBetweenCycles, StopsWithTransferInFlight) {
   EXPECT_EQ(s.bus.sdo().pending(0), 1U);  // still on its way: nobody completed it behind our back
   core::ParamReply r;
   EXPECT_FALSE(s.reply(r));
+  const auto consumer = [&] {
+    return s.wire.locked([](InprocBus&, sim::SimNetwork& net) { return net.node(0).nmt().heartbeat_consumer(); });
+  };
+  ASSERT_NE(consumer(), 0U);
+  s.bus.close();
+  EXPECT_TRUE(wait_for([&] { return consumer() == 0; }, 1000ms));
 }
 
 // The drive falls silent mid transfer: the SDO timeout still ends it, and waiting for the answer
