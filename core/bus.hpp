@@ -3,6 +3,9 @@
 // A Bus owns its transport and its protocol engines and exposes one AxisController per axis.
 // The cycle thread calls receive() at the start of a cycle, lets the controllers run, then calls
 // transmit(). Those two calls are the cyclic path: no heap allocation, lock, logging or blocking.
+// Between two cycles it calls serve_until(), where a bus may do acyclic work (an SDO exchange) as
+// its frames arrive, under the same rules; it blocks only waiting for frames, never past the
+// deadline.
 #include <cstddef>
 #include <cstdint>
 #include <stdexcept>
@@ -52,6 +55,10 @@ class Bus {
   // Cyclic path.
   virtual void receive(TimePoint now) noexcept = 0;
   virtual void transmit(TimePoint now) noexcept = 0;
+  // Between cycles, on the cycle thread: acyclic work until at most `deadline` (the next cycle's
+  // start on the monotonic clock), then return; the caller sleeps the rest precisely. The default
+  // has none and returns at once.
+  virtual void serve_until(TimePoint /*deadline*/) noexcept {}
   // Events the bus itself reports, taken after receive(); false when there is none. With `axis`
   // kNoAxis (or out of range) the event is about the bus (another master on the wire, ...); with
   // an axis index it is about that axis' device (a CANopen EMCY) and the runner adds the axis'

@@ -33,7 +33,8 @@ void sleep_until(std::int64_t deadline_ns) noexcept {
 
 }  // namespace
 
-CycleThread::CycleThread(Schedule schedule, Body body) : schedule_(schedule), body_(std::move(body)) {}
+CycleThread::CycleThread(Schedule schedule, Body body, Between between)
+    : schedule_(std::move(schedule)), body_(std::move(body)), between_(std::move(between)) {}
 
 CycleThread::~CycleThread() { stop(); }
 
@@ -106,6 +107,7 @@ void CycleThread::run() noexcept {
 
   try {
     for (std::uint64_t cycle = 0;; ++cycle) {
+      if (between_ && !stop_requested_.load(std::memory_order_acquire)) between_(core::TimePoint{core::Duration{next}});
       sleep_until(next);
       if (stop_requested_.load(std::memory_order_acquire)) break;
       const std::int64_t wake = monotonic_ns();

@@ -5,6 +5,9 @@
 //
 // The loop adds no allocation, lock, logging or blocking beyond the sleep itself; what the body
 // does is the body's business (it runs the bus' sans-I/O engines and must follow the same rules).
+// Before each sleep an optional `between` function gets the next cycle's start: a bus answers its
+// acyclic traffic there (core::Bus::serve_until). It must return by that deadline; the final wake
+// is still the absolute-time sleep, so the cycle starts as precisely as without it.
 #include <atomic>
 #include <chrono>
 #include <cstdint>
@@ -44,8 +47,10 @@ class CycleThread {
   };
   // now: the CLOCK_MONOTONIC wake-up time of this cycle; cycle: 0, 1, 2, ...
   using Body = std::function<void(core::TimePoint now, std::uint64_t cycle)>;
+  // deadline: the CLOCK_MONOTONIC time of the next cycle's start.
+  using Between = std::function<void(core::TimePoint deadline)>;
 
-  CycleThread(Schedule schedule, Body body);
+  CycleThread(Schedule schedule, Body body, Between between = {});
   ~CycleThread();  // stops the thread
   CycleThread(const CycleThread&) = delete;
   CycleThread& operator=(const CycleThread&) = delete;
@@ -77,6 +82,7 @@ class CycleThread {
 
   Schedule schedule_;
   Body body_;
+  Between between_;
   std::thread thread_;
   std::string note_;  // written by the thread before started_ is released, then read-only
   bool launched_ = false;  // start() was called; control thread only

@@ -81,9 +81,13 @@ void Gateway::start() {
     sched.cpu = b.plan->cpu;
     sched.name = "dg-cycle-" + b.plan->name;  // "dg-cycle-sim0" (the kernel keeps 15 characters)
     core::BusRunner* runner = b.runner.get();
-    b.thread = std::make_unique<CycleThread>(sched, [runner, signal = &output_signal_](core::TimePoint t, std::uint64_t) {
-      if (runner->cycle(t)) signal->notify();
-    });
+    core::Bus* bus = b.bus.get();
+    b.thread = std::make_unique<CycleThread>(
+        sched,
+        [runner, signal = &output_signal_](core::TimePoint t, std::uint64_t) {
+          if (runner->cycle(t)) signal->notify();
+        },
+        [bus](core::TimePoint deadline) { bus->serve_until(deadline); });
     if (!b.thread->start()) throw core::BusError("bus '" + b.plan->name + "': could not start its cycle thread");
     spdlog::info("bus {}: {} with {} axes, cycle {} us", b.plan->name, b.plan->type, b.specs.size(),
                  std::chrono::duration_cast<std::chrono::microseconds>(b.plan->cycle_time).count());

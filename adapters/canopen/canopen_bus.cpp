@@ -1,9 +1,12 @@
 #include "adapters/canopen/canopen_bus.hpp"
 
+#include <poll.h>
+
 #include <algorithm>
 #include <thread>
 
 #include "adapters/canopen/boot_plan.hpp"
+#include "adapters/canopen/wire/bit_timing.hpp"
 #include "profiles/cia402/master_settings.hpp"
 #include "profiles/cia402/op_modes.hpp"
 #include "profiles/cia402/sdo_abort.hpp"
@@ -88,7 +91,8 @@ CanopenBus::CanopenBus(const config::BusPlan& plan, std::unique_ptr<Transport> t
                        plan.axes[i].device.section<config::CanopenDeviceSpec>().emcy_zero_needs_clear_register});
         return e;
       }()),
-      sync_(cob::kSync, plan.cycle_time) {
+      sync_(cob::kSync, plan.cycle_time),
+      serve_quiet_(kServeGuard + 2 * frame_time(8, plan.section<config::CanopenBusOptions>().bitrate)) {
   for (std::size_t i = 0; i < plan.axes.size(); ++i) {
     const auto& a = plan.axes[i];
     auto steps = build_boot_steps(a, plan);
@@ -124,6 +128,7 @@ void CanopenBus::open(core::TimePoint now) {
     throw core::BusError("bus '" + name_ + "': " + e.what());
   }
   open_ = true;
+  held_count_ = 0;
   controller_ = transport_->controller_state();
   if (options_.sync) sync_.start(now);
   for (auto& n : nodes_) {
@@ -134,6 +139,9 @@ void CanopenBus::open(core::TimePoint now) {
 
 void CanopenBus::close() noexcept {
   if (!open_) return;
+  // A transfer the profile still has in flight (a 4 KiB upload takes a while) must not hold up the
+  // watchdog writes on its channel: it is aborted.
+  for (auto& n : nodes_) n->io->cancel_requests();
   release_watchdogs();
   // Leave the drives pre-operational (SD6 gateway step B15: before guarding and SYNC stop, so a
   // life-guarding fault is not raised), then release the transport.
@@ -229,6 +237,9 @@ void CanopenBus::receive(core::TimePoint now) noexcept {
   if (!open_) return;
   last_now_ = now;
   if (peer_) peer_->step(now);
+  // What serve_until() read since the last cycle comes first: it was on the wire before the rest.
+  for (std::size_t i = 0; i < held_count_; ++i) dispatch(held_[i], now);
+  held_count_ = 0;
   for (;;) {
     const std::size_t got = transport_->receive(rx_buffer_, now);
     for (std::size_t i = 0; i < got; ++i) dispatch(rx_buffer_[i], now);
@@ -610,6 +621,55 @@ void CanopenBus::transmit(core::TimePoint now) noexcept {
   sdo_.poll(now, tx_);
   flush(now);
   publish_counters();
+}
+
+void CanopenBus::serve_until(core::TimePoint deadline) noexcept {
+  const int fd = transport_->wait_fd();
+  if (!open_ || fd < 0 || controller_ == ControllerState::BusOff) return;
+  const core::TimePoint stop = deadline - serve_quiet_;
+  for (;;) {
+    const core::TimePoint now = clock_.now();
+    if (now >= stop) return;
+    // The next segment request, a retry or a queued request goes out now, not at the next cycle
+    // (with any frame of the last cycle the transport had no room for: it was due already).
+    sdo_.poll(now, tx_);
+    flush(now);
+    const core::TimePoint due = sdo_.next_deadline();
+    // No SDO work in flight: sleep through the rest of the period (no wake-up per frame).
+    if (due == core::TimePoint::max()) return;
+    if (held_count_ == held_.size()) {
+      ++serve_.held_full;
+      return;
+    }
+    const core::TimePoint until = std::min(stop, due);
+    if (until <= now) return;  // poll() has just handled what was due: nothing left to wait for
+    const auto wait = until - now;
+    timespec ts{};
+    ts.tv_sec = static_cast<time_t>(std::chrono::duration_cast<std::chrono::seconds>(wait).count());
+    ts.tv_nsec = static_cast<long>((wait - std::chrono::seconds(ts.tv_sec)).count());
+    pollfd p{fd, POLLIN, 0};
+    ++serve_.waits;
+    const int ready = ::ppoll(&p, 1, &ts, nullptr);
+    if (ready > 0 && (p.revents & POLLIN) != 0) take_between_cycles(clock_.now());
+    // A timeout: the loop polls the SDO client (its timeout) or returns at `stop`. EINTR: again.
+  }
+}
+
+// Reads what the transport has into the held frames and hands the SDO responses among them to the
+// SDO client now; the rest stays held, in order, for the next receive().
+void CanopenBus::take_between_cycles(core::TimePoint now) noexcept {
+  const std::size_t first = held_count_;
+  const std::size_t end = first + transport_->receive(std::span<CanFrame>(held_).subspan(first), now);
+  for (std::size_t i = first; i < end; ++i) {
+    const CanFrame& f = held_[i];
+    if (!f.extended && split_cob_id(f.id).function == Function::SdoTx && sdo_.on_frame(f, now)) {
+      received_.fetch_add(1, std::memory_order_relaxed);
+      ++serve_.sdo_frames;
+      continue;
+    }
+    ++serve_.held_frames;
+    held_[held_count_++] = f;
+  }
 }
 
 void CanopenBus::flush(core::TimePoint now) noexcept {

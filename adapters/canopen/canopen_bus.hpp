@@ -42,6 +42,15 @@
 //   the gateway's CAN controller is bus-off / CAN controller recovered from bus-off: ...
 //
 // receive() and transmit() are the cyclic path: no allocation, lock, logging or blocking.
+//
+// Between cycles (serve_until()), while an SDO transfer is in flight or waiting, the bus waits on
+// the transport's wait_fd() until shortly before the next cycle and hands SDO responses to the SDO
+// client as they arrive, so the next segment request goes out at once instead of one exchange per
+// cycle. Every other frame it reads then (PDOs, heartbeats, EMCY, ...) is held, in order, for the
+// next receive(), which handles it with the cycle's time exactly as if it had just been read:
+// PDO freshness, loss detection and error control see no difference. With no SDO work, or a
+// transport without wait_fd() (the in-process bus of `transport: sim`), it returns at once and
+// the thread sleeps: it never wakes per frame then.
 #include <array>
 #include <atomic>
 #include <memory>
@@ -93,12 +102,29 @@ class CanopenBus final : public core::Bus {
   std::string_view link_detail(std::size_t axis) const noexcept override;
   void receive(core::TimePoint now) noexcept override;
   void transmit(core::TimePoint now) noexcept override;
+  void serve_until(core::TimePoint deadline) noexcept override;
   bool next_event(core::Event& out) noexcept override;
   core::BusCounters counters() const noexcept override;
 
   // EMCY events per node: this many at once, then one per kEmcyRefill.
   static constexpr std::uint32_t kEmcyBurst = 8;
   static constexpr core::Duration kEmcyRefill = std::chrono::seconds(1);
+  // serve_until() ends this long plus one SDO exchange on the wire (request and response, two
+  // 8-byte frames at the bus' bit rate) before the next cycle: a frame handled at the last moment
+  // cannot delay the cycle's start, and an exchange it starts is off the wire when the SYNC is due
+  // (CAN does not preempt a frame on the wire).
+  static constexpr core::Duration kServeGuard = std::chrono::microseconds(100);
+  // Frames serve_until() holds for the next receive(); when full, it stops reading.
+  static constexpr std::size_t kHeldFrames = 256;
+
+  // What serve_until() did (bus thread only, or while the bus is not cycling).
+  struct ServeCounters {
+    std::uint64_t waits = 0;         // waits on the transport's fd
+    std::uint64_t sdo_frames = 0;    // SDO responses handled between cycles
+    std::uint64_t held_frames = 0;   // other frames held for the next receive()
+    std::uint64_t held_full = 0;     // returned early because the held frames filled up
+  };
+  [[nodiscard]] const ServeCounters& serve_counters() const noexcept { return serve_; }
 
   // Diagnostics (bus thread only, or while the bus is not cycling).
   [[nodiscard]] Phase phase(std::size_t axis) const noexcept { return nodes_[axis]->phase; }
@@ -161,6 +187,7 @@ class CanopenBus final : public core::Bus {
   void run_safe_stop(Node& n, core::TimePoint now) noexcept;
   Node* node_by_id(NodeId id) noexcept { return id <= kMaxNodeId ? by_id_[id] : nullptr; }
   void flush(core::TimePoint now) noexcept;
+  void take_between_cycles(core::TimePoint now) noexcept;
   void release_watchdogs() noexcept;
   void publish_counters() noexcept;
   void note_foreign_master(const CanFrame& f, core::TimePoint now) noexcept;
@@ -188,6 +215,11 @@ class CanopenBus final : public core::Bus {
   std::array<Node*, 128> by_id_{};
   TxQueue tx_;
   std::array<CanFrame, 64> rx_buffer_{};
+  std::array<CanFrame, kHeldFrames> held_{};  // read between cycles, for the next receive()
+  std::size_t held_count_ = 0;
+  ServeCounters serve_;
+  const core::SteadyClock clock_;  // serve_until()'s time line: the cycle thread's monotonic clock
+  const core::Duration serve_quiet_;  // kServeGuard + one SDO exchange at the bit rate
   bool open_ = false;
   core::TimePoint last_now_{};  // the last cycle's time
   ControllerState controller_ = ControllerState::Active;

@@ -71,6 +71,13 @@ void NodeAccess::cancel(cia402::RequestId id) noexcept {
   *p = {};
 }
 
+void NodeAccess::cancel_requests() noexcept {
+  for (auto& p : pending_) {
+    if (p.id != kNoSdoRequest) sdo_.cancel(p.id);
+    p = {};
+  }
+}
+
 cia402::DriveFaultReport NodeAccess::fault_report() const noexcept {
   const EmcyReport* r = emcy_.active(node_);
   if (!r) return {};

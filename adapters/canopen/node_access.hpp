@@ -39,6 +39,9 @@ class NodeAccess final : public cia402::ObjectAccess {
   }
   // The node went away or rebooted: every request is forgotten (the SDO channel was reset).
   void forget_requests() noexcept { pending_.fill({}); }
+  // The bus is closing: every request is given up (SdoClient::cancel), so a transfer through the
+  // profile's buffer is aborted on the wire and frees the channel at once.
+  void cancel_requests() noexcept;
 
   [[nodiscard]] bool mapped(cia402::ObjectId id) const noexcept override { return pdos_.image().contains(id); }
   [[nodiscard]] std::int64_t read(cia402::ObjectId id) const noexcept override { return pdos_.image().get(id); }

@@ -66,6 +66,23 @@ TEST_F(ThreeNodes, EightByteFrameArrivesAfter270usAtEveryOtherNode) {
   EXPECT_TRUE(bus.idle());
 }
 
+TEST_F(ThreeNodes, NextChangeAndAvailableLetACallerRunTheWireOnAClock) {
+  EXPECT_EQ(bus.next_change(), core::TimePoint::max());
+  ASSERT_EQ(a->send(frame(0x181, 8), t0), SendResult::Sent);
+  EXPECT_EQ(bus.next_change(), t0 + 1ns);  // it starts once time has moved past its queueing
+  bus.advance(t0 + 1ns);
+  EXPECT_EQ(bus.next_change(), t0 + kEightBytes);  // then it ends
+  bus.advance(t0 + kEightBytes - 1ns);
+  EXPECT_EQ(b->available(), 0U);
+  bus.advance(bus.next_change());
+  EXPECT_EQ(b->available(), 1U);
+  EXPECT_EQ(c->available(), 1U);
+  EXPECT_EQ(a->available(), 0U);
+  EXPECT_EQ(bus.next_change(), core::TimePoint::max());
+  EXPECT_EQ(drain(*b, t0 + 1ms).size(), 1U);
+  EXPECT_EQ(b->available(), 0U);
+}
+
 TEST_F(ThreeNodes, FramesQueueBackToBackAtTheirLength) {
   // Three frames from one node: FIFO, each starts when the previous ends.
   ASSERT_EQ(a->send(frame(0x201, 8), t0), SendResult::Sent);

@@ -125,6 +125,37 @@ TEST(CycleThread, LoopAddsNoAllocation) {
   EXPECT_EQ(loop_allocations, 0U);
 }
 
+TEST(CycleThread, BetweenGetsEachNextStartAndTheCycleStillStartsThere) {
+  // `between` is called before every sleep with the next cycle's start; the body's `now` of that
+  // cycle is never before it, and what `between` spends of the period does not move the schedule.
+  constexpr std::int64_t kPeriod = 2'000'000;
+  std::int64_t announced = 0;     // cycle thread only until stop() joined
+  std::int64_t first_start = 0;
+  std::uint64_t early = 0;        // cycles that started before the start `between` was given
+  std::uint64_t off_grid = 0;     // announced starts not on the period grid
+  std::atomic<std::uint64_t> calls{0};
+  CycleThread thread(
+      {.period = std::chrono::nanoseconds(kPeriod)},
+      [&](core::TimePoint now, std::uint64_t) {
+        if (core::to_ns(now) < announced) ++early;
+        ++calls;
+      },
+      [&](core::TimePoint deadline) {
+        const std::int64_t d = core::to_ns(deadline);
+        if (first_start == 0) first_start = d;
+        if ((d - first_start) % kPeriod != 0) ++off_grid;
+        announced = d;
+        // Busy until half a period before the deadline, as a bus serving frames would be.
+        while (core::to_ns(monotonic_now()) < d - kPeriod / 2) {
+        }
+      });
+  ASSERT_TRUE(thread.start());
+  ASSERT_TRUE(eventually([&] { return calls.load() >= 50; }));
+  thread.stop();
+  EXPECT_EQ(early, 0U);
+  EXPECT_EQ(off_grid, 0U);
+}
+
 TEST(CycleThread, BodyExceptionEndsThreadWithoutCrash) {
   CycleThread thread({.period = 1ms}, [](core::TimePoint, std::uint64_t cycle) {
     if (cycle == 3) throw std::runtime_error("bug in a bus engine");

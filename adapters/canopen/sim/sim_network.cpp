@@ -89,12 +89,14 @@ SimPeer::SimPeer(std::shared_ptr<InprocBus> bus)
 
 SimPeer::~SimPeer() = default;
 
-SimPeer::Wiring SimPeer::wire(const config::BusPlan& plan) {
-  // Each end may queue a whole cycle's frames at once: per node up to 4 PDOs, an SDO frame and
-  // error control, plus SYNC and NMT on the gateway side.
+InprocBusOptions sim_wire_options(const config::BusPlan& plan) {
   InprocBusOptions options;
   options.tx_queue_capacity = std::max<std::size_t>(options.tx_queue_capacity, 8 * plan.axes.size() + 64);
-  auto bus = std::make_shared<InprocBus>(plan.section<config::CanopenBusOptions>().bitrate, options);
+  return options;
+}
+
+SimPeer::Wiring SimPeer::wire(const config::BusPlan& plan) {
+  auto bus = std::make_shared<InprocBus>(plan.section<config::CanopenBusOptions>().bitrate, sim_wire_options(plan));
   auto endpoint = bus->connect();
   const InprocEndpoint* gateway_end = endpoint.get();
   auto gateway = std::make_unique<GatewayEndpoint>(bus, std::move(endpoint));

@@ -57,6 +57,11 @@ class SimNetwork {
   SimNetworkCounters counters_;
 };
 
+// The in-process wire's options for simulated drives of a plan's bus: each end may queue a whole
+// cycle's frames at once (per node up to 4 PDOs, an SDO frame and error control, plus SYNC and NMT
+// on the gateway side).
+InprocBusOptions sim_wire_options(const config::BusPlan& plan);
+
 // The simulated drives of a `transport: sim` canopen bus, stepped by the bus every cycle
 // (CanopenBus calls step() before it receives). They sit on an in-process wire at the bus' bit
 // rate (transport/inproc_bus.hpp); the gateway gets the other end of it.

@@ -268,6 +268,17 @@ bool InprocBus::idle() const noexcept {
   return true;
 }
 
+core::TimePoint InprocBus::next_change() const noexcept {
+  if (wire_->active) return wire_->end;
+  core::TimePoint first = core::TimePoint::max();
+  for (std::size_t i = 0; i < slot_count_; ++i) {
+    if (!slots_[i].tx.empty()) first = std::min(first, slots_[i].tx.front().at);
+  }
+  if (first == core::TimePoint::max()) return first;
+  // start_next() starts a transmission once time has moved past its start.
+  return std::max(free_since_, first) + (bitrate_ != 0 ? core::Duration{1} : core::Duration::zero());
+}
+
 // --- InprocEndpoint ----------------------------------------------------------------------------
 
 InprocEndpoint::~InprocEndpoint() { close(); }
@@ -282,6 +293,8 @@ void InprocEndpoint::close() noexcept {
 }
 
 bool InprocEndpoint::is_open() const noexcept { return bus_->slots_[index_].open; }
+
+std::size_t InprocEndpoint::available() const noexcept { return bus_->slots_[index_].rx.size(); }
 
 std::size_t InprocEndpoint::receive(std::span<CanFrame> out, core::TimePoint now) noexcept {
   return bus_->take(index_, out, now);

@@ -54,6 +54,8 @@ class InprocEndpoint final : public Transport {
   [[nodiscard]] std::string describe() const override;
 
   [[nodiscard]] std::size_t index() const noexcept { return index_; }
+  // Frames delivered to this endpoint and not yet received (as far as the medium has been run).
+  [[nodiscard]] std::size_t available() const noexcept;
 
  private:
   friend class InprocBus;
@@ -118,6 +120,9 @@ class InprocBus {
   [[nodiscard]] double load(core::TimePoint now) noexcept;
   // Nothing queued and nothing on the wire.
   [[nodiscard]] bool idle() const noexcept;
+  // The earliest `now` at which advance() has something to do (a transmission ends, a queued frame
+  // starts); TimePoint::max() when idle. For a caller that runs the medium on a real clock.
+  [[nodiscard]] core::TimePoint next_change() const noexcept;
   [[nodiscard]] std::uint32_t bitrate() const noexcept { return bitrate_; }
 
  private:
