@@ -34,6 +34,11 @@ constexpr std::size_t kMaxEvents = 1000;
 constexpr Millis kPollSlice{50};
 // Gateways on one domain are discovered within a few hundred ms of each other.
 constexpr Millis kDiscoveryQuiet{1000};
+// How long the first read of a state-like topic waits for its reader to match every known gateway
+// and for the data to arrive: endpoint discovery takes some ms, then axis_state (best effort,
+// volatile) comes with the next publication (status_rate_hz, 50 Hz by default; 1 Hz and up
+// allowed), the transient-local topics with their history.
+constexpr Millis kFirstData{1500};
 
 std::string default_name() {
   char host[256] = {};
@@ -89,21 +94,14 @@ class Client::Impl : public dds::DataReaderListener {
     const std::string identity = opt_.identity.empty() ? env("DRIVEGATE_IDENTITY") : opt_.identity;
     if (!identity.empty()) o.security = msg::security_files_in(identity);
     node_ = std::make_unique<msg::DdsNode>(o);
-    // Transient-local history can be delivered while create_datareader() is still running, before
-    // the reader pointers below are known to on_data_available(). So: create all readers without a
-    // listener, then attach it and take whatever already arrived.
+    // Discovery from the start. Transient-local history can be delivered while create_datareader()
+    // is still running, before info_r_ is known to on_data_available(). So: create the reader
+    // without a listener, then attach it and take whatever already arrived. The readers of the
+    // state-like topics are made on first use (subscribe()): a client that only commands matches
+    // no gateway's axis_state writer, which would otherwise send it every state at the status rate.
     info_r_ = &node_->reader(msg::TopicId::GatewayInfo, nullptr, dds::StatusMask::none());
-    state_r_ = &node_->reader(msg::TopicId::AxisState, nullptr, dds::StatusMask::none());
-    event_r_ = &node_->reader(msg::TopicId::AxisEvent, nullptr, dds::StatusMask::none());
-    bus_r_ = &node_->reader(msg::TopicId::BusStatus, nullptr, dds::StatusMask::none());
-    // Permissions made before axis_link existed refuse its reader: then there are no link details.
-    std::string no_links;
-    link_r_ = optional_reader(msg::TopicId::AxisLink, no_links);
-    for (dds::DataReader* r : {info_r_, state_r_, event_r_, bus_r_, link_r_}) {
-      if (r == nullptr) continue;
-      r->set_listener(this, dds::StatusMask::data_available());
-      on_data_available(r);
-    }
+    info_r_->set_listener(this, dds::StatusMask::data_available());
+    on_data_available(info_r_);
   }
 
   // The endpoints for commands (and set-points) or parameter requests, made on first use: a client
@@ -146,11 +144,11 @@ class Client::Impl : public dds::DataReaderListener {
   void on_data_available(dds::DataReader* reader) override {
     if (reader == nullptr) return;
     if (reader == info_r_) take_infos();
-    else if (reader == state_r_) take_states();
+    else if (reader == state_r_.load()) take_states(*reader);
     else if (reader == reply_r_) take_replies();
-    else if (reader == event_r_) take_events();
-    else if (reader == bus_r_) take_buses();
-    else if (reader == link_r_) take_links();
+    else if (reader == event_r_.load()) take_events(*reader);
+    else if (reader == bus_r_.load()) take_buses(*reader);
+    else if (reader == link_r_.load()) take_links(*reader);
     else if (reader == param_r_) take_param_replies();
     {
       std::lock_guard lock(mutex_);
@@ -361,37 +359,46 @@ class Client::Impl : public dds::DataReaderListener {
     for (const auto& [name, g] : gateways_) v.push_back(g);
     return v;
   }
-  std::vector<AxisState> states() const {
+  std::vector<AxisState> states() {
+    subscribe_states();
     std::lock_guard lock(mutex_);
     std::vector<AxisState> v;
     for (const auto& [key, s] : states_) v.push_back(s);
     return v;
   }
-  std::optional<AxisState> state(std::string_view axis, std::string_view gateway) const {
+  std::optional<AxisState> state(std::string_view axis, std::string_view gateway) {
+    subscribe_states();
     std::lock_guard lock(mutex_);
     for (const auto& [key, s] : states_)
       if (s.axis == axis && (gateway.empty() || s.gateway == gateway)) return s;
     return std::nullopt;
   }
-  std::vector<BusStatus> buses() const {
+  std::vector<BusStatus> buses() {
+    subscribe(bus_r_, msg::TopicId::BusStatus, [&] {
+      return every_axis_has([&](const std::string& g, const AxisInfo& a) { return buses_.count({g, a.bus}) > 0; });
+    });
     std::lock_guard lock(mutex_);
     std::vector<BusStatus> v;
     for (const auto& [key, b] : buses_) v.push_back(b);
     return v;
   }
-  std::vector<AxisLink> links() const {
+  std::vector<AxisLink> links() {
+    subscribe_links();
     std::lock_guard lock(mutex_);
     std::vector<AxisLink> v;
     for (const auto& [key, l] : links_) v.push_back(l);
     return v;
   }
-  std::optional<AxisLink> link(std::string_view axis, std::string_view gateway) const {
+  std::optional<AxisLink> link(std::string_view axis, std::string_view gateway) {
+    subscribe_links();
     std::lock_guard lock(mutex_);
     for (const auto& [key, l] : links_)
       if (l.axis == axis && (gateway.empty() || l.gateway == gateway)) return l;
     return std::nullopt;
   }
-  std::vector<AxisEvent> events_since(std::uint64_t& cursor) const {
+  std::vector<AxisEvent> events_since(std::uint64_t& cursor) {
+    // The gateways' event history (transient local) follows the match without further waiting.
+    subscribe(event_r_, msg::TopicId::AxisEvent, [] { return true; });
     std::lock_guard lock(mutex_);
     std::vector<AxisEvent> v;
     const std::uint64_t first = events_end_ - events_.size();
@@ -436,6 +443,52 @@ class Client::Impl : public dds::DataReaderListener {
       if (refusal.empty()) refusal = std::string(e.what()) + " (client '" + opt_.name + "')";
       return nullptr;
     }
+  }
+
+  void subscribe_states() {
+    subscribe(state_r_, msg::TopicId::AxisState,
+              [&] { return every_axis_has([&](const std::string& g, const AxisInfo& a) { return states_.count({g, a.name}) > 0; }); });
+  }
+  void subscribe_links() {
+    subscribe(link_r_, msg::TopicId::AxisLink,
+              [&] { return every_axis_has([&](const std::string& g, const AxisInfo& a) { return links_.count({g, a.name}) > 0; }); });
+  }
+
+  // Makes the reader of a state-like topic on the first call (the later ones return at once) and
+  // waits, up to kFirstData, until it matched every known gateway and `arrived` says the gateways'
+  // present data is in, so that the first read after subscribing is not silently empty. Readers
+  // the DDS identity may not have (permissions made before axis_link existed, say) stay absent:
+  // their data is then empty. The mutex makes concurrent first calls wait for the same reader; the
+  // reader is published (slot) before the listener is attached, as in the constructor.
+  void subscribe(std::atomic<dds::DataReader*>& slot, msg::TopicId topic, const std::function<bool()>& arrived) {
+    if (subscribed_.load(std::memory_order_acquire) & bit(topic)) return;
+    std::lock_guard lock(subscribe_mutex_);
+    if (subscribed_.load(std::memory_order_relaxed) & bit(topic)) return;
+    std::string refusal;
+    dds::DataReader* r = optional_reader(topic, refusal);
+    if (r != nullptr) {
+      slot.store(r);
+      r->set_listener(this, dds::StatusMask::data_available());
+      on_data_available(r);
+      wait_until(
+          [&] {
+            dds::SubscriptionMatchedStatus m{};
+            r->get_subscription_matched_status(m);
+            std::lock_guard data_lock(mutex_);
+            return m.current_count >= static_cast<std::int32_t>(gateways_.size()) && arrived();
+          },
+          kFirstData);
+    }
+    subscribed_.fetch_or(bit(topic), std::memory_order_release);
+  }
+  static unsigned bit(msg::TopicId t) { return 1U << static_cast<unsigned>(t); }
+  // Under mutex_: whether `has(gateway, axis)` holds for every discovered axis.
+  template <typename Has>
+  bool every_axis_has(Has&& has) const {
+    for (const auto& [name, g] : gateways_)
+      for (const auto& a : g.axes)
+        if (!has(name, a)) return false;
+    return true;
   }
 
   // Flow control: at most opt_.window requests of this client wait for their first reply; then
@@ -543,8 +596,8 @@ class Client::Impl : public dds::DataReaderListener {
     }
   }
 
-  void take_states() {
-    msg::take_valid<msg::AxisState>(*state_r_, [&](const msg::AxisState& in) {
+  void take_states(dds::DataReader& reader) {
+    msg::take_valid<msg::AxisState>(reader, [&](const msg::AxisState& in) {
       AxisState s;
       s.gateway = in.gateway();
       s.axis = in.axis();
@@ -581,8 +634,8 @@ class Client::Impl : public dds::DataReaderListener {
     });
   }
 
-  void take_events() {
-    msg::take_valid<msg::AxisEvent>(*event_r_, [&](const msg::AxisEvent& in) {
+  void take_events(dds::DataReader& reader) {
+    msg::take_valid<msg::AxisEvent>(reader, [&](const msg::AxisEvent& in) {
       std::lock_guard lock(mutex_);
       events_.push_back({in.gateway(), in.axis(), in.bus(), in.kind(), in.state(), in.code(), in.text(), in.stamp()});
       ++events_end_;
@@ -590,8 +643,8 @@ class Client::Impl : public dds::DataReaderListener {
     });
   }
 
-  void take_buses() {
-    msg::take_valid<msg::BusStatus>(*bus_r_, [&](const msg::BusStatus& in) {
+  void take_buses(dds::DataReader& reader) {
+    msg::take_valid<msg::BusStatus>(reader, [&](const msg::BusStatus& in) {
       BusStatus b{in.gateway(),        in.bus(),         in.type(),
                   in.running(),        in.healthy(),     in.period_ns(),
                   in.achieved_period_ns(), in.lateness_p50_ns(), in.lateness_p99_ns(),
@@ -603,8 +656,8 @@ class Client::Impl : public dds::DataReaderListener {
     });
   }
 
-  void take_links() {
-    msg::take_valid<msg::AxisLink>(*link_r_, [&](const msg::AxisLink& in) {
+  void take_links(dds::DataReader& reader) {
+    msg::take_valid<msg::AxisLink>(reader, [&](const msg::AxisLink& in) {
       AxisLink l{in.gateway(), in.axis(), in.bus(), in.bus_type(), in.address(), in.link(), in.detail(), in.since()};
       std::lock_guard lock(mutex_);
       links_[{l.gateway, l.axis}] = std::move(l);
@@ -637,12 +690,15 @@ class Client::Impl : public dds::DataReaderListener {
   dds::DataWriter* sp_w_ = nullptr;
   dds::DataWriter* param_w_ = nullptr;
   dds::DataReader* info_r_ = nullptr;
-  dds::DataReader* state_r_ = nullptr;
   dds::DataReader* reply_r_ = nullptr;
-  dds::DataReader* event_r_ = nullptr;
-  dds::DataReader* bus_r_ = nullptr;
-  dds::DataReader* link_r_ = nullptr;
   dds::DataReader* param_r_ = nullptr;
+  // Made on first use (subscribe()); read by the listener thread.
+  std::atomic<dds::DataReader*> state_r_{nullptr};
+  std::atomic<dds::DataReader*> event_r_{nullptr};
+  std::atomic<dds::DataReader*> bus_r_{nullptr};
+  std::atomic<dds::DataReader*> link_r_{nullptr};
+  std::mutex subscribe_mutex_;
+  std::atomic<unsigned> subscribed_{0};  // bit(topic): subscribe() done for that topic
 
   std::mutex endpoints_mutex_;
   bool command_endpoints_tried_ = false;

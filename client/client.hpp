@@ -217,7 +217,11 @@ class Client {
   [[nodiscard]] std::string command_refusal();
   [[nodiscard]] std::string parameter_refusal();
 
-  // Discovery and latest data (copies, sorted by gateway then axis).
+  // Discovery and latest data (copies, sorted by gateway then axis). Gateways are discovered from
+  // construction on. The states, bus statuses, links and events are subscribed to on the first call
+  // that reads them (a client that only commands receives none of them); that first call waits
+  // (up to 1.5 s) until the gateways discovered so far have delivered what they have: a state and
+  // a link per axis, a status per bus, the event history.
   [[nodiscard]] std::vector<GatewayInfo> gateways() const;
   [[nodiscard]] std::vector<AxisState> states() const;
   [[nodiscard]] std::optional<AxisState> state(std::string_view axis, std::string_view gateway = {}) const;

@@ -188,6 +188,53 @@ TEST(DdsBridge, CommandAcceptedThenCompleted) {
   EXPECT_NE(all[0].command.id, all[1].command.id);
 }
 
+// A client that only commands does not subscribe to axis_state: the gateway's state writer does not
+// send it every state at the status rate. The first states() subscribes and returns them at once.
+// A probe participant with its own axis_state writer and axis_command reader sees which endpoints
+// the client has.
+TEST(DdsBridge, CommandOnlyClientSubscribesToStatesOnFirstRead) {
+  FakeRuntime rt("gw1", {"x", "y"});
+  daemon::DdsBridge bridge(rt, bridge_options());
+  bridge.start();
+  msg::DdsNode probe(raw_options());
+  dds::DataWriter& state_w = probe.writer(msg::TopicId::AxisState);
+  dds::DataReader& command_r = probe.reader(msg::TopicId::AxisCommand);
+  const auto matched_state_readers = [&] {
+    dds::PublicationMatchedStatus m{};
+    state_w.get_publication_matched_status(m);
+    return m.current_count;
+  };
+  Client c(client_options());
+
+  CommandRequest req;
+  req.axis = "x";
+  req.kind = "enable";
+  ASSERT_EQ(c.send(req, true, kTimeout).outcome, Outcome::Completed);
+  EXPECT_EQ(c.stream_setpoint("x", "gw1", 0, 1, 0), "");
+  // The probe has discovered the client's endpoints (the command writer, made after the readers the
+  // client made at construction) ...
+  ASSERT_TRUE(c.wait_until(
+      [&] {
+        dds::SubscriptionMatchedStatus m{};
+        command_r.get_subscription_matched_status(m);
+        return m.current_count > 0;
+      },
+      kTimeout));
+  // ... and no axis_state reader among them.
+  EXPECT_FALSE(c.wait_until([&] { return matched_state_readers() > 0; }, Millis(500)));
+
+  // The first read subscribes and waits for the present states: not empty right after subscribing.
+  const auto states = c.states();
+  ASSERT_EQ(states.size(), 2U);
+  EXPECT_EQ(states[0].axis, "x");
+  EXPECT_EQ(states[1].axis, "y");
+  EXPECT_TRUE(c.wait_until([&] { return matched_state_readers() == 1; }, kTimeout));
+  // Likewise links and bus statuses (transient local) on their first read.
+  EXPECT_EQ(c.links().size(), 2U);
+  ASSERT_EQ(c.buses().size(), 1U);
+  EXPECT_EQ(c.buses()[0].bus, "can0");
+}
+
 TEST(DdsBridge, UnknownAxisIsRejectedWithTheAxesWeHave) {
   FakeRuntime rt("gw1", {"x", "y"});
   daemon::DdsBridge bridge(rt, bridge_options());
