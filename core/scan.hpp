@@ -61,6 +61,8 @@ struct FoundDevice {
   std::optional<std::string> software_version;  // 100Ah
   std::string profile;         // the device profile that fits, "" for none
   std::string profile_reason;  // why that one, or why none
+  // Without a profile: what to do so that it becomes an axis ("add a device profile for it ...").
+  std::string next_step;
   bool drive = false;          // an axis in the configuration skeleton (it has a profile to run it)
   // Why its identity cannot be trusted (more than one device answers at its address: a conflict);
   // "" when it can. Such a device has no profile and is no axis.
@@ -74,6 +76,12 @@ struct ScanResult {
   std::string description;  // what was scanned, "udp-multicast 239.1.2.3:43113 on 127.0.0.1"
   // The bus' options as the configuration file writes them (key, YAML scalar), in order.
   std::vector<std::pair<std::string, std::string>> bus_options;
+  // Options the scan could not learn and assumed: key and what to check, a CHECK comment in the
+  // skeleton (CANopen: the bit rate, which SocketCAN does not tell).
+  std::vector<std::pair<std::string, std::string>> bus_option_checks;
+  // What the scan assumed, for the table's first line ("bit rate not given (500 kbit/s assumed ...)");
+  // empty: nothing.
+  std::string assumed;
   // Cycle times to offer in the skeleton, best first; the first the configuration accepts is used.
   std::vector<Duration> cycle_times;
   std::vector<FoundDevice> devices;  // by address

@@ -27,6 +27,7 @@ using namespace std::chrono_literals;
 constexpr std::uint32_t kNoObject = 0x06020000;
 constexpr std::uint32_t kNoSubIndex = 0x06090011;
 constexpr std::uint32_t kTimeout = 0x05040000;
+constexpr std::uint32_t kOutOfMemory = 0x05040005;
 
 constexpr ObjectId kDeviceType{0x1000, 0};
 // The identity reads after the probe, in CanopenScan::Node::reads order.
@@ -84,6 +85,36 @@ core::Duration request_timeout(const CanopenScanSettings& s) {
   return s.answer_timeout + 2 * kMaxNodeId * frame_time(8, s.bitrate);
 }
 
+std::string times(std::uint64_t n) { return std::to_string(n) + (n == 1 ? " time" : " times"); }
+
+// "another CANopen master is active on this bus (SYNC 080h seen 25 times, SDO requests on 605h): ..."
+std::string refusal_words(const ForeignMasterFrames& f) {
+  std::string seen;
+  const auto add = [&](const std::string& what) { seen += (seen.empty() ? "" : ", ") + what; };
+  if (f.sync > 0) add("SYNC 080h seen " + times(f.sync));
+  if (f.nmt > 0) add("NMT commands on 000h seen " + times(f.nmt));
+  if (f.rpdo > 0) add("RPDOs seen " + times(f.rpdo));
+  if (f.sdo_requests > 0) {
+    std::string on;
+    int listed = 0;
+    for (int n = kMinNodeId; n <= kMaxNodeId; ++n) {
+      if (!f.sdo_request_on[static_cast<std::size_t>(n)]) continue;
+      if (++listed > 8) {
+        on += ", ...";
+        break;
+      }
+      char b[8];
+      std::snprintf(b, sizeof b, "%03Xh", cob::sdo_rx(static_cast<NodeId>(n)));
+      on += (on.empty() ? " on " : ", ") + std::string(b);
+    }
+    add("SDO requests" + on + " seen " + times(f.sdo_requests));
+  }
+  if (f.guarding > 0) add("node guarding requests seen " + times(f.guarding));
+  return "another CANopen master is active on this bus (" + seen +
+         "): stop it, or scan while it is off; the scan sent nothing, its SDO requests would break that "
+         "master's transfers";
+}
+
 }  // namespace
 
 CanopenScan::CanopenScan(CanopenScanSettings settings, core::TimePoint start)
@@ -116,6 +147,7 @@ void CanopenScan::on_frame(const CanFrame& frame, core::TimePoint now) noexcept 
       if (node == nullptr) break;
       if (frame.remote) {  // a node guarding request: someone guards this node
         ++counters_.foreign_master;
+        ++foreign_.guarding;
         break;
       }
       if (const auto ec = decode_error_control(frame.payload())) {
@@ -131,9 +163,22 @@ void CanopenScan::on_frame(const CanFrame& frame, core::TimePoint now) noexcept 
       if (node != nullptr) node->seen.heard = true;
       break;
     case Function::Nmt:
+      ++counters_.foreign_master;
+      ++foreign_.nmt;
+      break;
     case Function::Sync:
+      ++counters_.foreign_master;
+      ++foreign_.sync;
+      break;
     case Function::Rpdo:
-    case Function::SdoRx: ++counters_.foreign_master; break;
+      ++counters_.foreign_master;
+      ++foreign_.rpdo;
+      break;
+    case Function::SdoRx:
+      ++counters_.foreign_master;
+      ++foreign_.sdo_requests;
+      if (node != nullptr) foreign_.sdo_request_on[s.node] = true;
+      break;
     case Function::Time:
     case Function::Other: break;
   }
@@ -217,6 +262,10 @@ void CanopenScan::collect(Node& n, core::TimePoint now) {
       seen.notes.push_back(object_name(o) + " not present");
     } else if (r.status == SdoStatus::Failed && r.abort_code == kTimeout) {
       seen.notes.push_back(object_name(o) + ": no answer in time");
+    } else if (r.status == SdoStatus::Failed && r.abort_code == kOutOfMemory && i >= kFirstString) {
+      // The client aborts an upload longer than its buffer with 05040005h (sdo_client.hpp).
+      seen.notes.push_back(object_name(o) + ": longer than " + std::to_string(settings_.string_limit) +
+                           " bytes, not read");
     } else if (r.status == SdoStatus::Failed) {
       seen.notes.push_back(object_name(o) + ": " + abort_words(r.abort_code));
     } else {
@@ -231,6 +280,11 @@ void CanopenScan::collect(Node& n, core::TimePoint now) {
 }
 
 void CanopenScan::poll(core::TimePoint now, TxQueue& tx) {
+  if (phase_ == Phase::Listen && now >= listen_end_ && counters_.foreign_master > 0) {
+    refusal_ = refusal_words(foreign_);
+    phase_ = Phase::Done;
+    return;
+  }
   if (phase_ == Phase::Listen && now >= listen_end_) {
     phase_ = Phase::Probe;
     for (int n = kMinNodeId; n <= kMaxNodeId; ++n)
@@ -252,7 +306,6 @@ void CanopenScan::finish_all() {
       sdo_.cancel(n.probe);
       n.probe = kNoSdoRequest;
       n.seen.notes.push_back("1000h: no answer before the scan's deadline");
-      n.seen.answered = n.seen.heard;
       n.finished = true;
       continue;
     }
@@ -341,20 +394,33 @@ const config::BusTypeRegistry& scan_types() {
 
 }  // namespace
 
+namespace {
+
+// WHERE's options, "?key=value&key=value", in order. Throws core::ScanError.
+std::vector<std::pair<std::string, std::string>> where_options(const std::string& where) {
+  std::vector<std::pair<std::string, std::string>> options;
+  const auto q = where.find('?');
+  if (q == std::string::npos) return options;
+  std::istringstream in(where.substr(q + 1));
+  for (std::string item; std::getline(in, item, '&');) {
+    const auto eq = item.find('=');
+    if (eq == std::string::npos || eq == 0) throw core::ScanError("option \"" + item + "\" is not KEY=VALUE");
+    options.emplace_back(item.substr(0, eq), item.substr(eq + 1));
+  }
+  return options;
+}
+
+}  // namespace
+
+bool scan_option_given(const core::ScanRequest& request, const std::string& key) {
+  const auto options = where_options(request.where);
+  return std::any_of(options.begin(), options.end(), [&](const auto& o) { return o.first == key; });
+}
+
 config::BusPlan scan_bus_plan(const core::ScanRequest& request) {
   const std::string& where = request.where;
-  const auto q = where.find('?');
-  std::string transport = where.substr(0, q);
-  std::vector<std::pair<std::string, std::string>> options;
-  if (q != std::string::npos) {
-    std::istringstream in(where.substr(q + 1));
-    for (std::string item; std::getline(in, item, '&');) {
-      const auto eq = item.find('=');
-      if (eq == std::string::npos || eq == 0)
-        throw core::ScanError("option \"" + item + "\" is not KEY=VALUE");
-      options.emplace_back(item.substr(0, eq), item.substr(eq + 1));
-    }
-  }
+  std::string transport = where.substr(0, where.find('?'));
+  auto options = where_options(where);
   if (transport.empty())
     throw core::ScanError("name the bus: a CAN interface (canopen:can0) or udp-multicast "
                           "(canopen:udp-multicast?group=239.74.163.2&port=43113&interface=127.0.0.1)");
@@ -455,6 +521,7 @@ void match_profile(core::FoundDevice& d, const std::vector<config::DeviceProfile
     int score;  // 3 vendor and product, 2 vendor, 1 device type only
   };
   std::vector<Fit> fits;
+  std::string identity_of;  // a profile whose identity is the device's, but not its 1000h
   for (const auto& p : profiles) {
     const auto& pid = p.identity;
     if (pid.vendor_id || pid.product_code) {
@@ -465,6 +532,7 @@ void match_profile(core::FoundDevice& d, const std::vector<config::DeviceProfile
         d.notes.push_back(identity_words(id) + " is " + p.name + "'s, but its 1000h " +
                           (d.device_type ? hex32(*d.device_type) : std::string("(not read)")) + " is not the " +
                           hex32(*p.section<config::CanopenDeviceSpec>().device_type) + " that profile expects");
+        if (identity_of.empty()) identity_of = p.name;
         continue;
       }
       fits.push_back({&p, pid.product_code ? 3 : 2});
@@ -483,6 +551,16 @@ void match_profile(core::FoundDevice& d, const std::vector<config::DeviceProfile
                                          : std::string("1000h not read");
   if (fits.empty()) {
     d.profile_reason = identity_words(id) + " matches no profile and no profile fits " + type;
+    if (!d.device_type) {
+      d.next_step = "its device type (1000h) could not be read (see its notes); without it no profile can be chosen";
+    } else if (!identity_of.empty()) {
+      d.profile_reason = identity_words(id) + " is " + identity_of + "'s, but its " + type + ", not what that "
+                         "profile expects";
+      d.next_step = "its identity is " + identity_of + "'s but its device type (1000h) is not; check the device's "
+                    "setup (drive type, firmware) against that profile and scan again";
+    } else {
+      d.next_step = "add a device profile for it (profiles/devices/README.md) and scan again";
+    }
     return;
   }
   const Fit& best = fits.front();
@@ -569,13 +647,20 @@ void fold_extra_channels(std::vector<core::FoundDevice>& devices, const std::vec
 }  // namespace
 
 core::ScanResult scan_result(const CanopenScan& scan, const config::BusPlan& plan,
-                             const std::vector<config::DeviceProfile>& profiles) {
+                             const std::vector<config::DeviceProfile>& profiles, bool bitrate_given) {
+  if (!scan.refusal().empty()) throw core::ScanError(scan.refusal());
   const auto& c = plan.section<config::CanopenBusOptions>();
   core::ScanResult r;
   r.bus_type = "canopen";
   r.bus_options.emplace_back("transport", config::to_string(c.transport));
   r.bus_options.emplace_back("interface", c.interface);
   r.bus_options.emplace_back("bitrate", std::to_string(c.bitrate));
+  if (!bitrate_given) {
+    r.bus_option_checks.emplace_back("bitrate", "the bus' bit rate (not read from the interface; set it to the "
+                                                "interface's)");
+    r.assumed = "bit rate not given (" + std::to_string(c.bitrate / 1000) +
+                " kbit/s assumed for the answer times and the load estimate)";
+  }
   if (c.transport == config::CanTransportKind::UdpMulticast) {
     r.bus_name = "can0";
     r.bus_options.emplace_back("group", c.group);
@@ -609,8 +694,10 @@ core::ScanResult scan_result(const CanopenScan& scan, const config::BusPlan& pla
       r.warnings.push_back(d.conflict);
     } else if (n.answered) {
       match_profile(d, profiles);
-    } else {
-      d.profile_reason = "no SDO answer: nothing to match";
+    } else {  // listed, so heard
+      d.profile_reason = "heard (heartbeat, boot-up, EMCY or PDO) but its SDO server did not answer";
+      d.next_step = "its SDO server did not answer; check the device's node-ID and SDO settings and the bus' bit "
+                    "rate, and scan again";
     }
     taken[n.node] = true;
     r.devices.push_back(std::move(d));
@@ -679,7 +766,7 @@ core::ScanResult run_scan(const config::BusPlan& plan, const core::ScanRequest& 
       std::this_thread::sleep_for(std::min(wait, std::chrono::milliseconds(1)));
     }
   }
-  core::ScanResult r = scan_result(scan, plan, profiles);
+  core::ScanResult r = scan_result(scan, plan, profiles, scan_option_given(request, "bitrate"));
   r.description = transport->describe();
   r.elapsed = clock.now() - start;
   if (not_sent > 0)

@@ -7,7 +7,9 @@
 // and, as CiA 301 has a client do, an SDO abort (05040000h) for a request that got no answer.
 //
 //   1. Listen for `listen`: boot-ups and heartbeats (700h + N), EMCY and TPDOs name nodes that are
-//      there; SYNC, NMT, RPDOs and SDO requests mean another master runs the bus.
+//      there; SYNC, NMT, RPDOs, SDO requests and guarding requests mean another master runs the bus.
+//      Then the scan stops without sending anything (refusal()): its requests on 600h + N would
+//      break that master's SDO transfers on the same channels.
 //   2. Read 1000h on every node-ID 1..127 at once: each node has its own SDO server channel, so
 //      the 127 uploads run in parallel.
 //   3. A node that answered (a value or an abort) is asked, in order, 1018h:01..04, 1008h, 1009h
@@ -52,6 +54,16 @@ struct CanopenScanSettings {
   std::uint16_t string_limit = 256;  // bytes read of 1008h, 1009h, 100Ah at most
 };
 
+// The frames of another master, by kind.
+struct ForeignMasterFrames {
+  std::uint64_t sync = 0;
+  std::uint64_t nmt = 0;
+  std::uint64_t rpdo = 0;
+  std::uint64_t sdo_requests = 0;
+  std::uint64_t guarding = 0;                        // node guarding RTRs on 700h + N
+  std::array<bool, kMaxNodeId + 1> sdo_request_on{};  // [N]: an SDO request on 600h + N
+};
+
 struct CanopenScanCounters {
   std::uint64_t frames = 0;              // frames received
   std::uint64_t malformed = 0;           // error-control frames of a wrong length or state, frames past 11 bits
@@ -93,6 +105,9 @@ class CanopenScan {
   [[nodiscard]] std::vector<ScannedNode> nodes() const;
   [[nodiscard]] CanopenScanCounters counters() const noexcept;
   [[nodiscard]] core::TimePoint hard_deadline() const noexcept { return hard_deadline_; }
+  // Why the scan stopped after listening without sending a request (another master is active);
+  // empty when it did not.
+  [[nodiscard]] const std::string& refusal() const noexcept { return refusal_; }
 
  private:
   // The requests asked of a node after its probe, in this order.
@@ -126,6 +141,8 @@ class CanopenScan {
   SdoClient sdo_;
   std::array<Node, kMaxNodeId + 1> nodes_;  // [0] unused
   CanopenScanCounters counters_;
+  ForeignMasterFrames foreign_;
+  std::string refusal_;
 };
 
 // The bus a scan request names, checked by the same rules as a configuration file's canopen bus:
@@ -140,8 +157,13 @@ config::BusPlan scan_bus_plan(const core::ScanRequest& request);
 core::ScanResult run_scan(const config::BusPlan& plan, const core::ScanRequest& request);
 
 // The rows of what `scan` saw, profiles matched; what run_scan() returns without the timing.
+// `bitrate_given`: the scan request named the bit rate (SocketCAN does not tell it); when not, the
+// skeleton marks it CHECK. Throws core::ScanError with scan.refusal() when the scan refused.
 core::ScanResult scan_result(const CanopenScan& scan, const config::BusPlan& plan,
-                             const std::vector<config::DeviceProfile>& profiles);
+                             const std::vector<config::DeviceProfile>& profiles, bool bitrate_given);
+
+// Whether the scan request's WHERE names `key` as an option ("can0?bitrate=250000": bitrate).
+bool scan_option_given(const core::ScanRequest& request, const std::string& key);
 
 // The device profiles with a canopen section in the directories, in name order; broken ones are
 // left out with a note in `notes`.

@@ -116,7 +116,7 @@ TEST_F(ScanOnWire, NobodyThereEndsWithinASecondAndFindsNothing) {
   // listen 200 ms + one answer time (100 ms + the probe's frames on the wire) + the aborts.
   EXPECT_LT(took, 500ms);
   EXPECT_GT(took, 300ms);
-  const auto r = scan_result(*scan_, udp_plan(), profiles());
+  const auto r = scan_result(*scan_, udp_plan(), profiles(), true);
   EXPECT_TRUE(r.devices.empty());
   EXPECT_TRUE(r.notes.empty());
 }
@@ -156,7 +156,7 @@ TEST_F(ScanOnWire, FindsPersonasAtTheirNodeIdsAndReadsTheirIdentity) {
   // The SD6's channels 2..4 answer on the default channels of 37, 69, 101 (SD6 §5.3): the table
   // folds them into node 5.
   EXPECT_NE(node(37), nullptr);
-  const auto r = scan_result(*scan_, udp_plan(), profiles());
+  const auto r = scan_result(*scan_, udp_plan(), profiles(), true);
   std::vector<int> ids;
   for (const auto& d : r.devices) ids.push_back(d.address.number);
   EXPECT_EQ(ids, (std::vector<int>{1, 5, 0x20, 127}));
@@ -219,7 +219,7 @@ TEST_F(ScanOnWire, AnAbortOnTheProbeStillShowsTheNode) {
   EXPECT_EQ(n->device_type, std::nullopt);
   EXPECT_TRUE(has_note(n->notes, "1000h: abort 0x06010000"));
   EXPECT_TRUE(n->identity.vendor_id.has_value());
-  const auto r = scan_result(*scan_, udp_plan(), profiles());
+  const auto r = scan_result(*scan_, udp_plan(), profiles(), true);
   ASSERT_EQ(r.devices.size(), 1U);
   EXPECT_FALSE(r.devices[0].drive);  // no device type: no profile can be chosen
   EXPECT_NE(r.devices[0].profile_reason.find("1000h not read"), std::string::npos) << r.devices[0].profile_reason;
@@ -233,11 +233,13 @@ TEST_F(ScanOnWire, AStringLongerThanTheLimitIsNotedNotTruncatedSilently) {
   const auto* n = node(7);
   ASSERT_NE(n, nullptr);
   EXPECT_EQ(n->name, std::nullopt);  // "NORD SK 500P" is 12 bytes
-  EXPECT_TRUE(has_note(n->notes, "1008h: abort 0x05040005"));
+  // The scanner's own limit, not the device's fault.
+  EXPECT_TRUE(has_note(n->notes, "1008h: longer than 8 bytes, not read"));
+  EXPECT_FALSE(has_note(n->notes, "out of memory"));
   EXPECT_EQ(n->software_version, "V1.2 R0");
 }
 
-TEST_F(ScanOnWire, MalformedFramesAndAnotherMasterAreCountedAndNoted) {
+TEST_F(ScanOnWire, MalformedFramesAreCountedAndNoted) {
   network_.add(sim::test::generic(2));
   bool sent = false;
   responder_ = [&](core::TimePoint t) {
@@ -245,7 +247,6 @@ TEST_F(ScanOnWire, MalformedFramesAndAnotherMasterAreCountedAndNoted) {
     sent = true;
     EXPECT_EQ(other_->send(make_frame(0x709, {0x05, 0x00, 0x00}), t), SendResult::Sent);  // heartbeat, 3 bytes
     EXPECT_EQ(other_->send(make_frame(0x70A, {0x33}), t), SendResult::Sent);              // no NMT state
-    EXPECT_EQ(other_->send(make_frame(0x080, std::initializer_list<std::uint8_t>{}), t), SendResult::Sent);  // SYNC
     CanFrame ext = make_frame(0x12345, {1, 2});
     ext.extended = true;
     EXPECT_EQ(other_->send(ext, t), SendResult::Sent);
@@ -255,15 +256,44 @@ TEST_F(ScanOnWire, MalformedFramesAndAnotherMasterAreCountedAndNoted) {
   ASSERT_TRUE(scan_->done());
   const auto c = scan_->counters();
   EXPECT_EQ(c.malformed, 2U);
-  EXPECT_EQ(c.foreign_master, 1U);
+  EXPECT_EQ(c.foreign_master, 0U);
   EXPECT_GE(c.sdo_unexpected + c.sdo_malformed, 1U);
   EXPECT_EQ(node(9), nullptr);
   EXPECT_EQ(node(10), nullptr);
   ASSERT_NE(node(2), nullptr);
   EXPECT_EQ(node(2)->name, "drivegate simulated CiA 402 drive");
-  const auto r = scan_result(*scan_, udp_plan(), profiles());
+  const auto r = scan_result(*scan_, udp_plan(), profiles(), true);
   EXPECT_TRUE(has_note(r.notes, "2 malformed frames dropped"));
-  EXPECT_TRUE(has_note(r.notes, "1 frames of another master"));
+}
+
+TEST_F(ScanOnWire, AnotherMasterOnTheBusStopsTheScanBeforeAnyRequest) {
+  // Another master runs the bus: SYNC every 10 ms and an SDO transfer with node 5.
+  network_.add(sim::test::generic(5));
+  core::TimePoint next = kT0;
+  bool asked = false;
+  responder_ = [&](core::TimePoint t) {
+    if (t >= next) {
+      EXPECT_EQ(other_->send(make_frame(0x080, std::initializer_list<std::uint8_t>{}), t), SendResult::Sent);
+      next = t + 10ms;
+    }
+    if (!asked && t >= kT0 + 50ms) {
+      asked = true;
+      EXPECT_EQ(other_->send(make_frame(cob::sdo_rx(5), {0x40, 0x00, 0x10, 0x00, 0, 0, 0, 0}), t), SendResult::Sent);
+    }
+  };
+  const auto took = run();
+  ASSERT_TRUE(scan_->done());
+  EXPECT_LT(took, 250ms);  // right after listening
+  EXPECT_TRUE(sent_.empty()) << sent_.size() << " frames sent";
+  EXPECT_EQ(scan_->refusal(),
+            "another CANopen master is active on this bus (SYNC 080h seen 20 times, SDO requests on 605h seen 1 time): stop "
+            "it, or scan while it is off; the scan sent nothing, its SDO requests would break that master's transfers");
+  try {
+    (void)scan_result(*scan_, udp_plan(), profiles(), true);
+    FAIL() << "a result while another master runs the bus";
+  } catch (const core::ScanError& e) {
+    EXPECT_EQ(std::string(e.what()), scan_->refusal());
+  }
 }
 
 TEST_F(ScanOnWire, AServerAnsweringWithTogglingGarbageEndsCleanly) {
@@ -331,10 +361,72 @@ TEST_F(ScanOnWire, ANodeHeardButWithoutSdoAnswerIsListedWithoutAProfile) {
   EXPECT_FALSE(n->boot_up);
   EXPECT_EQ(n->state, NmtState::PreOperational);
   EXPECT_TRUE(has_note(n->notes, "heard on the bus (pre-operational) but its SDO server did not answer 1000h"));
-  const auto r = scan_result(*scan_, udp_plan(), profiles());
+  const auto r = scan_result(*scan_, udp_plan(), profiles(), true);
   ASSERT_EQ(r.devices.size(), 1U);
   EXPECT_FALSE(r.devices[0].drive);
   EXPECT_EQ(r.devices[0].profile, "");
+  EXPECT_EQ(r.devices[0].profile_reason, "heard (heartbeat, boot-up, EMCY or PDO) but its SDO server did not answer");
+  EXPECT_NE(r.devices[0].next_step.find("its SDO server did not answer"), std::string::npos);
+}
+
+TEST_F(ScanOnWire, ANodeHeardWhoseProbeRunsPastTheDeadlineIsNotAnswered) {
+  // The engine is polled only at its hard deadline: the probe of node 33, heard, is still running.
+  CanopenScan scan({}, kT0);
+  scan.on_frame(make_frame(cob::error_control(33), {0x05}), kT0 + 10ms);
+  TxQueue tx;
+  scan.poll(scan.hard_deadline(), tx);
+  ASSERT_TRUE(scan.done());
+  const auto nodes = scan.nodes();
+  ASSERT_EQ(nodes.size(), 1U);
+  EXPECT_TRUE(nodes[0].heard);
+  EXPECT_FALSE(nodes[0].answered);
+  EXPECT_TRUE(has_note(nodes[0].notes, "1000h: no answer before the scan's deadline"));
+  const auto r = scan_result(scan, udp_plan(), profiles(), true);
+  ASSERT_EQ(r.devices.size(), 1U);
+  EXPECT_EQ(r.devices[0].profile_reason, "heard (heartbeat, boot-up, EMCY or PDO) but its SDO server did not answer");
+}
+
+TEST_F(ScanOnWire, WhatToDoAboutADeviceWithoutProfileFollowsWhy) {
+  sim::Persona akd_identity_io_type = sim::persona_for("akd");
+  akd_identity_io_type.device_type = 0x000F0191;  // the AKD's identity, an I/O module's 1000h
+  sim::Persona io_module = sim::persona_for("generic");
+  io_module.device_type = 0x00000195;
+  network_.add(sim::make_slave_config(14, akd_identity_io_type, sim::test::drive_with_modes({1, 3})));
+  network_.add(sim::make_slave_config(15, io_module, sim::test::drive_with_modes({1, 3})));
+  auto& unread = network_.add(sim::test::generic(16));
+  inject_after_boot(unread, {0x1000, 0}, 0x06010000);
+  run();
+  ASSERT_TRUE(scan_->done());
+  const auto r = scan_result(*scan_, udp_plan(), profiles(), true);
+  ASSERT_EQ(r.devices.size(), 3U);
+  EXPECT_FALSE(r.devices[0].drive);
+  EXPECT_NE(r.devices[0].profile_reason.find("is kollmorgen-akd's, but its 1000h = 0x000F0191"), std::string::npos)
+      << r.devices[0].profile_reason;
+  EXPECT_NE(r.devices[0].next_step.find("its identity is kollmorgen-akd's but its device type (1000h) is not"),
+            std::string::npos)
+      << r.devices[0].next_step;
+  EXPECT_EQ(r.devices[1].next_step, "add a device profile for it (profiles/devices/README.md) and scan again");
+  EXPECT_NE(r.devices[2].next_step.find("its device type (1000h) could not be read"), std::string::npos)
+      << r.devices[2].next_step;
+}
+
+TEST(ScanResultBitRate, NotGivenIsMarkedForCheckingAndSaidToBeAssumed) {
+  core::ScanRequest req;
+  req.bus_type = "canopen";
+  req.device_dirs = config::default_device_dirs();
+  req.where = "can0";
+  EXPECT_FALSE(scan_option_given(req, "bitrate"));
+  const CanopenScan scan({}, kT0);
+  auto r = scan_result(scan, scan_bus_plan(req), {}, false);
+  EXPECT_EQ(r.bus_option_checks, (std::vector<std::pair<std::string, std::string>>{
+                                     {"bitrate", "the bus' bit rate (not read from the interface; set it to the "
+                                                 "interface's)"}}));
+  EXPECT_NE(r.assumed.find("bit rate not given (500 kbit/s assumed"), std::string::npos) << r.assumed;
+  req.where = "can0?bitrate=250000";
+  EXPECT_TRUE(scan_option_given(req, "bitrate"));
+  r = scan_result(scan, scan_bus_plan(req), {}, true);
+  EXPECT_TRUE(r.bus_option_checks.empty());
+  EXPECT_TRUE(r.assumed.empty());
 }
 
 TEST_F(ScanOnWire, TwoDevicesOnOneNodeIdAreAConflictWithoutProfile) {
@@ -355,7 +447,7 @@ TEST_F(ScanOnWire, TwoDevicesOnOneNodeIdAreAConflictWithoutProfile) {
   // The second answers went nowhere else: the node next door reads cleanly.
   EXPECT_EQ(node(13)->name, "drivegate simulated CiA 402 drive");
 
-  const auto r = scan_result(*scan_, udp_plan(), profiles());
+  const auto r = scan_result(*scan_, udp_plan(), profiles(), true);
   ASSERT_EQ(r.devices.size(), 2U);
   const auto& d = r.devices[0];
   EXPECT_EQ(d.conflict,
@@ -380,7 +472,7 @@ TEST_F(ScanOnWire, TwoIdenticalDrivesOnOneNodeIdAreStillAConflict) {
   EXPECT_TRUE(has_note(n->second_answers, "1000h: answered twice, the same (0x00020192)"))
       << (n->second_answers.empty() ? "" : n->second_answers[0]);
   EXPECT_TRUE(has_note(n->second_answers, "1008h: answered twice, the same (a segmented upload of 33 bytes)"));
-  const auto r = scan_result(*scan_, udp_plan(), profiles());
+  const auto r = scan_result(*scan_, udp_plan(), profiles(), true);
   ASSERT_EQ(r.devices.size(), 1U);
   EXPECT_FALSE(r.devices[0].drive);
   EXPECT_NE(r.devices[0].conflict.find("node-ID 40: more than one device answers on 628h/5A8h"), std::string::npos);
@@ -393,7 +485,7 @@ TEST_F(ScanOnWire, ADriveOnAnSd6ExtraChannelIsAConflictThatNamesTheSd6) {
   network_.add(sim::test::generic(35));
   run();
   ASSERT_TRUE(scan_->done());
-  const auto r = scan_result(*scan_, udp_plan(), profiles());
+  const auto r = scan_result(*scan_, udp_plan(), profiles(), true);
   std::vector<int> ids;
   for (const auto& d : r.devices) ids.push_back(d.address.number);
   EXPECT_EQ(ids, (std::vector<int>{3, 35}));  // 67 and 99 folded into the SD6, 35 not
