@@ -8,6 +8,7 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <memory>
 #include <ostream>
 #include <sstream>
 
@@ -58,12 +59,17 @@ core::ScanResult scan_bus(const core::ScanRequest& request, const config::BusTyp
     const config::BusPlan plan = type->scan.plan(request);
     // A gateway on this bus would see our requests as another master's (and its devices' answers
     // would confuse both): refuse while one holds the bus, and hold it ourselves while scanning.
-    const BusLock lock(bus_resource(plan));
+    // A bus that holds nothing on this machine has no lock (as daemon/gateway.cpp).
+    std::unique_ptr<BusLock> lock;
+    if (const auto resource = bus_resource(plan); !resource.empty()) lock = std::make_unique<BusLock>(resource);
     return type->scan.run(plan, request);
   }
   std::string scans;
   for (const auto& t : types.types())
     if (t->scan) scans += (scans.empty() ? "" : ", ") + t->name;
+  if (type != nullptr && type->available)
+    throw core::ScanError("cannot scan " + request.bus_type + ": " + request.bus_type + " has no bus scan (scans: " +
+                          scans + ")");
   if (type != nullptr)
     throw core::ScanError("cannot scan " + request.bus_type + ": no adapter in this build (scans: " + scans + ")");
   throw core::ScanError("cannot scan \"" + request.bus_type + "\": not a bus type; scans: " + scans);
@@ -83,7 +89,8 @@ std::string format_scan_table(const core::ScanResult& result) {
   std::ostringstream out;
   const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(result.elapsed).count();
   const auto n = result.devices.size();
-  out << result.bus_type << " " << result.description << ": "
+  out << result.bus_type << " " << result.description
+      << (result.assumed.empty() ? std::string() : ", " + result.assumed) << ": "
       << (n == 0 ? std::string("no devices answered") : std::to_string(n) + (n == 1 ? " device" : " devices"))
       << " (scan took " << ms << " ms)\n";
   if (n > 0) {
@@ -110,6 +117,31 @@ std::string format_scan_table(const core::ScanResult& result) {
 
 namespace {
 
+// A YAML double-quoted scalar: `\` and `"` escaped, control characters as \xNN.
+std::string yaml_quoted(const std::string& s) {
+  std::string q = "\"";
+  for (const char c : s) {
+    if (c == '\\' || c == '"') {
+      q += '\\';
+      q += c;
+    } else if (static_cast<unsigned char>(c) < 0x20) {
+      char b[8];
+      std::snprintf(b, sizeof b, "\\x%02X", static_cast<unsigned>(static_cast<unsigned char>(c)));
+      q += b;
+    } else {
+      q += c;
+    }
+  }
+  return q + "\"";
+}
+
+// Whether every one of the loader's problems is about the bus cycle (another cycle time may pass).
+bool about_the_cycle(const config::ConfigError& e) {
+  return std::all_of(e.problems().begin(), e.problems().end(), [](const auto& p) {
+    return p.path.find("cycle_time") != std::string::npos || p.message.find("cycle_time") != std::string::npos;
+  });
+}
+
 std::string skeleton_text(const core::ScanResult& result, core::Duration cycle_time,
                           const std::vector<std::filesystem::path>& extra_dirs) {
   std::ostringstream y;
@@ -121,7 +153,7 @@ std::string skeleton_text(const core::ScanResult& result, core::Duration cycle_t
     << "  dds: { domain: 0, namespace: drivegate }\n";
   if (!extra_dirs.empty()) {
     y << "  device_dirs:\n";
-    for (const auto& d : extra_dirs) y << "    - " << d.string() << "\n";
+    for (const auto& d : extra_dirs) y << "    - " << yaml_quoted(d.string()) << "\n";
   }
   y << "buses:\n"
     << "  - name: " << result.bus_name << "\n"
@@ -129,7 +161,12 @@ std::string skeleton_text(const core::ScanResult& result, core::Duration cycle_t
     << "    cycle_time: " << config::format_duration(cycle_time)
     << "             # CHECK: the bus cycle (CANopen: the SYNC period)\n"
     << "    options:\n";
-  for (const auto& [key, value] : result.bus_options) y << "      " << key << ": " << value << "\n";
+  for (const auto& [key, value] : result.bus_options) {
+    y << "      " << key << ": " << value;
+    for (const auto& [check_key, check] : result.bus_option_checks)
+      if (check_key == key) y << "    # CHECK: " << check;
+    y << "\n";
+  }
   const auto is_axis = [](const core::FoundDevice& d) { return d.drive && d.conflict.empty(); };
   const bool any = std::any_of(result.devices.begin(), result.devices.end(), is_axis);
   y << "axes:" << (any ? "\n" : " []\n");
@@ -143,7 +180,7 @@ std::string skeleton_text(const core::ScanResult& result, core::Duration cycle_t
       continue;
     }
     if (!d.drive) {
-      y << "  #   not an axis here: add a device profile for it (profiles/devices/README.md) and scan again\n";
+      y << "  #   not an axis here" << (d.next_step.empty() ? "" : ": " + d.next_step) << "\n";
       continue;
     }
     y << "  - name: " << d.profile << "-" << d.address.number << "    # CHECK: the name clients use\n"
@@ -170,6 +207,7 @@ std::string scan_skeleton(const core::ScanResult& result, const config::LoadOpti
   for (const auto& d : options.device_dirs)
     if (std::find(builtin.begin(), builtin.end(), d) == builtin.end()) extra.push_back(std::filesystem::absolute(d));
   std::string first_problems;
+  std::string tried;
   for (const auto cycle : result.cycle_times) {
     std::string text = skeleton_text(result, cycle, extra);
     try {
@@ -177,10 +215,14 @@ std::string scan_skeleton(const core::ScanResult& result, const config::LoadOpti
       return text;
     } catch (const config::ConfigError& e) {
       if (first_problems.empty()) first_problems = e.what();
+      tried += (tried.empty() ? "" : ", ") + config::format_duration(cycle);
+      // Only a problem with the cycle can go away with another cycle time.
+      if (!about_the_cycle(e)) throw core::ScanError("the skeleton does not pass the configuration checks, so it is "
+                                                     "not written:\n" + std::string(e.what()));
     }
   }
-  throw core::ScanError("the configuration skeleton does not pass the checks with any cycle time, so none is "
-                        "written:\n" + first_problems);
+  throw core::ScanError("the skeleton does not pass the configuration checks with any of the cycle times " + tried +
+                        ", so it is not written:\n" + first_problems);
 }
 
 void write_skeleton(const std::filesystem::path& file, const std::string& text, bool force) {

@@ -10,7 +10,9 @@
 
 #include "config/canopen/plan.hpp"
 #include "config/loader.hpp"
+#include "daemon/bus_lock.hpp"
 #include "daemon/scan.hpp"
+#include "core/bus.hpp"
 
 namespace drivegate::daemon {
 namespace {
@@ -40,6 +42,7 @@ core::ScanResult two_devices() {
   io.device_type = 0x000F0191;
   io.device_type_text = "CiA 401 I/O module";
   io.profile_reason = "vendor 0x00000123 matches no profile and no profile fits 1000h = 0x000F0191";
+  io.next_step = "add a device profile for it (profiles/devices/README.md) and scan again";
   r.devices = {akd, io};
   r.elapsed = 412ms;
   return r;
@@ -124,7 +127,71 @@ TEST(ScanSkeleton, TakesTheNextCycleTimeWhenTheFirstIsRefused) {
   const auto plan = config::load_plan_from_string(scan_skeleton(r, load), "skeleton.yaml", load);
   EXPECT_EQ(plan.buses[0].cycle_time, 8ms);
   r.cycle_times = {3ms};
-  EXPECT_THROW((void)scan_skeleton(r, load), core::ScanError);
+  try {
+    (void)scan_skeleton(r, load);
+    FAIL() << "a skeleton with a cycle time the SD6 refuses";
+  } catch (const core::ScanError& e) {
+    EXPECT_NE(std::string(e.what()).find("the skeleton does not pass the configuration checks with any of the cycle "
+                                         "times 3ms"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(ScanSkeleton, AProblemNotAboutTheCycleDoesNotBlameTheCycleTimes) {
+  auto r = two_devices();
+  r.devices[0].profile = "no-such-profile";
+  const config::LoadOptions load;
+  try {
+    (void)scan_skeleton(r, load);
+    FAIL() << "a skeleton naming a profile that does not exist";
+  } catch (const core::ScanError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.find("the skeleton does not pass the configuration checks, so it is not written:\n"), 0U) << what;
+    EXPECT_EQ(what.find("cycle time"), std::string::npos) << what;
+  }
+}
+
+TEST(ScanSkeleton, ABitRateNotGivenIsACheckAndTheTableSaysItWasAssumed) {
+  auto r = two_devices();
+  r.bus_option_checks = {{"bitrate", "the bus' bit rate (not read from the interface; set it to the interface's)"}};
+  r.assumed = "bit rate not given (500 kbit/s assumed for the answer times and the load estimate)";
+  const config::LoadOptions load;
+  const std::string text = scan_skeleton(r, load);
+  EXPECT_NE(text.find("      bitrate: 500000    # CHECK: the bus' bit rate (not read from the interface; set it to "
+                      "the interface's)\n"),
+            std::string::npos)
+      << text;
+  EXPECT_EQ(config::load_plan_from_string(text, "skeleton.yaml", load).buses[0].section<config::CanopenBusOptions>().bitrate,
+            500000U);
+  EXPECT_EQ(format_scan_table(r).find("canopen udp-multicast 239.1.2.3:17000 on 127.0.0.1, bit rate not given (500 "
+                                      "kbit/s assumed for the answer times and the load estimate): 2 devices"),
+            0U)
+      << format_scan_table(r);
+}
+
+TEST(ScanSkeleton, DeviceDirsAreQuotedScalars) {
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("drivegate-scan-dirs-" + std::to_string(::getpid())) / "a: b #c \"q\" back\\slash";
+  std::filesystem::create_directories(dir);
+  config::LoadOptions load;
+  load.device_dirs = {dir};
+  for (const auto& d : config::default_device_dirs()) load.device_dirs.push_back(d);
+  const std::string text = scan_skeleton(two_devices(), load);
+  EXPECT_NE(text.find("    - \"" + dir.parent_path().string() + "/a: b #c \\\"q\\\" back\\\\slash\"\n"),
+            std::string::npos)
+      << text;
+  std::filesystem::remove_all(dir.parent_path());
+}
+
+TEST(ScanSkeleton, WhatToDoAboutADeviceWithoutProfileIsTheScannersWord) {
+  auto r = two_devices();
+  r.devices[1].next_step = "its SDO server did not answer; check the device's node-ID";
+  const std::string text = scan_skeleton(r, config::LoadOptions{});
+  EXPECT_NE(text.find("  #   not an axis here: its SDO server did not answer; check the device's node-ID\n"),
+            std::string::npos)
+      << text;
+  EXPECT_EQ(text.find("add a device profile"), std::string::npos) << text;
 }
 
 TEST(ScanSkeleton, WithoutDevicesIsABusWithoutAxes) {
@@ -169,6 +236,38 @@ TEST(ScanBus, RefusesBusTypesWithoutAScanner) {
   }
   r.bus_type = "canbus";
   EXPECT_THROW((void)scan_bus(r, registry), core::ScanError);
+  // sim has an adapter, only no scanner.
+  r.bus_type = "sim";
+  try {
+    (void)scan_bus(r, registry);
+    FAIL() << "scanned sim";
+  } catch (const core::ScanError& e) {
+    EXPECT_STREQ(e.what(), "cannot scan sim: sim has no bus scan (scans: canopen)");
+  }
+}
+
+TEST(ScanBus, TakesNoLockForABusThatHoldsNothing) {
+  config::BusTypeRegistry registry;
+  config::BusTypeInfo fake;
+  fake.name = "fake";
+  fake.available = true;
+  fake.resource = [](const config::BusPlan&) { return std::string(); };
+  fake.scan.plan = [&registry](const core::ScanRequest&) {
+    config::BusPlan p;
+    p.type_info = registry.find("fake");
+    return p;
+  };
+  fake.scan.run = [](const config::BusPlan&, const core::ScanRequest&) {
+    core::ScanResult result;
+    result.bus_type = "fake";
+    return result;
+  };
+  registry.add(fake);
+  // Another process locking "" (what BusLock would name an empty resource) does not stop the scan.
+  const BusLock held("");
+  core::ScanRequest r;
+  r.bus_type = "fake";
+  EXPECT_EQ(scan_bus(r, registry).bus_type, "fake");
 }
 
 }  // namespace

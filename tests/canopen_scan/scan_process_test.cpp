@@ -87,7 +87,8 @@ TEST(ScanProcess, FindsTheSimulatedDrivesAndWritesAConfigurationCheckConfigAccep
   const Outcome scan = drivegated("--scan " + bus.where() + " --write-config " + file);
   ASSERT_EQ(scan.status, 0) << scan.out;
   EXPECT_TRUE(has_line(scan.out, "^canopen udp-multicast " + bus.group + ":" + std::to_string(bus.port) +
-                                     " on 127.0.0.1: 3 devices \\(scan took [0-9]+ ms\\)$"))
+                                     " on 127.0.0.1, bit rate not given \\(500 kbit/s assumed for the answer times "
+                                     "and the load estimate\\): 3 devices \\(scan took [0-9]+ ms\\)$"))
       << scan.out;
   EXPECT_TRUE(has_line(scan.out, "^1 \\(01h\\) +0x00020192 +CiA 402 drive: servo drive +0x0000006A +0x3630304D .*\"M006\" +- +\"0.20\" +kollmorgen-akd$"))
       << scan.out;
@@ -99,6 +100,12 @@ TEST(ScanProcess, FindsTheSimulatedDrivesAndWritesAConfigurationCheckConfigAccep
   const Outcome check = drivegated("--check-config " + file);
   EXPECT_EQ(check.status, 0) << check.out << "\n" << scan.out;
   EXPECT_NE(check.out.find("axis kollmorgen-akd-1"), std::string::npos) << check.out;
+  std::ifstream text_in(file);
+  std::ostringstream text;
+  text << text_in.rdbuf();
+  // The sim runs at 1 Mbit/s; the scan was not told, so the skeleton's 500000 is marked.
+  EXPECT_TRUE(has_line(text.str(), "^      bitrate: 500000 +# CHECK: the bus' bit rate \\(not read from the interface"))
+      << text.str();
   const YAML::Node written = YAML::LoadFile(file);
   EXPECT_EQ(written["buses"][0]["options"]["group"].as<std::string>(), bus.group);
   EXPECT_EQ(written["buses"][0]["options"]["port"].as<int>(), bus.port);
@@ -177,6 +184,9 @@ TEST(ScanProcess, RefusalsAreOneClearLine) {
   EXPECT_NE(r.out.find("cannot scan ethercat: no adapter in this build"), std::string::npos) << r.out;
   r = drivegated("--scan profinet:eth0");
   EXPECT_NE(r.out.find("cannot scan profinet: no adapter in this build"), std::string::npos) << r.out;
+  r = drivegated("--scan sim:x");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.out.find("cannot scan sim: sim has no bus scan (scans: canopen)"), std::string::npos) << r.out;
   r = drivegated("--scan can0");
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.out.find("expected TYPE:WHERE"), std::string::npos) << r.out;
