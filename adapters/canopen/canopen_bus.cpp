@@ -660,8 +660,17 @@ void CanopenBus::serve_until(core::TimePoint deadline) noexcept {
     pollfd p{fd, POLLIN, 0};
     ++serve_.waits;
     const int ready = ::ppoll(&p, 1, &ts, nullptr);
-    if (ready > 0 && (p.revents & POLLIN) != 0) take_between_cycles(clock_.now());
     // A timeout: the loop polls the SDO client (its timeout) or returns at `stop`. EINTR: again.
+    if (ready <= 0) continue;
+    // Read on any event: a socket's pending error (a CAN interface that went down) is reported,
+    // and cleared, by the read.
+    take_between_cycles(clock_.now());
+    // An error or hang-up would wake every ppoll() again at once until the deadline: the cycle's
+    // receive() meets the transport's state instead.
+    if ((p.revents & (POLLERR | POLLHUP | POLLNVAL)) != 0) {
+      ++serve_.fd_errors;
+      return;
+    }
   }
 }
 

@@ -123,6 +123,7 @@ class CanopenBus final : public core::Bus {
     std::uint64_t sdo_frames = 0;    // SDO responses handled between cycles
     std::uint64_t held_frames = 0;   // other frames held for the next receive()
     std::uint64_t held_full = 0;     // returned early because the held frames filled up
+    std::uint64_t fd_errors = 0;     // returned early: the fd reported an error or hang-up
   };
   [[nodiscard]] const ServeCounters& serve_counters() const noexcept { return serve_; }
 

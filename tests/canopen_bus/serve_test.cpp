@@ -3,12 +3,14 @@
 // bus (sim/threaded_wire.hpp), on the monotonic clock.
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
 #include <sys/eventfd.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <chrono>
 #include <memory>
+#include <optional>
 #include <thread>
 #include <vector>
 
@@ -237,11 +239,12 @@ TEST(ServeBetweenCycles, ServingAllocatesNothing) {
 }
 
 // A transport the test scripts: it delivers what the test puts in `inbox`, records every frame
-// sent with the bus' time, and its wait_fd() is an eventfd the test controls.
+// sent with the bus' time, and its wait_fd() is the descriptor the test gives it.
 struct Script {
+  explicit Script(int wait_fd) : fd(wait_fd) {}
   std::vector<CanFrame> inbox;
   std::vector<std::pair<core::TimePoint, CanFrame>> sent;
-  FdGuard fd{::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC)};
+  FdGuard fd;
 };
 
 class ScriptedTransport final : public Transport {
@@ -284,34 +287,53 @@ axes:
 
 bool is_sdo_request(const CanFrame& f) { return !f.extended && f.id >= 0x601 && f.id <= 0x604; }
 
+// The bus of kFourSilentDrives on a ScriptedTransport waiting on `wait_fd`, booted until the
+// boot's first SDO request went out on every channel in one cycle.
+struct SilentDrives {
+  explicit SilentDrives(int wait_fd)
+      : plan(config::load_plan_from_string(kFourSilentDrives, "serve-test.yaml")),
+        script(std::make_shared<Script>(wait_fd)),
+        bus(plan.buses.at(0), std::make_unique<ScriptedTransport>(script)) {}
+  ~SilentDrives() { bus.close(); }
+  // Returns the time the bus sent the four requests with, or nullopt.
+  std::optional<core::TimePoint> boot() {
+    bus.open(clock.now());
+    for (std::uint32_t node = 1; node <= 4; ++node) script->inbox.push_back(make_frame(0x700 + node, {0x00}));
+    for (int i = 0; i < 10; ++i) {
+      const auto now = clock.now();
+      bus.receive(now);
+      bus.transmit(now);
+      if (std::count_if(script->sent.begin(), script->sent.end(),
+                        [](const auto& s) { return is_sdo_request(s.second); }) == 4) {
+        const core::TimePoint at = script->sent.back().first;
+        script->sent.clear();
+        return at;
+      }
+    }
+    return std::nullopt;
+  }
+
+  config::Plan plan;
+  std::shared_ptr<Script> script;
+  CanopenBus bus;
+  const core::SteadyClock clock;
+};
+
 // Several SDO channels whose retries fall due together shortly before the next cycle: between
 // cycles only the frames that are off the wire (sent back to back) kServeGuard plus two frame
 // times before the deadline go out; the others wait for the cycle and are not lost.
 TEST(ServeBetweenCycles, ParallelTransfersNearTheDeadlineKeepTheQuietWindow) {
-  const config::Plan plan = config::load_plan_from_string(kFourSilentDrives, "serve-test.yaml");
-  const auto& bp = plan.buses.at(0);
-  auto script = std::make_shared<Script>();
-  ASSERT_GE(script->fd.get(), 0);
-  CanopenBus bus(bp, std::make_unique<ScriptedTransport>(script));
-  const core::SteadyClock clock;
-  bus.open(clock.now());
-  for (std::uint32_t node = 1; node <= 4; ++node) script->inbox.push_back(make_frame(0x700 + node, {0x00}));
-  // The boot-ups arrive; the boot's first SDO request goes out on every channel in one cycle.
-  std::size_t requests = 0;
-  for (int i = 0; i < 10 && requests < 4; ++i) {
-    const auto now = clock.now();
-    bus.receive(now);
-    bus.transmit(now);
-    requests = static_cast<std::size_t>(std::count_if(script->sent.begin(), script->sent.end(),
-                                                      [](const auto& s) { return is_sdo_request(s.second); }));
-  }
-  ASSERT_EQ(requests, 4U);
-  const core::TimePoint requested = script->sent.back().first;
-  script->sent.clear();
+  SilentDrives d(::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC));
+  ASSERT_GE(d.script->fd.get(), 0);
+  const auto requested = d.boot();
+  ASSERT_TRUE(requested);
+  auto& bus = d.bus;
+  const auto& script = d.script;
+  const auto& clock = d.clock;
 
   // The four retries fall due 1 ms later; the next cycle starts 5 ms later: room for two frames.
   const core::Duration frame = frame_time(8, 125000);
-  const core::TimePoint deadline = requested + 1ms + 5ms;
+  const core::TimePoint deadline = *requested + 1ms + 5ms;
   bus.serve_until(deadline);
   ASSERT_LT(clock.now(), deadline);
   ASSERT_FALSE(script->sent.empty()) << "no retry went out between cycles";
@@ -336,7 +358,21 @@ TEST(ServeBetweenCycles, ParallelTransfersNearTheDeadlineKeepTheQuietWindow) {
   }
   EXPECT_GE(bus.sdo().counters().retries, 4U);
   EXPECT_EQ(bus.sdo().counters().timeouts, 0U);
-  bus.close();
+}
+
+// A descriptor that reports a hang-up or error without data (a CAN interface going down sets the
+// socket's error) ends serving at once instead of waking again and again until the deadline.
+TEST(ServeBetweenCycles, HungUpDescriptorDoesNotBusyLoop) {
+  int fds[2];
+  ASSERT_EQ(::pipe2(fds, O_CLOEXEC), 0);
+  ::close(fds[1]);  // the read end now reports POLLHUP and never data
+  SilentDrives d(fds[0]);
+  ASSERT_TRUE(d.boot());
+  const auto start = d.clock.now();
+  d.bus.serve_until(start + 20ms);  // the SDO transfers stay in flight: there is work to wait for
+  EXPECT_LT(d.clock.now() - start, 5ms);
+  EXPECT_EQ(d.bus.serve_counters().waits, 1U);
+  EXPECT_EQ(d.bus.serve_counters().fd_errors, 1U);
 }
 
 }  // namespace
