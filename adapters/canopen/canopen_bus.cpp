@@ -92,7 +92,7 @@ CanopenBus::CanopenBus(const config::BusPlan& plan, std::unique_ptr<Transport> t
         return e;
       }()),
       sync_(cob::kSync, plan.cycle_time),
-      serve_quiet_(kServeGuard + 2 * frame_time(8, plan.section<config::CanopenBusOptions>().bitrate)) {
+      frame_time_(frame_time(8, plan.section<config::CanopenBusOptions>().bitrate)) {
   for (std::size_t i = 0; i < plan.axes.size(); ++i) {
     const auto& a = plan.axes[i];
     auto steps = build_boot_steps(a, plan);
@@ -626,14 +626,23 @@ void CanopenBus::transmit(core::TimePoint now) noexcept {
 void CanopenBus::serve_until(core::TimePoint deadline) noexcept {
   const int fd = transport_->wait_fd();
   if (!open_ || fd < 0 || controller_ == ControllerState::BusOff) return;
-  const core::TimePoint stop = deadline - serve_quiet_;
+  // The controller sends our frames in order (a FIFO), so the SYNC queued at the next cycle start
+  // waits behind every frame sent here; other nodes' frames lose arbitration to it. What is sent
+  // here must be off the wire kServeGuard plus two frame times (one frame that may be on the wire,
+  // one spare) before the deadline: each pass sends only the frames that fit after the ones it
+  // sent before (estimated back to back, at 8 data bytes each).
+  const core::TimePoint stop = deadline - kServeGuard - 2 * frame_time_;
+  core::TimePoint wire_free = clock_.now();  // when the frames sent here have left, estimated
   for (;;) {
     const core::TimePoint now = clock_.now();
     if (now >= stop) return;
+    const core::TimePoint from = std::max(now, wire_free);
+    const auto fit = from < stop ? static_cast<std::size_t>((stop - from) / frame_time_) : 0;
     // The next segment request, a retry or a queued request goes out now, not at the next cycle
-    // (with any frame of the last cycle the transport had no room for: it was due already).
-    sdo_.poll(now, tx_);
-    flush(now);
+    // (after any frame of the last cycle the transport had no room for: it was due already).
+    const std::size_t queued = tx_.size();
+    sdo_.poll(now, tx_, fit > queued ? fit - queued : 0);
+    wire_free = from + static_cast<std::int64_t>(flush(now)) * frame_time_;
     const core::TimePoint due = sdo_.next_deadline();
     // No SDO work in flight: sleep through the rest of the period (no wake-up per frame).
     if (due == core::TimePoint::max()) return;
@@ -642,7 +651,8 @@ void CanopenBus::serve_until(core::TimePoint deadline) noexcept {
       return;
     }
     const core::TimePoint until = std::min(stop, due);
-    if (until <= now) return;  // poll() has just handled what was due: nothing left to wait for
+    // poll() has just handled what was due, or what is due does not fit before the deadline.
+    if (until <= now) return;
     const auto wait = until - now;
     timespec ts{};
     ts.tv_sec = static_cast<time_t>(std::chrono::duration_cast<std::chrono::seconds>(wait).count());
@@ -650,8 +660,17 @@ void CanopenBus::serve_until(core::TimePoint deadline) noexcept {
     pollfd p{fd, POLLIN, 0};
     ++serve_.waits;
     const int ready = ::ppoll(&p, 1, &ts, nullptr);
-    if (ready > 0 && (p.revents & POLLIN) != 0) take_between_cycles(clock_.now());
     // A timeout: the loop polls the SDO client (its timeout) or returns at `stop`. EINTR: again.
+    if (ready <= 0) continue;
+    // Read on any event: a socket's pending error (a CAN interface that went down) is reported,
+    // and cleared, by the read.
+    take_between_cycles(clock_.now());
+    // An error or hang-up would wake every ppoll() again at once until the deadline: the cycle's
+    // receive() meets the transport's state instead.
+    if ((p.revents & (POLLERR | POLLHUP | POLLNVAL)) != 0) {
+      ++serve_.fd_errors;
+      return;
+    }
   }
 }
 
@@ -672,15 +691,18 @@ void CanopenBus::take_between_cycles(core::TimePoint now) noexcept {
   }
 }
 
-void CanopenBus::flush(core::TimePoint now) noexcept {
+std::size_t CanopenBus::flush(core::TimePoint now) noexcept {
   // One batch per contiguous run of the queue (two when it wraps around).
+  std::size_t sent = 0;
   while (!tx_.empty()) {
     const SendBatchResult r = transport_->send_batch(tx_.front_run(), now);
     sent_.fetch_add(r.sent, std::memory_order_relaxed);
+    sent += r.sent;
     tx_dropped_ += r.taken - r.sent;
     tx_.pop(r.taken);
     if (r.busy || r.taken == 0) break;  // the rest goes next cycle; timeouts cover what is late
   }
+  return sent;
 }
 
 void CanopenBus::publish_counters() noexcept {

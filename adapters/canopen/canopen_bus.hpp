@@ -109,10 +109,10 @@ class CanopenBus final : public core::Bus {
   // EMCY events per node: this many at once, then one per kEmcyRefill.
   static constexpr std::uint32_t kEmcyBurst = 8;
   static constexpr core::Duration kEmcyRefill = std::chrono::seconds(1);
-  // serve_until() ends this long plus one SDO exchange on the wire (request and response, two
-  // 8-byte frames at the bus' bit rate) before the next cycle: a frame handled at the last moment
-  // cannot delay the cycle's start, and an exchange it starts is off the wire when the SYNC is due
-  // (CAN does not preempt a frame on the wire).
+  // serve_until() ends this long plus two 8-byte frame times before the next cycle, and sends only
+  // as many frames as are off the wire by then: a frame handled at the last moment cannot delay
+  // the cycle's start, and the SYNC is not queued behind our own frames (CAN does not preempt a
+  // frame on the wire; the controller sends our frames in order).
   static constexpr core::Duration kServeGuard = std::chrono::microseconds(100);
   // Frames serve_until() holds for the next receive(); when full, it stops reading.
   static constexpr std::size_t kHeldFrames = 256;
@@ -123,6 +123,7 @@ class CanopenBus final : public core::Bus {
     std::uint64_t sdo_frames = 0;    // SDO responses handled between cycles
     std::uint64_t held_frames = 0;   // other frames held for the next receive()
     std::uint64_t held_full = 0;     // returned early because the held frames filled up
+    std::uint64_t fd_errors = 0;     // returned early: the fd reported an error or hang-up
   };
   [[nodiscard]] const ServeCounters& serve_counters() const noexcept { return serve_; }
 
@@ -186,7 +187,8 @@ class CanopenBus final : public core::Bus {
   void start_safe_stop(Node& n, core::TimePoint now) noexcept;
   void run_safe_stop(Node& n, core::TimePoint now) noexcept;
   Node* node_by_id(NodeId id) noexcept { return id <= kMaxNodeId ? by_id_[id] : nullptr; }
-  void flush(core::TimePoint now) noexcept;
+  // Sends what tx_ holds, as far as the transport takes it; returns the frames sent.
+  std::size_t flush(core::TimePoint now) noexcept;
   void take_between_cycles(core::TimePoint now) noexcept;
   void release_watchdogs() noexcept;
   void publish_counters() noexcept;
@@ -219,7 +221,7 @@ class CanopenBus final : public core::Bus {
   std::size_t held_count_ = 0;
   ServeCounters serve_;
   const core::SteadyClock clock_;  // serve_until()'s time line: the cycle thread's monotonic clock
-  const core::Duration serve_quiet_;  // kServeGuard + one SDO exchange at the bit rate
+  const core::Duration frame_time_;  // an 8-byte frame at the bus' bit rate
   bool open_ = false;
   core::TimePoint last_now_{};  // the last cycle's time
   ControllerState controller_ = ControllerState::Active;

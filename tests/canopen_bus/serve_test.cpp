@@ -3,14 +3,21 @@
 // bus (sim/threaded_wire.hpp), on the monotonic clock.
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
+#include <sys/eventfd.h>
+#include <unistd.h>
+
 #include <atomic>
 #include <chrono>
 #include <memory>
+#include <optional>
 #include <thread>
 #include <vector>
 
 #include "adapters/canopen/canopen_bus.hpp"
 #include "adapters/canopen/sim/threaded_wire.hpp"
+#include "adapters/canopen/transport/fd_guard.hpp"
+#include "adapters/canopen/wire/bit_timing.hpp"
 #include "config/loader.hpp"
 #include "core/bus_runner.hpp"
 #include "daemon/cycle_thread.hpp"
@@ -229,6 +236,143 @@ TEST(ServeBetweenCycles, ServingAllocatesNothing) {
   EXPECT_EQ(allocations, 0U);
   bus.close();
   wire.stop();
+}
+
+// A transport the test scripts: it delivers what the test puts in `inbox`, records every frame
+// sent with the bus' time, and its wait_fd() is the descriptor the test gives it.
+struct Script {
+  explicit Script(int wait_fd) : fd(wait_fd) {}
+  std::vector<CanFrame> inbox;
+  std::vector<std::pair<core::TimePoint, CanFrame>> sent;
+  FdGuard fd;
+};
+
+class ScriptedTransport final : public Transport {
+ public:
+  explicit ScriptedTransport(std::shared_ptr<Script> script) : script_(std::move(script)) {}
+  void open() override { open_ = true; }
+  void close() noexcept override { open_ = false; }
+  [[nodiscard]] bool is_open() const noexcept override { return open_; }
+  std::size_t receive(std::span<CanFrame> out, core::TimePoint) noexcept override {
+    const std::size_t n = std::min(out.size(), script_->inbox.size());
+    std::copy_n(script_->inbox.begin(), n, out.begin());
+    script_->inbox.erase(script_->inbox.begin(), script_->inbox.begin() + static_cast<std::ptrdiff_t>(n));
+    return n;
+  }
+  SendResult send(const CanFrame& frame, core::TimePoint now) noexcept override {
+    script_->sent.emplace_back(now, frame);
+    return SendResult::Sent;
+  }
+  [[nodiscard]] ControllerState controller_state() const noexcept override { return ControllerState::Active; }
+  [[nodiscard]] TransportCounters counters() const noexcept override { return {}; }
+  [[nodiscard]] std::string describe() const override { return "scripted"; }
+  [[nodiscard]] int wait_fd() const noexcept override { return script_->fd.get(); }
+
+ private:
+  std::shared_ptr<Script> script_;
+  bool open_ = false;
+};
+
+// Four drives that boot at once and never answer SDO, at 125 kbit/s (an 8-byte frame: 1.08 ms).
+const char* kFourSilentDrives = R"(gateway: { name: serve-test }
+buses:
+  - { name: can0, type: canopen, cycle_time: 20ms,
+      options: { transport: sim, bitrate: 125000, sdo_timeout: 1ms, sdo_retries: 2 } }
+axes:
+  - { name: a1, bus: can0, address: 1, device: generic-cia402, mechanics: { encoder_counts_per_rev: 10000 } }
+  - { name: a2, bus: can0, address: 2, device: generic-cia402, mechanics: { encoder_counts_per_rev: 10000 } }
+  - { name: a3, bus: can0, address: 3, device: generic-cia402, mechanics: { encoder_counts_per_rev: 10000 } }
+  - { name: a4, bus: can0, address: 4, device: generic-cia402, mechanics: { encoder_counts_per_rev: 10000 } }
+)";
+
+bool is_sdo_request(const CanFrame& f) { return !f.extended && f.id >= 0x601 && f.id <= 0x604; }
+
+// The bus of kFourSilentDrives on a ScriptedTransport waiting on `wait_fd`, booted until the
+// boot's first SDO request went out on every channel in one cycle.
+struct SilentDrives {
+  explicit SilentDrives(int wait_fd)
+      : plan(config::load_plan_from_string(kFourSilentDrives, "serve-test.yaml")),
+        script(std::make_shared<Script>(wait_fd)),
+        bus(plan.buses.at(0), std::make_unique<ScriptedTransport>(script)) {}
+  ~SilentDrives() { bus.close(); }
+  // Returns the time the bus sent the four requests with, or nullopt.
+  std::optional<core::TimePoint> boot() {
+    bus.open(clock.now());
+    for (std::uint32_t node = 1; node <= 4; ++node) script->inbox.push_back(make_frame(0x700 + node, {0x00}));
+    for (int i = 0; i < 10; ++i) {
+      const auto now = clock.now();
+      bus.receive(now);
+      bus.transmit(now);
+      if (std::count_if(script->sent.begin(), script->sent.end(),
+                        [](const auto& s) { return is_sdo_request(s.second); }) == 4) {
+        const core::TimePoint at = script->sent.back().first;
+        script->sent.clear();
+        return at;
+      }
+    }
+    return std::nullopt;
+  }
+
+  config::Plan plan;
+  std::shared_ptr<Script> script;
+  CanopenBus bus;
+  const core::SteadyClock clock;
+};
+
+// Several SDO channels whose retries fall due together shortly before the next cycle: between
+// cycles only the frames that are off the wire (sent back to back) kServeGuard plus two frame
+// times before the deadline go out; the others wait for the cycle and are not lost.
+TEST(ServeBetweenCycles, ParallelTransfersNearTheDeadlineKeepTheQuietWindow) {
+  SilentDrives d(::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC));
+  ASSERT_GE(d.script->fd.get(), 0);
+  const auto requested = d.boot();
+  ASSERT_TRUE(requested);
+  auto& bus = d.bus;
+  const auto& script = d.script;
+  const auto& clock = d.clock;
+
+  // The four retries fall due 1 ms later; the next cycle starts 5 ms later: room for two frames.
+  const core::Duration frame = frame_time(8, 125000);
+  const core::TimePoint deadline = *requested + 1ms + 5ms;
+  bus.serve_until(deadline);
+  ASSERT_LT(clock.now(), deadline);
+  ASSERT_FALSE(script->sent.empty()) << "no retry went out between cycles";
+  core::TimePoint wire_free{};
+  for (const auto& [at, f] : script->sent) {
+    EXPECT_TRUE(is_sdo_request(f)) << std::hex << f.id;
+    wire_free = std::max(wire_free, at) + frame;
+  }
+  EXPECT_LE(wire_free, deadline - CanopenBus::kServeGuard - 2 * frame)
+      << script->sent.size() << " frames sent between cycles end on the wire "
+      << std::chrono::duration_cast<std::chrono::microseconds>(wire_free - deadline).count()
+      << " us after the deadline";
+
+  // The cycle sends the retries that did not fit: every channel retried.
+  const auto now = clock.now();
+  bus.receive(now);
+  bus.transmit(now);
+  for (std::uint32_t node = 1; node <= 4; ++node) {
+    EXPECT_TRUE(std::any_of(script->sent.begin(), script->sent.end(),
+                            [node](const auto& s) { return s.second.id == 0x600 + node; }))
+        << "node " << node << " was never retried";
+  }
+  EXPECT_GE(bus.sdo().counters().retries, 4U);
+  EXPECT_EQ(bus.sdo().counters().timeouts, 0U);
+}
+
+// A descriptor that reports a hang-up or error without data (a CAN interface going down sets the
+// socket's error) ends serving at once instead of waking again and again until the deadline.
+TEST(ServeBetweenCycles, HungUpDescriptorDoesNotBusyLoop) {
+  int fds[2];
+  ASSERT_EQ(::pipe2(fds, O_CLOEXEC), 0);
+  ::close(fds[1]);  // the read end now reports POLLHUP and never data
+  SilentDrives d(fds[0]);
+  ASSERT_TRUE(d.boot());
+  const auto start = d.clock.now();
+  d.bus.serve_until(start + 20ms);  // the SDO transfers stay in flight: there is work to wait for
+  EXPECT_LT(d.clock.now() - start, 5ms);
+  EXPECT_EQ(d.bus.serve_counters().waits, 1U);
+  EXPECT_EQ(d.bus.serve_counters().fd_errors, 1U);
 }
 
 }  // namespace

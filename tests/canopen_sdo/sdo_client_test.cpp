@@ -556,6 +556,34 @@ TEST(SdoClientChannels, SeveralChannelsInterleave) {
   EXPECT_EQ(c.counters().completed, 2U);
 }
 
+// poll() with a frame limit sends that many frames; the rest stays due, in each channel's order
+// (the timeout's abort before the next request's initiate), and nothing is lost.
+TEST(SdoClientChannels, FrameLimitDefersTheRestInOrder) {
+  const std::vector<SdoChannelConfig> cfg = {{5, 1, 0, 0}, {7, 1, 0, 0}};
+  SdoClient c(cfg, SdoTiming{100ms, 0});
+  TxQueue tx;
+  const Sent read5{0x605, {0x40, 0x00, 0x10, 0x00, 0, 0, 0, 0}};
+  const Sent read7{0x607, {0x40, 0x00, 0x10, 0x00, 0, 0, 0, 0}};
+  c.read(0, {0x1000, 0});
+  c.read(1, {0x1000, 0});
+  c.poll(kT0, tx, 1);
+  EXPECT_EQ(drain(tx), Frames{read5});
+  EXPECT_EQ(c.next_deadline(), core::TimePoint::min());  // node 7's request is still due
+  c.poll(kT0, tx, 0);
+  EXPECT_TRUE(drain(tx).empty());
+  EXPECT_EQ(poll(c, kT0 + 1ms, tx), Frames{read7});
+
+  // Node 5 times out with a second request queued: its abort, then that request's initiate.
+  c.read(0, {0x1018, 1});
+  c.poll(kT0 + 100ms, tx, 1);
+  EXPECT_EQ(drain(tx), (Frames{{0x605, {0x80, 0x00, 0x10, 0x00, 0x00, 0x00, 0x04, 0x05}}}));
+  EXPECT_EQ(c.next_deadline(), core::TimePoint::min());
+  c.poll(kT0 + 100ms, tx, 1);
+  EXPECT_EQ(drain(tx), (Frames{{0x605, {0x40, 0x18, 0x10, 0x01, 0, 0, 0, 0}}}));
+  EXPECT_EQ(c.next_deadline(), kT0 + 101ms);  // node 7's timeout: nothing else is due
+  EXPECT_EQ(c.counters().timeouts, 1U);
+}
+
 // Bad input of every kind is counted and dropped and leaves the transfer in flight as it was.
 TEST(SdoClientBadInput, CountedAndDroppedWithoutTouchingTheTransfer) {
   SdoClient c = client_for(5);

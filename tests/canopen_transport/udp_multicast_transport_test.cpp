@@ -592,5 +592,39 @@ TEST(UdpMulticast, LiveInteropWithPythonCan) {
   EXPECT_EQ(us.counters().rx_filtered, 2U);  // our two frames came back to us
 }
 
+TEST(UdpMulticast, WithInterfaceAnyOwnEchoesAreDroppedWhileAPeerReceivesThem) {
+  if (::geteuid() != 0) GTEST_SKIP() << "needs root to create a network namespace (ip netns add)";
+  // With interface 0.0.0.0 (the configuration default) the send socket is bound to 0.0.0.0 and
+  // the kernel sends from an address of the interface the group's route leads to. In a namespace
+  // of our own that is loopback, given a global address (127.0.0.1 is host scope, never chosen
+  // as a multicast source) as a NIC has one. Nothing leaves this host.
+  Netns ns("dg-any-" + std::to_string(::getpid()));
+  if (!ns.ok() || run({"ip", "-n", ns.name(), "addr", "add", "198.51.100.7/32", "dev", "lo"}) != 0) {
+    GTEST_SKIP() << "ip netns failed: cannot set up " << ns.name();
+  }
+  auto o = options(test_port(9));
+  o.interface_address = "0.0.0.0";
+  UdpMulticastTransport us(o);
+  UdpMulticastTransport peer(o);
+  {
+    InNetns inside(ns.name());
+    ASSERT_TRUE(inside.entered()) << "setns into " << ns.name();
+    us.open();
+    peer.open();
+  }
+  ASSERT_EQ(us.send(make_frame(0x80, {}), now()), SendResult::Sent);  // a SYNC
+  ASSERT_EQ(us.send(make_frame(0x000, {0x01, 0x00}), now()), SendResult::Sent);
+
+  const auto at_peer = receive_n(peer, 2);
+  ASSERT_EQ(at_peer.size(), 2U);
+  EXPECT_EQ(at_peer[0].id, 0x80U);
+  EXPECT_EQ(at_peer[1].id, 0x000U);
+  const auto echoes = receive_until(us, [&us](const auto&) { return us.counters().rx_filtered >= 2; });
+  EXPECT_TRUE(echoes.empty()) << "own frame decoded as a peer's, id " << std::hex << echoes.front().id;
+  EXPECT_EQ(us.counters().rx_filtered, 2U);
+  EXPECT_EQ(us.counters().rx_frames, 0U);
+  EXPECT_EQ(peer.counters().rx_filtered, 0U);
+}
+
 }  // namespace
 }  // namespace drivegate::canopen

@@ -427,33 +427,44 @@ SdoBytes SdoClient::initiate_frame(const Slot& slot) noexcept {
   return sdo_download_initiate(slot.object, slot.size);
 }
 
-void SdoClient::poll(core::TimePoint now, TxQueue& tx) noexcept {
+void SdoClient::poll(core::TimePoint now, TxQueue& tx, std::size_t max_frames) noexcept {
+  // Each frame takes one of `max_frames`; once they are used up the rest waits, so that a
+  // channel's frames still leave in order (an abort before its next initiate).
+  std::size_t room = max_frames;
+  const auto take_room = [&room] {
+    if (room == 0) return false;
+    --room;
+    return true;
+  };
   for (auto& ch : channels_) {
     // An abort goes out before the next request's initiate, so the server sees them in order.
     if (ch.abort_due) {
+      if (!take_room()) return;
       send(ch, ch.abort_frame, tx);
       ch.abort_due = false;
     }
-    if (ch.phase != Phase::Idle) {
+    if (ch.phase != Phase::Idle && (ch.frame_due || now >= ch.deadline)) {
+      if (!take_room()) return;
       Slot& slot = ch.slots[ch.active];
       if (ch.frame_due) {
         send(ch, ch.frame, tx);
         ch.frame_due = false;
         ch.deadline = now + timing_.timeout;
-      } else if (now >= ch.deadline) {
-        if (ch.phase == Phase::Initiate && ch.retries_left > 0) {
-          --ch.retries_left;
-          ++counters_.retries;
-          send(ch, initiate_frame(slot), tx);
-          ch.deadline = now + timing_.timeout;
-        } else {
-          ++counters_.timeouts;
-          send(ch, sdo_abort(slot.object, sdo_abort_code::kTimeout), tx);
-          finish(ch, slot, SlotState::Failed, sdo_abort_code::kTimeout);
-        }
+      } else if (ch.phase == Phase::Initiate && ch.retries_left > 0) {
+        --ch.retries_left;
+        ++counters_.retries;
+        send(ch, initiate_frame(slot), tx);
+        ch.deadline = now + timing_.timeout;
+      } else {
+        ++counters_.timeouts;
+        send(ch, sdo_abort(slot.object, sdo_abort_code::kTimeout), tx);
+        finish(ch, slot, SlotState::Failed, sdo_abort_code::kTimeout);
       }
     }
-    if (ch.phase == Phase::Idle && ch.fifo_size > 0) start(ch, now, tx);
+    if (ch.phase == Phase::Idle && ch.fifo_size > 0) {
+      if (!take_room()) return;
+      start(ch, now, tx);
+    }
   }
 }
 

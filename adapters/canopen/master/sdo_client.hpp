@@ -122,7 +122,9 @@ class SdoClient {
   // Engine interface (adapters/canopen/README.md).
   // True when the frame's COB-ID is one of this client's response COB-IDs (consumed).
   bool on_frame(const CanFrame& frame, core::TimePoint now) noexcept;
-  void poll(core::TimePoint now, TxQueue& tx) noexcept;
+  // Queues at most `max_frames` frames; what does not fit stays due (next_deadline() keeps
+  // saying so) and goes out, in order, at a later poll().
+  void poll(core::TimePoint now, TxQueue& tx, std::size_t max_frames = SIZE_MAX) noexcept;
   // TimePoint::min() while a frame waits for poll() (a request submitted, a response that asks for
   // the next segment, an abort), else the earliest timeout, else TimePoint::max().
   [[nodiscard]] core::TimePoint next_deadline() const noexcept;

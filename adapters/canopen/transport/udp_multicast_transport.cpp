@@ -51,8 +51,7 @@ UdpMulticastTransport::UdpMulticastTransport(UdpMulticastOptions options) : opti
     rx_msgs_[i].msg_hdr.msg_iov = &rx_iov_[i];
     rx_msgs_[i].msg_hdr.msg_iovlen = 1;
     tx_iov_[i] = iovec{tx_buffers_[i].data(), 0};
-    tx_msgs_[i].msg_hdr.msg_name = &destination_;
-    tx_msgs_[i].msg_hdr.msg_namelen = sizeof destination_;
+    // No msg_name: the send socket is connected to the group (open()).
     tx_msgs_[i].msg_hdr.msg_iov = &tx_iov_[i];
     tx_msgs_[i].msg_hdr.msg_iovlen = 1;
   }
@@ -101,8 +100,8 @@ void UdpMulticastTransport::open() {
   set_option(rx.get(), IPPROTO_IP, IP_MULTICAST_ALL, int{0}, "IP_MULTICAST_ALL");
 
   FdGuard tx(udp_socket());
-  // Bound to the interface address so that the source of our datagrams, and so our echoes, are
-  // known: the kernel picks the port.
+  // Bound to the interface address (the kernel picks the port); 0.0.0.0 leaves the address to the
+  // route, chosen at connect() below.
   sockaddr_in source{};
   source.sin_family = AF_INET;
   source.sin_addr = interface;
@@ -111,15 +110,21 @@ void UdpMulticastTransport::open() {
   set_option(tx.get(), IPPROTO_IP, IP_MULTICAST_TTL, options_.ttl, "IP_MULTICAST_TTL");
   // Other members on this host (python-can peers, simulated drives) receive through loopback.
   set_option(tx.get(), IPPROTO_IP, IP_MULTICAST_LOOP, int{1}, "IP_MULTICAST_LOOP");
+  // Connected to the group so that the kernel fixes the source address now: with interface
+  // 0.0.0.0 the socket is bound to 0.0.0.0, while our datagrams (and so our echoes) carry the
+  // address of the interface the route picks. getsockname() then reports that real source.
+  sockaddr_in destination{};
+  destination.sin_family = AF_INET;
+  destination.sin_port = htons(options_.port);
+  destination.sin_addr = group;
+  if (::connect(tx.get(), as_sockaddr(destination), sizeof destination) != 0) {
+    fail("cannot send to " + options_.group + " from " + options_.interface_address + " (connect: " +
+         errno_text(errno) + "); give the IPv4 address of the interface to use, or add a route for the group");
+  }
   socklen_t len = sizeof own_source_;
   if (::getsockname(tx.get(), as_sockaddr(own_source_), &len) != 0) {
     fail("cannot read the send socket's address (getsockname: " + errno_text(errno) + ")");
   }
-
-  destination_ = sockaddr_in{};
-  destination_.sin_family = AF_INET;
-  destination_.sin_port = htons(options_.port);
-  destination_.sin_addr = group;
   rx_fd_ = rx.release();
   tx_fd_ = tx.release();
 }

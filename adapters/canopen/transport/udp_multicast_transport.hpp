@@ -63,8 +63,8 @@ class UdpMulticastTransport final : public Transport {
   UdpMulticastOptions options_;
   int rx_fd_ = -1;
   int tx_fd_ = -1;
-  sockaddr_in destination_{};  // group:port
-  sockaddr_in own_source_{};   // the send socket's address, to recognise our echoes
+  // The send socket's address as our datagrams carry it (never 0.0.0.0), to recognise our echoes.
+  sockaddr_in own_source_{};
   CounterCells counters_;
   // python-can reads up to 4096 bytes per datagram; a longer one is malformed for us too.
   static constexpr std::size_t kRxDatagramMax = 4096;
