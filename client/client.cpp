@@ -58,6 +58,35 @@ std::string join(const std::vector<std::string>& v) {
   return s;
 }
 
+// Lets one thread at a time take from a reader and store what it took, so an older sample never
+// overwrites a newer one and events keep their order. Without blocking: Fast DDS may call
+// on_data_available() with the reader's own lock held, and waiting there for a thread that is inside
+// take() (waiting for that lock) would deadlock. A thread that finds another taking leaves a note,
+// and the taking thread takes again before it leaves.
+class SerialTake {
+ public:
+  template <typename Take>
+  void run(Take&& take) {
+    pending_.store(true);
+    while (pending_.load()) {
+      std::unique_lock lock(mutex_, std::try_to_lock);
+      if (!lock.owns_lock()) return;  // the thread that holds it sees pending_ after it unlocked
+      pending_.store(false);
+      take();
+    }
+  }
+
+ private:
+  std::mutex mutex_;
+  std::atomic<bool> pending_{false};
+};
+
+// A reader of a state-like topic, made on first use.
+struct LazyReader {
+  std::atomic<dds::DataReader*> reader{nullptr};
+  SerialTake take;
+};
+
 struct ReplyRecord {
   std::string gateway;
   std::string status;
@@ -141,15 +170,17 @@ class Client::Impl : public dds::DataReaderListener {
     return parameter_refusal_;
   }
 
+  // Called by DDS listener threads, and by the thread that attached the listener for what arrived
+  // before (constructor, subscribe()): the readers taken on both take through a SerialTake.
   void on_data_available(dds::DataReader* reader) override {
     if (reader == nullptr) return;
-    if (reader == info_r_) take_infos();
-    else if (reader == state_r_.load()) take_states(*reader);
+    if (reader == info_r_) info_take_.run([&] { take_infos(); });
     else if (reader == reply_r_) take_replies();
-    else if (reader == event_r_.load()) take_events(*reader);
-    else if (reader == bus_r_.load()) take_buses(*reader);
-    else if (reader == link_r_.load()) take_links(*reader);
     else if (reader == param_r_) take_param_replies();
+    else if (reader == state_r_.reader.load()) state_r_.take.run([&] { take_states(*reader); });
+    else if (reader == event_r_.reader.load()) event_r_.take.run([&] { take_events(*reader); });
+    else if (reader == bus_r_.reader.load()) bus_r_.take.run([&] { take_buses(*reader); });
+    else if (reader == link_r_.reader.load()) link_r_.take.run([&] { take_links(*reader); });
     {
       std::lock_guard lock(mutex_);
       ++generation_;
@@ -460,14 +491,14 @@ class Client::Impl : public dds::DataReaderListener {
   // the DDS identity may not have (permissions made before axis_link existed, say) stay absent:
   // their data is then empty. The mutex makes concurrent first calls wait for the same reader; the
   // reader is published (slot) before the listener is attached, as in the constructor.
-  void subscribe(std::atomic<dds::DataReader*>& slot, msg::TopicId topic, const std::function<bool()>& arrived) {
+  void subscribe(LazyReader& slot, msg::TopicId topic, const std::function<bool()>& arrived) {
     if (subscribed_.load(std::memory_order_acquire) & bit(topic)) return;
     std::lock_guard lock(subscribe_mutex_);
     if (subscribed_.load(std::memory_order_relaxed) & bit(topic)) return;
     std::string refusal;
     dds::DataReader* r = optional_reader(topic, refusal);
     if (r != nullptr) {
-      slot.store(r);
+      slot.reader.store(r);
       r->set_listener(this, dds::StatusMask::data_available());
       on_data_available(r);
       wait_until(
@@ -692,11 +723,12 @@ class Client::Impl : public dds::DataReaderListener {
   dds::DataReader* info_r_ = nullptr;
   dds::DataReader* reply_r_ = nullptr;
   dds::DataReader* param_r_ = nullptr;
+  SerialTake info_take_;
   // Made on first use (subscribe()); read by the listener thread.
-  std::atomic<dds::DataReader*> state_r_{nullptr};
-  std::atomic<dds::DataReader*> event_r_{nullptr};
-  std::atomic<dds::DataReader*> bus_r_{nullptr};
-  std::atomic<dds::DataReader*> link_r_{nullptr};
+  LazyReader state_r_;
+  LazyReader event_r_;
+  LazyReader bus_r_;
+  LazyReader link_r_;
   std::mutex subscribe_mutex_;
   std::atomic<unsigned> subscribed_{0};  // bit(topic): subscribe() done for that topic
 
