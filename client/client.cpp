@@ -487,7 +487,9 @@ class Client::Impl : public dds::DataReaderListener {
 
   // Makes the reader of a state-like topic on the first call (the later ones return at once) and
   // waits, up to kFirstData, until it matched every known gateway and `arrived` says the gateways'
-  // present data is in, so that the first read after subscribing is not silently empty. Readers
+  // present data is in, so that the first read after subscribing is not silently empty. When no
+  // gateway is known yet (a read right after construction), it first waits, within the same budget,
+  // for discovery: a gateway, then none new for kDiscoveryQuiet (as wait_route()). Readers
   // the DDS identity may not have (permissions made before axis_link existed, say) stay absent:
   // their data is then empty. The mutex makes concurrent first calls wait for the same reader; the
   // reader is published (slot) before the listener is attached, as in the constructor.
@@ -501,11 +503,18 @@ class Client::Impl : public dds::DataReaderListener {
       slot.reader.store(r);
       r->set_listener(this, dds::StatusMask::data_available());
       on_data_available(r);
+      bool discovering = false;
+      {
+        std::lock_guard data_lock(mutex_);
+        discovering = gateways_.empty();
+      }
       wait_until(
           [&] {
             dds::SubscriptionMatchedStatus m{};
             r->get_subscription_matched_status(m);
             std::lock_guard data_lock(mutex_);
+            if (discovering && (gateways_.empty() || SteadyClock::now() - last_info_change_ < kDiscoveryQuiet))
+              return false;
             return m.current_count >= static_cast<std::int32_t>(gateways_.size()) && arrived();
           },
           kFirstData);

@@ -221,7 +221,8 @@ class Client {
   // construction on. The states, bus statuses, links and events are subscribed to on the first call
   // that reads them (a client that only commands receives none of them); that first call waits
   // (up to 1.5 s) until the gateways discovered so far have delivered what they have: a state and
-  // a link per axis, a status per bus, the event history.
+  // a link per axis, a status per bus, the event history. When no gateway is discovered yet (a read
+  // right after construction) it first waits, within the same 1.5 s, for the gateways to appear.
   [[nodiscard]] std::vector<GatewayInfo> gateways() const;
   [[nodiscard]] std::vector<AxisState> states() const;
   [[nodiscard]] std::optional<AxisState> state(std::string_view axis, std::string_view gateway = {}) const;

@@ -235,6 +235,18 @@ TEST(DdsBridge, CommandOnlyClientSubscribesToStatesOnFirstRead) {
   EXPECT_EQ(c.buses()[0].bus, "can0");
 }
 
+// The first read right after construction, before any gateway was discovered, waits for discovery
+// and the gateway's data: not an empty answer that later reads would never correct by waiting.
+TEST(DdsBridge, FirstReadRightAfterConstructionWaitsForTheGateway) {
+  FakeRuntime rt("gw1", {"x", "y"});
+  daemon::DdsBridge bridge(rt, bridge_options());
+  bridge.start();
+  Client c(client_options());
+  EXPECT_EQ(c.states().size(), 2U);
+  Client other(client_options());
+  EXPECT_EQ(other.links().size(), 2U);
+}
+
 TEST(DdsBridge, UnknownAxisIsRejectedWithTheAxesWeHave) {
   FakeRuntime rt("gw1", {"x", "y"});
   daemon::DdsBridge bridge(rt, bridge_options());
