@@ -39,6 +39,9 @@ constexpr Millis kDiscoveryQuiet{1000};
 // volatile) comes with the next publication (status_rate_hz, 50 Hz by default; 1 Hz and up
 // allowed), the transient-local topics with their history.
 constexpr Millis kFirstData{1500};
+// The event history comes after the match: the first read takes it as complete once no event arrived for
+// this long (Fast DDS 2 does not implement DataReader::wait_for_historical_data).
+constexpr Millis kHistoryQuiet{300};
 
 std::string default_name() {
   char host[256] = {};
@@ -428,8 +431,18 @@ class Client::Impl : public dds::DataReaderListener {
     return std::nullopt;
   }
   std::vector<AxisEvent> events_since(std::uint64_t& cursor) {
-    // The gateways' event history (transient local) follows the match without further waiting.
-    subscribe(event_r_, msg::TopicId::AxisEvent, [] { return true; });
+    // The gateways' event history (transient local) reaches the reader after it matched their
+    // writers: wait until it stopped growing (called under mutex_, once the reader matched).
+    std::uint64_t last = 0;
+    std::optional<SteadyClock::time_point> since;
+    subscribe(event_r_, msg::TopicId::AxisEvent, [&] {
+      const auto now = SteadyClock::now();
+      if (!since || events_end_ != last) {
+        since = now;
+        last = events_end_;
+      }
+      return now - *since >= kHistoryQuiet;
+    });
     std::lock_guard lock(mutex_);
     std::vector<AxisEvent> v;
     const std::uint64_t first = events_end_ - events_.size();

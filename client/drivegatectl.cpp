@@ -434,13 +434,7 @@ void print_event(const Context& ctx, const AxisEvent& e) {
 int cmd_events(Context& ctx) {
   expect_words(ctx, 1);
   const std::string axis = ctx.words.empty() ? "" : ctx.words[0];
-  std::uint64_t seen = 0;
-  auto count = [&] {
-    std::uint64_t cursor = 0;
-    return ctx.client.events_since(cursor).size();
-  };
-  // Transient-local history arrives right after matching; wait for it to stop growing.
-  wait_settled(ctx.client, count, Millis(300), ctx.timeout);
+  std::uint64_t seen = 0;  // the first events_since() waits for the gateways' event history
   do {
     for (const auto& e : ctx.client.events_since(seen)) {
       if (!axis.empty() && e.axis != axis) continue;
