@@ -430,6 +430,14 @@ class Client::Impl : public dds::DataReaderListener {
       if (l.axis == axis && (gateway.empty() || l.gateway == gateway)) return l;
     return std::nullopt;
   }
+  std::size_t link_writers() {
+    subscribe_links();
+    const dds::DataReader* r = link_r_.reader.load();
+    if (r == nullptr) return 0;
+    dds::SubscriptionMatchedStatus m{};
+    r->get_subscription_matched_status(m);
+    return static_cast<std::size_t>(std::max(m.current_count, 0));
+  }
   std::vector<AxisEvent> events_since(std::uint64_t& cursor) {
     // The gateways' event history (transient local) reaches the reader after it matched their
     // writers: wait until it stopped growing (called under mutex_, once the reader matched).
@@ -794,6 +802,7 @@ std::vector<AxisLink> Client::links() const { return impl_->links(); }
 std::optional<AxisLink> Client::link(std::string_view axis, std::string_view gateway) const {
   return impl_->link(axis, gateway);
 }
+std::size_t Client::link_writers() const { return impl_->link_writers(); }
 std::vector<AxisEvent> Client::events_since(std::uint64_t& cursor) const { return impl_->events_since(cursor); }
 bool Client::wait_until(const std::function<bool()>& condition, Millis timeout) const {
   return impl_->wait_until(condition, timeout);

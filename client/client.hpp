@@ -230,6 +230,10 @@ class Client {
   // Empty when no gateway published the axis' link (or this identity may not read axis_link).
   [[nodiscard]] std::vector<AxisLink> links() const;
   [[nodiscard]] std::optional<AxisLink> link(std::string_view axis, std::string_view gateway = {}) const;
+  // How many axis_link writers (one per gateway that publishes links) the link reader matched; 0
+  // when this identity may not read axis_link. Fewer than gateways(): some gateway publishes no links
+  // (its permissions predate the topic), so waiting for its axes' links is pointless.
+  [[nodiscard]] std::size_t link_writers() const;
 
   // Events in arrival order. `cursor` starts at 0 and is advanced past the returned events; at most
   // the newest 1000 are kept.
