@@ -39,6 +39,9 @@ constexpr Millis kDiscoveryQuiet{1000};
 // volatile) comes with the next publication (status_rate_hz, 50 Hz by default; 1 Hz and up
 // allowed), the transient-local topics with their history.
 constexpr Millis kFirstData{1500};
+// The event history comes after the match: the first read takes it as complete once no event arrived for
+// this long (Fast DDS 2 does not implement DataReader::wait_for_historical_data).
+constexpr Millis kHistoryQuiet{300};
 
 std::string default_name() {
   char host[256] = {};
@@ -57,6 +60,35 @@ std::string join(const std::vector<std::string>& v) {
   }
   return s;
 }
+
+// Lets one thread at a time take from a reader and store what it took, so an older sample never
+// overwrites a newer one and events keep their order. Without blocking: Fast DDS may call
+// on_data_available() with the reader's own lock held, and waiting there for a thread that is inside
+// take() (waiting for that lock) would deadlock. A thread that finds another taking leaves a note,
+// and the taking thread takes again before it leaves.
+class SerialTake {
+ public:
+  template <typename Take>
+  void run(Take&& take) {
+    pending_.store(true);
+    while (pending_.load()) {
+      std::unique_lock lock(mutex_, std::try_to_lock);
+      if (!lock.owns_lock()) return;  // the thread that holds it sees pending_ after it unlocked
+      pending_.store(false);
+      take();
+    }
+  }
+
+ private:
+  std::mutex mutex_;
+  std::atomic<bool> pending_{false};
+};
+
+// A reader of a state-like topic, made on first use.
+struct LazyReader {
+  std::atomic<dds::DataReader*> reader{nullptr};
+  SerialTake take;
+};
 
 struct ReplyRecord {
   std::string gateway;
@@ -141,15 +173,17 @@ class Client::Impl : public dds::DataReaderListener {
     return parameter_refusal_;
   }
 
+  // Called by DDS listener threads, and by the thread that attached the listener for what arrived
+  // before (constructor, subscribe()): the readers taken on both take through a SerialTake.
   void on_data_available(dds::DataReader* reader) override {
     if (reader == nullptr) return;
-    if (reader == info_r_) take_infos();
-    else if (reader == state_r_.load()) take_states(*reader);
+    if (reader == info_r_) info_take_.run([&] { take_infos(); });
     else if (reader == reply_r_) take_replies();
-    else if (reader == event_r_.load()) take_events(*reader);
-    else if (reader == bus_r_.load()) take_buses(*reader);
-    else if (reader == link_r_.load()) take_links(*reader);
     else if (reader == param_r_) take_param_replies();
+    else if (reader == state_r_.reader.load()) state_r_.take.run([&] { take_states(*reader); });
+    else if (reader == event_r_.reader.load()) event_r_.take.run([&] { take_events(*reader); });
+    else if (reader == bus_r_.reader.load()) bus_r_.take.run([&] { take_buses(*reader); });
+    else if (reader == link_r_.reader.load()) link_r_.take.run([&] { take_links(*reader); });
     {
       std::lock_guard lock(mutex_);
       ++generation_;
@@ -396,9 +430,27 @@ class Client::Impl : public dds::DataReaderListener {
       if (l.axis == axis && (gateway.empty() || l.gateway == gateway)) return l;
     return std::nullopt;
   }
+  std::size_t link_writers() {
+    subscribe_links();
+    const dds::DataReader* r = link_r_.reader.load();
+    if (r == nullptr) return 0;
+    dds::SubscriptionMatchedStatus m{};
+    r->get_subscription_matched_status(m);
+    return static_cast<std::size_t>(std::max(m.current_count, 0));
+  }
   std::vector<AxisEvent> events_since(std::uint64_t& cursor) {
-    // The gateways' event history (transient local) follows the match without further waiting.
-    subscribe(event_r_, msg::TopicId::AxisEvent, [] { return true; });
+    // The gateways' event history (transient local) reaches the reader after it matched their
+    // writers: wait until it stopped growing (called under mutex_, once the reader matched).
+    std::uint64_t last = 0;
+    std::optional<SteadyClock::time_point> since;
+    subscribe(event_r_, msg::TopicId::AxisEvent, [&] {
+      const auto now = SteadyClock::now();
+      if (!since || events_end_ != last) {
+        since = now;
+        last = events_end_;
+      }
+      return now - *since >= kHistoryQuiet;
+    });
     std::lock_guard lock(mutex_);
     std::vector<AxisEvent> v;
     const std::uint64_t first = events_end_ - events_.size();
@@ -456,25 +508,34 @@ class Client::Impl : public dds::DataReaderListener {
 
   // Makes the reader of a state-like topic on the first call (the later ones return at once) and
   // waits, up to kFirstData, until it matched every known gateway and `arrived` says the gateways'
-  // present data is in, so that the first read after subscribing is not silently empty. Readers
+  // present data is in, so that the first read after subscribing is not silently empty. When no
+  // gateway is known yet (a read right after construction), it first waits, within the same budget,
+  // for discovery: a gateway, then none new for kDiscoveryQuiet (as wait_route()). Readers
   // the DDS identity may not have (permissions made before axis_link existed, say) stay absent:
   // their data is then empty. The mutex makes concurrent first calls wait for the same reader; the
   // reader is published (slot) before the listener is attached, as in the constructor.
-  void subscribe(std::atomic<dds::DataReader*>& slot, msg::TopicId topic, const std::function<bool()>& arrived) {
+  void subscribe(LazyReader& slot, msg::TopicId topic, const std::function<bool()>& arrived) {
     if (subscribed_.load(std::memory_order_acquire) & bit(topic)) return;
     std::lock_guard lock(subscribe_mutex_);
     if (subscribed_.load(std::memory_order_relaxed) & bit(topic)) return;
     std::string refusal;
     dds::DataReader* r = optional_reader(topic, refusal);
     if (r != nullptr) {
-      slot.store(r);
+      slot.reader.store(r);
       r->set_listener(this, dds::StatusMask::data_available());
       on_data_available(r);
+      bool discovering = false;
+      {
+        std::lock_guard data_lock(mutex_);
+        discovering = gateways_.empty();
+      }
       wait_until(
           [&] {
             dds::SubscriptionMatchedStatus m{};
             r->get_subscription_matched_status(m);
             std::lock_guard data_lock(mutex_);
+            if (discovering && (gateways_.empty() || SteadyClock::now() - last_info_change_ < kDiscoveryQuiet))
+              return false;
             return m.current_count >= static_cast<std::int32_t>(gateways_.size()) && arrived();
           },
           kFirstData);
@@ -692,11 +753,12 @@ class Client::Impl : public dds::DataReaderListener {
   dds::DataReader* info_r_ = nullptr;
   dds::DataReader* reply_r_ = nullptr;
   dds::DataReader* param_r_ = nullptr;
+  SerialTake info_take_;
   // Made on first use (subscribe()); read by the listener thread.
-  std::atomic<dds::DataReader*> state_r_{nullptr};
-  std::atomic<dds::DataReader*> event_r_{nullptr};
-  std::atomic<dds::DataReader*> bus_r_{nullptr};
-  std::atomic<dds::DataReader*> link_r_{nullptr};
+  LazyReader state_r_;
+  LazyReader event_r_;
+  LazyReader bus_r_;
+  LazyReader link_r_;
   std::mutex subscribe_mutex_;
   std::atomic<unsigned> subscribed_{0};  // bit(topic): subscribe() done for that topic
 
@@ -740,6 +802,7 @@ std::vector<AxisLink> Client::links() const { return impl_->links(); }
 std::optional<AxisLink> Client::link(std::string_view axis, std::string_view gateway) const {
   return impl_->link(axis, gateway);
 }
+std::size_t Client::link_writers() const { return impl_->link_writers(); }
 std::vector<AxisEvent> Client::events_since(std::uint64_t& cursor) const { return impl_->events_since(cursor); }
 bool Client::wait_until(const std::function<bool()>& condition, Millis timeout) const {
   return impl_->wait_until(condition, timeout);

@@ -221,7 +221,8 @@ class Client {
   // construction on. The states, bus statuses, links and events are subscribed to on the first call
   // that reads them (a client that only commands receives none of them); that first call waits
   // (up to 1.5 s) until the gateways discovered so far have delivered what they have: a state and
-  // a link per axis, a status per bus, the event history.
+  // a link per axis, a status per bus, the event history. When no gateway is discovered yet (a read
+  // right after construction) it first waits, within the same 1.5 s, for the gateways to appear.
   [[nodiscard]] std::vector<GatewayInfo> gateways() const;
   [[nodiscard]] std::vector<AxisState> states() const;
   [[nodiscard]] std::optional<AxisState> state(std::string_view axis, std::string_view gateway = {}) const;
@@ -229,6 +230,10 @@ class Client {
   // Empty when no gateway published the axis' link (or this identity may not read axis_link).
   [[nodiscard]] std::vector<AxisLink> links() const;
   [[nodiscard]] std::optional<AxisLink> link(std::string_view axis, std::string_view gateway = {}) const;
+  // How many axis_link writers (one per gateway that publishes links) the link reader matched; 0
+  // when this identity may not read axis_link. Fewer than gateways(): some gateway publishes no links
+  // (its permissions predate the topic), so waiting for its axes' links is pointless.
+  [[nodiscard]] std::size_t link_writers() const;
 
   // Events in arrival order. `cursor` starts at 0 and is advanced past the returned events; at most
   // the newest 1000 are kept.

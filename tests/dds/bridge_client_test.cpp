@@ -235,6 +235,46 @@ TEST(DdsBridge, CommandOnlyClientSubscribesToStatesOnFirstRead) {
   EXPECT_EQ(c.buses()[0].bus, "can0");
 }
 
+// The first read right after construction, before any gateway was discovered, waits for discovery
+// and the gateway's data: not an empty answer that later reads would never correct by waiting.
+TEST(DdsBridge, FirstReadRightAfterConstructionWaitsForTheGateway) {
+  FakeRuntime rt("gw1", {"x", "y"});
+  daemon::DdsBridge bridge(rt, bridge_options());
+  bridge.start();
+  Client c(client_options());
+  EXPECT_EQ(c.states().size(), 2U);
+  Client other(client_options());
+  EXPECT_EQ(other.links().size(), 2U);
+}
+
+// The event history (transient local) reaches the reader after it matched the gateway's writer: the
+// first events_since() waits for it instead of returning as soon as the reader matched.
+TEST(DdsBridge, FirstEventsReadHasTheHistory) {
+  FakeRuntime rt("gw1", {"x"});
+  daemon::DdsBridge bridge(rt, bridge_options());
+  bridge.start();
+  constexpr int kEvents = 5;
+  for (int i = 0; i < kEvents; ++i) rt.push_event(0, core::EventKind::Warning, "history " + std::to_string(i));
+  {
+    // The events are published (seen by a first client) before the second client exists.
+    Client first(client_options());
+    std::uint64_t cursor = 0;
+    std::size_t seen_events = 0;
+    ASSERT_TRUE(first.wait_until(
+        [&] {
+          seen_events += first.events_since(cursor).size();
+          return seen_events >= kEvents;
+        },
+        kTimeout));
+  }
+  Client c(client_options());
+  ASSERT_TRUE(c.wait_until([&] { return has_axes(c, 1); }, kTimeout)) << seen(c);
+  std::uint64_t cursor = 0;
+  const auto events = c.events_since(cursor);
+  ASSERT_GE(events.size(), static_cast<std::size_t>(kEvents));
+  EXPECT_EQ(events.back().text, "history " + std::to_string(kEvents - 1));
+}
+
 TEST(DdsBridge, UnknownAxisIsRejectedWithTheAxesWeHave) {
   FakeRuntime rt("gw1", {"x", "y"});
   daemon::DdsBridge bridge(rt, bridge_options());

@@ -3,17 +3,25 @@
 #include <unistd.h>
 
 #include <array>
+#include <atomic>
+#include <chrono>
 #include <cstdio>
 #include <map>
 #include <string>
+#include <thread>
 
+#include <fastdds/dds/publisher/DataWriter.hpp>
 #include <gtest/gtest.h>
 
 #include "daemon/dds_bridge.hpp"
+#include "drivegate.h"
 #include "fake_runtime.hpp"
+#include "idl/dds_node.hpp"
 
 namespace drivegate::dds_test {
 namespace {
+
+namespace dds = eprosima::fastdds::dds;
 
 std::uint32_t test_domain() { return 20U + static_cast<std::uint32_t>(::getpid() % 80); }  // see bridge_client_test
 
@@ -218,6 +226,55 @@ TEST_F(Drivegatectl, VelocityStreamsKeepAliveThenStops) {
   // Set-points are best effort; at 20 Hz for 0.4 s at least one arrives in-process.
   ASSERT_FALSE(rt_.setpoints().empty());
   EXPECT_DOUBLE_EQ(rt_.setpoints().back().second.velocity, -4.5);
+}
+
+// A gateway without an axis_link writer (its DDS Security permissions predate the topic): list
+// and status do not wait their whole --timeout (10 s here) for links that never come.
+TEST(DrivegatectlWithoutLinks, ListAndStatusDoNotWaitForLinksNobodyPublishes) {
+  msg::DdsOptions o;
+  o.domain = test_domain();
+  o.ns = test_namespace();
+  o.participant_name = "gateway-without-axis-link";
+  msg::DdsNode gateway(o);
+  msg::GatewayInfo info;
+  info.gateway("old");
+  info.host("host");
+  info.pid(1);
+  msg::AxisDescription axis;
+  axis.name("x");
+  axis.bus("can0");
+  axis.device("sim");
+  axis.unit("mm");
+  info.axes().push_back(axis);
+  ASSERT_TRUE(gateway.writer(msg::TopicId::GatewayInfo).write(&info));
+  msg::AxisState state;
+  state.gateway("old");
+  state.axis("x");
+  state.state("operation_enabled");
+  state.link("operational");
+  dds::DataWriter& state_w = gateway.writer(msg::TopicId::AxisState);
+
+  const auto start = std::chrono::steady_clock::now();
+  CtlRun r = ctl("list");
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("x  bus=can0"), std::string::npos) << r.output;
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(6)) << r.output;
+
+  // axis_state is volatile: written until status has read it (as a gateway publishes it).
+  std::atomic<bool> done{false};
+  std::thread publisher([&] {
+    while (!done) {
+      state_w.write(&state);
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));  // the publication rate
+    }
+  });
+  const auto status_start = std::chrono::steady_clock::now();
+  r = ctl("status x");
+  done = true;
+  publisher.join();
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("operation_enabled"), std::string::npos) << r.output;
+  EXPECT_LT(std::chrono::steady_clock::now() - status_start, std::chrono::seconds(6)) << r.output;
 }
 
 TEST(DrivegateDemo, RunsTheWholeSequenceAndLeavesAxesDisabled) {
