@@ -13,6 +13,7 @@
 #include <system_error>
 #include <utility>
 
+#include "adapters/canopen/transport/batch_send.hpp"
 #include "adapters/canopen/transport/fd_guard.hpp"
 
 namespace drivegate::canopen {
@@ -255,37 +256,8 @@ SendBatchResult SocketCanTransport::send_batch(std::span<const CanFrame> frames,
     r.taken = frames.size();
     return r;
   }
-  while (r.taken < frames.size()) {
-    // The next batch; an invalid frame is refused here and never reaches the socket.
-    std::size_t count = 0;
-    std::size_t next = r.taken;
-    for (; next < frames.size() && count < kCanBatch; ++next) {
-      if (!frames[next].valid()) continue;
-      tx_frames_[count] = to_linux_frame(frames[next]);
-      tx_frame_of_[count] = next;
-      ++count;
-    }
-    for (std::size_t done = 0; done < count;) {
-      const int sent = ::sendmmsg(fd_, tx_msgs_.data() + done, static_cast<unsigned>(count - done), MSG_DONTWAIT);
-      if (sent > 0) {
-        done += static_cast<std::size_t>(sent);
-        r.sent += static_cast<std::size_t>(sent);
-        counters_.tx_frames.add(static_cast<std::uint64_t>(sent));
-        continue;
-      }
-      if (errno == EINTR) continue;
-      // ENOBUFS: the interface's transmit queue is full (SocketCAN reports that, not EAGAIN).
-      if (errno == EAGAIN || errno == EWOULDBLOCK || errno == ENOBUFS) {
-        counters_.tx_overflows.add();
-        r.taken = tx_frame_of_[done];
-        r.busy = true;
-        return r;
-      }
-      ++done;  // ENETDOWN, interface down: this frame is refused (Down)
-    }
-    r.taken = next;
-  }
-  return r;
+  return send_in_batches(fd_, frames, tx_msgs_, tx_frame_of_, counters_,
+                         [this](std::size_t slot, const CanFrame& f) { tx_frames_[slot] = to_linux_frame(f); });
 }
 
 std::string SocketCanTransport::describe() const {

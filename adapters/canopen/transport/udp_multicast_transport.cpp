@@ -9,6 +9,7 @@
 #include <system_error>
 #include <utility>
 
+#include "adapters/canopen/transport/batch_send.hpp"
 #include "adapters/canopen/transport/fd_guard.hpp"
 
 namespace drivegate::canopen {
@@ -200,36 +201,10 @@ SendBatchResult UdpMulticastTransport::send_batch(std::span<const CanFrame> fram
   }
   // Receivers replace the timestamp with their reception time; ours is for captures only.
   const double seconds = static_cast<double>(core::to_ns(now)) * 1e-9;
-  while (r.taken < frames.size()) {
-    // Encode the next batch; an invalid frame is refused here and never reaches the socket.
-    std::size_t count = 0;
-    std::size_t next = r.taken;
-    for (; next < frames.size() && count < kUdpBatch; ++next) {
-      if (!frames[next].valid()) continue;
-      tx_iov_[count].iov_len = encode_msgpack_frame(frames[next], seconds, tx_buffers_[count]);
-      tx_frame_of_[count] = next;
-      ++count;
-    }
-    for (std::size_t done = 0; done < count;) {
-      const int sent = ::sendmmsg(tx_fd_, tx_msgs_.data() + done, static_cast<unsigned>(count - done), MSG_DONTWAIT);
-      if (sent > 0) {
-        done += static_cast<std::size_t>(sent);
-        r.sent += static_cast<std::size_t>(sent);
-        counters_.tx_frames.add(static_cast<std::uint64_t>(sent));
-        continue;
-      }
-      if (errno == EINTR) continue;
-      if (errno == EAGAIN || errno == EWOULDBLOCK || errno == ENOBUFS) {
-        counters_.tx_overflows.add();
-        r.taken = tx_frame_of_[done];
-        r.busy = true;
-        return r;
-      }
-      ++done;  // ENETUNREACH, interface gone: this frame is refused (Down); retrying now fixes nothing
-    }
-    r.taken = next;
-  }
-  return r;
+  const auto stage = [this, seconds](std::size_t slot, const CanFrame& f) {
+    tx_iov_[slot].iov_len = encode_msgpack_frame(f, seconds, tx_buffers_[slot]);
+  };
+  return send_in_batches(tx_fd_, frames, tx_msgs_, tx_frame_of_, counters_, stage);
 }
 
 std::string UdpMulticastTransport::describe() const {
