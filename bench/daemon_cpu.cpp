@@ -29,11 +29,13 @@
 #include <thread>
 #include <vector>
 
+#include "bench/proc_stat.hpp"
 #include "client/client.hpp"
 #include "tests/canopen_e2e/sim_process.hpp"
 #include "tests/daemon/daemon_process.hpp"
 
 using namespace drivegate;
+using bench::stat_ticks;
 using namespace std::chrono_literals;
 using Clock = std::chrono::steady_clock;
 
@@ -43,25 +45,6 @@ constexpr int kAxes = 6;
 constexpr auto kCycle = 4ms;
 constexpr auto kKeepAlivePeriod = 50ms;  // drivegatectl's (client/drivegatectl.cpp)
 constexpr double kJogVelocity = 2;       // rev/s (10000 counts per revolution)
-
-// Clock ticks of utime + stime in a /proc stat line; the name between the parentheses to `name`.
-unsigned long long stat_ticks(const std::string& path, std::string* name = nullptr) {
-  std::ifstream in(path);
-  std::string text;
-  std::getline(in, text);
-  const auto open = text.find('(');
-  const auto close = text.rfind(')');
-  if (open == std::string::npos || close == std::string::npos) return 0;
-  if (name != nullptr) *name = text.substr(open + 1, close - open - 1);
-  std::istringstream rest(text.substr(close + 2));
-  std::string field;
-  unsigned long long utime = 0, stime = 0;
-  for (int i = 3; i <= 15 && rest >> field; ++i) {
-    if (i == 14) utime = std::stoull(field);
-    if (i == 15) stime = std::stoull(field);
-  }
-  return utime + stime;
-}
 
 // A process' CPU ticks, in total and per thread (by thread id, with its name).
 struct Sample {
@@ -168,11 +151,9 @@ int main(int argc, char** argv) {
     if (std::string(argv[i]) == "--seconds") seconds = std::max(1.0, std::atof(argv[i + 1]));
 
   const auto dds = test::unique_dds("bench_cpu");
-  // A group of this process, and a port between the RTPS port bands of the DDS domains 20..99 that
-  // test processes use (see tests/canopen_e2e/e2e_fixture.cpp).
-  const auto pid = static_cast<unsigned>(::getpid());
-  const std::string group = "239.202." + std::to_string((pid >> 8) & 0xFF) + "." + std::to_string(pid & 0xFF);
-  const auto port = static_cast<std::uint16_t>(7400 + 250 * (35 + pid % 15) + 120 + (pid / 15) % 120);
+  const test::BusAddress bus = test::unique_bus_address(0);
+  const std::string& group = bus.group;
+  const std::uint16_t port = bus.port;
   const auto config = test::write_config_text("bench-daemon-cpu", config_text(dds, group, port));
 
   test::SimProcess sim(config);

@@ -21,30 +21,21 @@
 #include <string>
 #include <vector>
 
+#include "bench/proc_stat.hpp"
 #include "client/client.hpp"
 #include "tests/daemon/daemon_process.hpp"
 
 using namespace drivegate;
+using bench::stat_ticks;
 using namespace std::chrono_literals;
 using Clock = std::chrono::steady_clock;
 
 namespace {
 
-// utime + stime of a process in seconds (/proc/PID/stat fields 14 and 15).
+// utime + stime of a process in seconds.
 double process_cpu(pid_t pid) {
-  std::ifstream in("/proc/" + std::to_string(pid) + "/stat");
-  std::string text;
-  std::getline(in, text);
-  const auto close = text.rfind(')');
-  if (close == std::string::npos) return 0;
-  std::istringstream rest(text.substr(close + 2));
-  std::string field;
-  unsigned long long utime = 0, stime = 0;
-  for (int i = 3; i <= 15 && rest >> field; ++i) {
-    if (i == 14) utime = std::stoull(field);
-    if (i == 15) stime = std::stoull(field);
-  }
-  return static_cast<double>(utime + stime) / static_cast<double>(::sysconf(_SC_CLK_TCK));
+  return static_cast<double>(stat_ticks("/proc/" + std::to_string(pid) + "/stat")) /
+         static_cast<double>(::sysconf(_SC_CLK_TCK));
 }
 
 double self_cpu() {

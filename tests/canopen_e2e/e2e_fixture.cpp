@@ -46,23 +46,6 @@ int check_config(const std::string& file, std::string& out) {
 
 }  // namespace
 
-BusAddress unique_bus_address(unsigned slot) {
-  // RTPS puts a DDS domain's ports at 7400 + 250 x domain + 0..~60 (participants of parallel tests
-  // on domains 20..99: unique_dds()), bound without SO_REUSEADDR. The bus ports sit in the gaps
-  // between those bands, at +120..+239, in 16270..19889: clear of the simulator process tests'
-  // block (12000..15999) and the UDP transport tests' (20000..31999). Two tests may share a port:
-  // the group differs per process (the transport turns IP_MULTICAST_ALL off).
-  constexpr unsigned kFirstBand = 35;  // 7400 + 250 x 35 = 16150
-  constexpr unsigned kBands = 15;
-  constexpr unsigned kGap = 120;
-  const auto pid = static_cast<unsigned>(::getpid());
-  const unsigned index = (pid * 16 + slot) % (kBands * kGap);
-  BusAddress a;
-  a.port = static_cast<std::uint16_t>(7400 + 250 * (kFirstBand + index / kGap) + 120 + index % kGap);
-  a.group = "239.201." + std::to_string((pid >> 8) & 0xFF) + "." + std::to_string(pid & 0xFF);
-  return a;
-}
-
 std::string three_drives_config(const std::string& gateway, const DdsIsolation& dds, const BusAddress& bus) {
   std::ostringstream y;
   y << "gateway: { name: " << gateway << ", dds: { domain: " << dds.domain << ", namespace: " << dds.ns

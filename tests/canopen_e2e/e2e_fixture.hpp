@@ -23,14 +23,6 @@ namespace drivegate::test {
 
 using namespace std::chrono_literals;
 
-// The virtual CAN bus of one test: a 239.x group of the test process and a port that no DDS
-// participant of a parallel test can hold.
-struct BusAddress {
-  std::string group;
-  std::uint16_t port = 0;
-};
-BusAddress unique_bus_address(unsigned slot);
-
 // The three drives on one canopen bus: 4 ms SYNC at 1 Mbit/s (57 % estimated load, which
 // --check-config accepts), axis defaults so that pp moves need no rates of their own, and a homing
 // method each device profile lists.

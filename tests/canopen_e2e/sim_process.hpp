@@ -6,11 +6,20 @@
 #include <sys/types.h>
 
 #include <chrono>
+#include <cstdint>
 #include <functional>
 #include <optional>
 #include <string>
 
 namespace drivegate::test {
+
+// The virtual CAN bus of one test: a 239.x group of the test process and a port that no DDS
+// participant of a parallel test can hold.
+struct BusAddress {
+  std::string group;
+  std::uint16_t port = 0;
+};
+BusAddress unique_bus_address(unsigned slot);
 
 class SimProcess {
  public:

@@ -40,23 +40,12 @@ Outcome drivegated(const std::string& args) {
   return r;
 }
 
-// A group of this process and a port in the gaps between the DDS port bands of parallel tests
-// (as tests/canopen_e2e's unique_bus_address, on groups of its own: 239.202.x.y).
-struct Bus {
-  std::string group;
-  int port = 0;
-  [[nodiscard]] std::string where() const {
-    return "'canopen:udp-multicast?group=" + group + "&port=" + std::to_string(port) + "&interface=127.0.0.1'";
-  }
-};
-Bus unique_bus(unsigned slot) {
-  const auto pid = static_cast<unsigned>(::getpid());
-  const unsigned index = (pid * 16 + slot) % (15 * 120);
-  return {"239.202." + std::to_string((pid >> 8) & 0xFF) + "." + std::to_string(pid & 0xFF),
-          static_cast<int>(7400 + 250 * (35 + index / 120) + 120 + index % 120)};
+// The scan's WHERE for a bus of unique_bus_address() (tests/canopen_e2e/sim_process.hpp).
+std::string where(const BusAddress& bus) {
+  return "'canopen:udp-multicast?group=" + bus.group + "&port=" + std::to_string(bus.port) + "&interface=127.0.0.1'";
 }
 
-std::string drives_config(const Bus& bus) {
+std::string drives_config(const BusAddress& bus) {
   std::ostringstream y;
   y << "gateway: { name: scan-sim }\n"
     << "buses:\n"
@@ -77,14 +66,14 @@ bool has_line(const std::string& text, const std::string& regex) {
 }
 
 TEST(ScanProcess, FindsTheSimulatedDrivesAndWritesAConfigurationCheckConfigAccepts) {
-  const Bus bus = unique_bus(0);
+  const BusAddress bus = unique_bus_address(0);
   const std::string sim_config = write_config_text("scan-sim", drives_config(bus));
   SimProcess sim(sim_config);
   ASSERT_TRUE(sim.wait_ready(10s)) << sim.log();
 
   const std::string file = sim_config + ".scanned.yaml";
   std::filesystem::remove(file);
-  const Outcome scan = drivegated("--scan " + bus.where() + " --write-config " + file);
+  const Outcome scan = drivegated("--scan " + where(bus) + " --write-config " + file);
   ASSERT_EQ(scan.status, 0) << scan.out;
   EXPECT_TRUE(has_line(scan.out, "^canopen udp-multicast " + bus.group + ":" + std::to_string(bus.port) +
                                      " on 127.0.0.1, bit rate not given \\(500 kbit/s assumed for the answer times "
@@ -116,14 +105,14 @@ TEST(ScanProcess, FindsTheSimulatedDrivesAndWritesAConfigurationCheckConfigAccep
 
   // The file is kept unless --force.
   std::ofstream(file) << "# mine\n";
-  const Outcome again = drivegated("--scan " + bus.where() + " --write-config " + file);
+  const Outcome again = drivegated("--scan " + where(bus) + " --write-config " + file);
   EXPECT_EQ(again.status, 1);
   EXPECT_NE(again.out.find("exists; it is kept (--force replaces it)"), std::string::npos) << again.out;
   std::ifstream in(file);
   std::ostringstream kept;
   kept << in.rdbuf();
   EXPECT_EQ(kept.str(), "# mine\n");
-  const Outcome forced = drivegated("--scan " + bus.where() + " --write-config " + file + " --force");
+  const Outcome forced = drivegated("--scan " + where(bus) + " --write-config " + file + " --force");
   EXPECT_EQ(forced.status, 0) << forced.out;
   EXPECT_EQ(drivegated("--check-config " + file).status, 0);
   std::filesystem::remove(file);
@@ -132,7 +121,7 @@ TEST(ScanProcess, FindsTheSimulatedDrivesAndWritesAConfigurationCheckConfigAccep
 TEST(ScanProcess, ADriveOnAnSd6ExtraChannelIsWarnedAboutAndNoAxisInTheSkeleton) {
   // The field case: an SD6 at 3, whose SDO channel 2 answers on node-ID 35 (SD6 §5.3), and a
   // drive at 35.
-  const Bus bus = unique_bus(3);
+  const BusAddress bus = unique_bus_address(3);
   std::string config = drives_config(bus);
   config = config.substr(0, config.find("  - { name: akd")) +
            "  - { name: sd6, bus: can0, address: 3, device: stoeber-sd6, mechanics: { encoder_counts_per_rev: 131072 } }\n"
@@ -141,7 +130,7 @@ TEST(ScanProcess, ADriveOnAnSd6ExtraChannelIsWarnedAboutAndNoAxisInTheSkeleton) 
   ASSERT_TRUE(sim.wait_ready(10s)) << sim.log();
   const std::string file = ::testing::TempDir() + "scan-conflict-" + std::to_string(::getpid()) + ".yaml";
   std::filesystem::remove(file);
-  const Outcome scan = drivegated("--scan " + bus.where() + " --write-config " + file);
+  const Outcome scan = drivegated("--scan " + where(bus) + " --write-config " + file);
   ASSERT_EQ(scan.status, 0) << scan.out;
   EXPECT_TRUE(has_line(scan.out, "^3 \\(03h\\) .* stoeber-sd6$")) << scan.out;
   EXPECT_TRUE(has_line(scan.out, "^35 \\(23h\\) .* \\(conflict\\)$")) << scan.out;
@@ -158,8 +147,8 @@ TEST(ScanProcess, ADriveOnAnSd6ExtraChannelIsWarnedAboutAndNoAxisInTheSkeleton) 
 }
 
 TEST(ScanProcess, NobodyThereSaysSoWithinASecond) {
-  const Bus bus = unique_bus(1);
-  const Outcome scan = drivegated("--scan " + bus.where());
+  const BusAddress bus = unique_bus_address(1);
+  const Outcome scan = drivegated("--scan " + where(bus));
   ASSERT_EQ(scan.status, 0) << scan.out;
   std::smatch m;
   ASSERT_TRUE(std::regex_search(scan.out, m, std::regex(": no devices answered \\(scan took ([0-9]+) ms\\)"))) << scan.out;
@@ -167,9 +156,9 @@ TEST(ScanProcess, NobodyThereSaysSoWithinASecond) {
 }
 
 TEST(ScanProcess, RefusedWhileAGatewayHoldsTheBus) {
-  const Bus bus = unique_bus(2);
+  const BusAddress bus = unique_bus_address(2);
   const daemon::BusLock lock("canopen udp-multicast " + bus.group + ":" + std::to_string(bus.port));
-  const Outcome scan = drivegated("--scan " + bus.where());
+  const Outcome scan = drivegated("--scan " + where(bus));
   EXPECT_EQ(scan.status, 1);
   EXPECT_NE(scan.out.find("is already driven by process " + std::to_string(::getpid())), std::string::npos) << scan.out;
 }
