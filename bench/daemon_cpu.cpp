@@ -4,7 +4,11 @@
 // still, (b) six DDS clients (one per axis, each its own participant) jogging the axes as
 // `drivegatectl velocity` does: a velocity command, then a set-point every 50 ms.
 //
-//   bench_daemon_cpu [--seconds N]   (default 10 per phase)
+//   bench_daemon_cpu [--seconds N] [--rpdo-refresh D] [--status-keepalive D]
+//
+// --seconds: per phase (default 10). --rpdo-refresh and --status-keepalive set the bus' and the
+// gateway's options of those names (default: the daemon's defaults); 0 for both is how the daemon
+// ran before they existed (every RPDO after every SYNC, every axis state at every period).
 //
 // CPU is utime + stime from /proc/PID/stat and /proc/PID/task/TID/stat over wall time, in % of one
 // core; threads are grouped by name (comm). The reference line per phase is what the rest of the
@@ -121,15 +125,24 @@ void print_usage(const char* who, const Usage& u, double seconds) {
   }
 }
 
-std::string config_text(const test::DdsIsolation& dds, const std::string& group, std::uint16_t port) {
+// Options left empty take the daemon's defaults.
+struct Tuning {
+  std::string rpdo_refresh;
+  std::string status_keepalive;
+};
+
+std::string config_text(const test::DdsIsolation& dds, const std::string& group, std::uint16_t port,
+                        const Tuning& tuning) {
   std::ostringstream y;
-  y << "gateway: { name: bench, dds: { domain: " << dds.domain << ", namespace: " << dds.ns << " } }\n"
+  y << "gateway: { name: bench, dds: { domain: " << dds.domain << ", namespace: " << dds.ns << " }"
+    << (tuning.status_keepalive.empty() ? "" : ", status_keepalive: " + tuning.status_keepalive) << " }\n"
     << "buses:\n"
     << "  - name: can0\n"
     << "    type: canopen\n"
     << "    cycle_time: 4ms\n"
     << "    options: { transport: udp-multicast, interface: 127.0.0.1, group: " << group << ", port: " << port
-    << ", bitrate: 1000000 }\n"
+    << ", bitrate: 1000000"
+    << (tuning.rpdo_refresh.empty() ? "" : ", rpdo_refresh: " + tuning.rpdo_refresh) << " }\n"
     << "axes:\n";
   for (int i = 1; i <= kAxes; ++i) {
     y << "  - { name: a" << i << ", bus: can0, address: " << i
@@ -147,14 +160,19 @@ int fail(const std::string& what) {
 
 int main(int argc, char** argv) {
   double seconds = 10;
-  for (int i = 1; i + 1 < argc; ++i)
-    if (std::string(argv[i]) == "--seconds") seconds = std::max(1.0, std::atof(argv[i + 1]));
+  Tuning tuning;
+  for (int i = 1; i + 1 < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--seconds") seconds = std::max(1.0, std::atof(argv[i + 1]));
+    if (a == "--rpdo-refresh") tuning.rpdo_refresh = argv[i + 1];
+    if (a == "--status-keepalive") tuning.status_keepalive = argv[i + 1];
+  }
 
   const auto dds = test::unique_dds("bench_cpu");
   const test::BusAddress bus = test::unique_bus_address(0);
   const std::string& group = bus.group;
   const std::uint16_t port = bus.port;
-  const auto config = test::write_config_text("bench-daemon-cpu", config_text(dds, group, port));
+  const auto config = test::write_config_text("bench-daemon-cpu", config_text(dds, group, port, tuning));
 
   test::SimProcess sim(config);
   if (!sim.wait_ready(20s)) return fail("drivegate-sim did not start:\n" + sim.log());

@@ -36,8 +36,9 @@ constexpr Millis kPollSlice{50};
 constexpr Millis kDiscoveryQuiet{1000};
 // How long the first read of a state-like topic waits for its reader to match every known gateway
 // and for the data to arrive: endpoint discovery takes some ms, then axis_state (best effort,
-// volatile) comes with the next publication (status_rate_hz, 50 Hz by default; 1 Hz and up
-// allowed), the transient-local topics with their history.
+// volatile) comes with the next publication (status_rate_hz, 50 Hz by default, 1 Hz and up
+// allowed; an unchanged state every status_keepalive, at most 500 ms), the transient-local
+// topics with their history.
 constexpr Millis kFirstData{1500};
 // The event history comes after the match: the first read takes it as complete once no event arrived for
 // this long (Fast DDS 2 does not implement DataReader::wait_for_historical_data).

@@ -31,7 +31,8 @@ enum class OptionKind : std::uint8_t { Integer, Number, Boolean, String, Duratio
 struct OptionSpec {
   std::string name;
   OptionKind kind = OptionKind::Integer;
-  double min = 0;  // Integer and Number; Duration: seconds (both 0: any duration > 0 up to 1 h)
+  double min = 0;  // Integer and Number; Duration: seconds (both 0: any duration > 0 up to 1 h;
+                   // a negative min: zero or more)
   double max = 0;
   OptionValue default_value;
   std::string help;

@@ -113,7 +113,10 @@ std::string describe_plan(const Plan& plan) {
                                           g.security->permissions
                                     : std::string{"off: anyone on the DDS domain can command the axes"});
   gp.row("log level", g.log_level);
-  gp.row("status rate", format_number(g.status_rate_hz) + " Hz");
+  gp.row("status rate", format_number(g.status_rate_hz) + " Hz" +
+                            (g.status_keepalive > core::Duration::zero()
+                                 ? " when changed, unchanged every " + format_duration(g.status_keepalive)
+                                 : std::string{", every period"}));
   if (!g.device_dirs.empty()) gp.row("device dirs", join(g.device_dirs));
   for (const auto& b : plan.buses) {
     out << "  bus " << b.name << '\n';

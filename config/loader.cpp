@@ -71,7 +71,7 @@ bool is_interface_or_address(const std::string& s) {
 }
 
 void read_gateway(const MapReader& g, const fs::path& base_dir, GatewayPlan& out) {
-  g.check_keys({"name", "dds", "security", "log_level", "status_rate_hz", "device_dirs"});
+  g.check_keys({"name", "dds", "security", "log_level", "status_rate_hz", "status_keepalive", "device_dirs"});
   out.name = g.name("name", Need::Required).value_or("");
   const MapReader dds = g.map("dds", Need::Optional);
   dds.check_keys({"domain", "namespace", "profiles_file", "profile", "interfaces", "duplicate_check"});
@@ -104,6 +104,10 @@ void read_gateway(const MapReader& g, const fs::path& base_dir, GatewayPlan& out
   out.log_level = g.choice("log_level", Need::Optional, kLevels).value_or(out.log_level);
   NumberRule rate{1, 1000, false, "a number in 1..1000 (Hz)"};
   out.status_rate_hz = g.number("status_rate_hz", Need::Optional, rate).value_or(out.status_rate_hz);
+  // A negative minimum: zero allowed (every period). At most 500 ms: clients take a state they
+  // have not heard of for 1 s as stale (client/status_table.hpp).
+  out.status_keepalive = g.duration("status_keepalive", Need::Optional, core::Duration{-1}, std::chrono::milliseconds(500))
+                             .value_or(out.status_keepalive);
   if (const auto dirs = g.list("device_dirs", Need::Optional)) {
     for (std::size_t i = 0; i < dirs->size(); ++i) {
       const auto dir = read_string((*dirs)[i], indexed(g.field("device_dirs"), i), g.source());
@@ -146,7 +150,7 @@ void read_options(const MapReader& m, const BusTypeInfo& type, BusPlan& bus) {
         break;
       case OptionKind::Duration: {
         const auto seconds = [](double s) { return core::Duration{std::llround(s * 1e9)}; };
-        const bool ranged = o.min > 0 || o.max > 0;
+        const bool ranged = o.min != 0 || o.max > 0;
         if (const auto d = m.duration(o.name, Need::Optional, ranged ? seconds(o.min) : 0ns,
                                       ranged ? seconds(o.max) : std::chrono::hours(1)))
           v = *d;

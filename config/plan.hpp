@@ -75,6 +75,9 @@ struct GatewayPlan {
   core::Duration duplicate_check = std::chrono::seconds(2);
   std::string log_level = "info";
   double status_rate_hz = 50;
+  // An axis state that did not change is published again after this long (0: at every
+  // status_rate_hz period); a change goes out at the next period.
+  core::Duration status_keepalive = std::chrono::milliseconds(250);
   std::vector<std::string> device_dirs;  // from the file, made absolute
 };
 

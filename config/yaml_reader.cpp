@@ -290,11 +290,16 @@ std::optional<std::int64_t> MapReader::integer(std::string_view key, Need need, 
 std::optional<core::Duration> read_duration(const YAML::Node& n, const std::string& path, const Source& src,
                                             core::Duration min, core::Duration max) {
   const auto d = n.IsScalar() && !is_quoted(n) ? parse_duration(n.Scalar()) : std::nullopt;
-  // A zero minimum means "strictly positive"; any other minimum is inclusive.
-  const bool ok = d && (min.count() == 0 ? *d > min : *d >= min) && *d <= max;
+  const bool zero_allowed = min.count() < 0;
+  // A zero minimum means "strictly positive", a negative one "zero or more"; any other minimum is
+  // inclusive.
+  if (min.count() < 0) min = core::Duration::zero();
+  const bool strict = min.count() == 0 && !zero_allowed;
+  const bool ok = d && (strict ? *d > min : *d >= min) && *d <= max;
   if (!ok) {
-    const std::string range = min.count() == 0 ? "> 0 (at most " + format_duration(max) + ")"
-                                               : "in " + format_duration(min) + ".." + format_duration(max);
+    const std::string range = strict ? "> 0 (at most " + format_duration(max) + ")"
+                            : zero_allowed ? "in 0.." + format_duration(max)
+                                           : "in " + format_duration(min) + ".." + format_duration(max);
     src.error(n.Mark(), path,
               "must be a duration " + range + " such as 250us, 1ms, 0.5s or 2s (a bare number is seconds)" + got(n));
     return std::nullopt;

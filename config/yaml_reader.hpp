@@ -55,7 +55,7 @@ std::optional<double> read_number(const YAML::Node& n, const std::string& path, 
 std::optional<std::int64_t> read_integer(const YAML::Node& n, const std::string& path, const Source& src,
                                          std::int64_t lo, std::int64_t hi, std::string_view words = "an integer");
 std::optional<std::string> read_string(const YAML::Node& n, const std::string& path, const Source& src);
-// A duration in min..max; a zero `min` means strictly positive.
+// A duration in min..max; a zero `min` means strictly positive, a negative one zero or more.
 std::optional<core::Duration> read_duration(const YAML::Node& n, const std::string& path, const Source& src,
                                             core::Duration min, core::Duration max);
 

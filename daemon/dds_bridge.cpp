@@ -213,7 +213,7 @@ class DdsBridge::Impl : private dds::DataWriterListener, private dds::DataReader
   void take_gateway_infos();
   void collect_outbox(Clock::time_point now);
   void write_replies(Clock::time_point now);
-  void publish_states();
+  void publish_states(Clock::time_point now);
   // axis_link of the axis whose snapshot is `s`, when its link state or detail changed.
   void publish_link(std::size_t axis_id, const core::AxisSnapshot& s);
   void publish_bus_status();
@@ -280,6 +280,13 @@ class DdsBridge::Impl : private dds::DataWriterListener, private dds::DataReader
   std::set<std::uint64_t> warned_instances_;                         // other instances of this gateway
   Outbox outbox_;
   std::uint64_t state_seq_ = 0;
+  // What axis_state last carried per axis, and when (status_keepalive).
+  struct PublishedState {
+    bool written = false;
+    core::AxisSnapshot snapshot;
+    Clock::time_point at{};
+  };
+  std::vector<PublishedState> states_;
   // The link state and detail last written on axis_link, per axis.
   struct PublishedLink {
     bool written = false;
@@ -343,6 +350,7 @@ void DdsBridge::Impl::start() {
                  e.what());
   }
   links_.assign(rt_.axes().size(), PublishedLink{});
+  states_.assign(rt_.axes().size(), PublishedState{});
   const auto arrival = dds::StatusMask::data_available();
   cmd_r_ = &node_->reader(msg::TopicId::AxisCommand, this, arrival);
   sp_r_ = &node_->reader(msg::TopicId::Setpoint, this, arrival);
@@ -419,7 +427,7 @@ void DdsBridge::Impl::run() {
     write_replies(t);
     forget_gone_clients();
     if (t >= next_state) {
-      publish_states();
+      publish_states(t);
       next_state += state_period;
       if (next_state < t) next_state = t + state_period;  // fell behind: do not burst to catch up
     }
@@ -863,13 +871,29 @@ void DdsBridge::Impl::log_summary(Clock::time_point now) {
   summary_clients_.clear();
 }
 
-void DdsBridge::Impl::publish_states() {
+namespace {
+// What a client sees of a state on axis_state: everything but the stamp and the cycle.
+bool same_published_state(const core::AxisSnapshot& a, const core::AxisSnapshot& b) {
+  return a.state == b.state && a.link == b.link && a.mode == b.mode && a.position == b.position &&
+         a.velocity == b.velocity && a.torque == b.torque && a.fault_code == b.fault_code &&
+         a.fault_text.view() == b.fault_text.view() && a.target_reached == b.target_reached && a.homed == b.homed &&
+         a.warning == b.warning && a.stopping == b.stopping && a.following_error == b.following_error &&
+         a.statusword == b.statusword && a.active_command == b.active_command;
+}
+}  // namespace
+
+void DdsBridge::Impl::publish_states(Clock::time_point now) {
   const auto axes = rt_.axes();
   msg::AxisState out;
   out.gateway(gateway_);
   ++state_seq_;
+  std::size_t written = 0;
   for (std::size_t i = 0; i < axes.size(); ++i) {
     const core::AxisSnapshot s = rt_.snapshot(i);
+    publish_link(i, s);
+    // An unchanged state waits for its keep-alive (a new client's first read waits for it too).
+    PublishedState& last = states_[i];
+    if (last.written && now - last.at < opt_.status_keepalive && same_published_state(last.snapshot, s)) continue;
     out.axis(axes[i].name);
     out.state(std::string(core::to_string(s.state)));
     out.link(std::string(core::to_string(s.link)));
@@ -889,10 +913,11 @@ void DdsBridge::Impl::publish_states() {
     out.active_command(s.active_command);
     out.stamp(s.stamp_ns);
     out.seq(state_seq_);
-    state_w_->write(&out);
-    publish_link(i, s);
+    if (!state_w_->write(&out)) continue;
+    last = {true, s, now};
+    ++written;
   }
-  count([&](Stats& st) { st.states_published += axes.size(); });
+  count([&](Stats& st) { st.states_published += written; });
 }
 
 void DdsBridge::Impl::publish_link(std::size_t axis_id, const core::AxisSnapshot& s) {

@@ -25,6 +25,8 @@ struct DdsBridgeOptions {
   std::uint32_t domain = 0;
   std::string ns = "drivegate";  // topic names are "<ns>/<topic>"
   double status_rate_hz = 50;    // axis_state rate; bus_status goes at min(1 Hz, this)
+  // An unchanged axis state is written again after this long (0: every period).
+  std::chrono::nanoseconds status_keepalive = std::chrono::milliseconds(250);
   std::string profiles_file;     // Fast DDS XML profiles (idl/dds_node.hpp)
   std::string profile;
   std::vector<std::string> interfaces;  // UDPv4 on these only

@@ -295,6 +295,7 @@ int run(const Args& args) {
   dds.domain = static_cast<std::uint32_t>(plan.gateway.domain);
   dds.ns = plan.gateway.ns;
   dds.status_rate_hz = plan.gateway.status_rate_hz;
+  dds.status_keepalive = plan.gateway.status_keepalive;
   dds.profiles_file = plan.gateway.dds_profiles_file;
   dds.profile = plan.gateway.dds_profile;
   dds.interfaces = plan.gateway.dds_interfaces;

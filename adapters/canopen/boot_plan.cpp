@@ -202,7 +202,7 @@ WatchOutcome watch_outcome(config::GatewayWatch watch, std::uint8_t found) noexc
   return WatchOutcome::Unwatched;
 }
 
-NodePdoConfig build_pdo_config(const config::AxisPlan& axis) {
+NodePdoConfig build_pdo_config(const config::AxisPlan& axis, core::Duration rpdo_refresh) {
   NodePdoConfig out;
   const auto node = static_cast<NodeId>(axis.address);
   const auto& dev = axis.device.section<config::CanopenDeviceSpec>();
@@ -217,6 +217,7 @@ NodePdoConfig build_pdo_config(const config::AxisPlan& axis) {
     c.layout = layout_of(p);
     c.transmission_type = static_cast<std::uint8_t>(p.transmission_type);
     c.dlc = static_cast<std::uint8_t>(p.dlc);
+    c.refresh = rpdo_refresh;
     out.rpdos.push_back(c);
   }
   for (const auto& p : dev.tpdos) {

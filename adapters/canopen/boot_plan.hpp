@@ -33,6 +33,7 @@ struct NodePdoConfig {
   std::vector<RpdoConfig> rpdos;
   std::vector<TpdoConfig> tpdos;
 };
-NodePdoConfig build_pdo_config(const config::AxisPlan& axis);
+// The node's PDOs from its device profile; synchronous RPDOs get the bus' rpdo_refresh.
+NodePdoConfig build_pdo_config(const config::AxisPlan& axis, core::Duration rpdo_refresh);
 
 }  // namespace drivegate::canopen

@@ -107,7 +107,7 @@ CanopenBus::CanopenBus(const config::BusPlan& plan, std::unique_ptr<Transport> t
     n->gateway_watch = config::gateway_watch_of(a);
     n->watchdog = n->gateway_watch == config::GatewayWatch::Guarding ? cia402::ObjectId{0x100C, 0}
                                                                      : cia402::ObjectId{0x1016, 1};
-    const NodePdoConfig pdo = build_pdo_config(a);
+    const NodePdoConfig pdo = build_pdo_config(a, plan.section<config::CanopenBusOptions>().rpdo_refresh);
     if (!n->pdos.configure(pdo.rpdos, pdo.tpdos))
       throw core::BusError("bus '" + name_ + "' axis '" + a.spec.name + "': PDO maps exceed the process image");
     seed_mode_object(a, n->pdos.image());

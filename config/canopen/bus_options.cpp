@@ -91,6 +91,9 @@ std::vector<OptionSpec> canopen_options() {
        "wait before the first retry of a failed drive boot; doubles on every failure", {}},
       {"boot_retry_max", OptionKind::Duration, ms(10), 3600, core::Duration{10s}, "longest wait between boot retries", {}},
       {"sync", OptionKind::Boolean, 0, 0, true, "produce SYNC every cycle_time (needed by synchronous PDOs)", {}},
+      {"rpdo_refresh", OptionKind::Duration, -1, 10, core::Duration{100ms},
+       "a synchronous RPDO goes after a SYNC when its data changed, and unchanged at least this often; "
+       "0 sends every one after every SYNC", {}},
   };
 }
 
@@ -153,6 +156,7 @@ void read_canopen_bus(const MapReader& b, const MapReader& m, BusPlan& bus) {
   c.boot_retry = option<core::Duration>(bus, "boot_retry");
   c.boot_retry_max = option<core::Duration>(bus, "boot_retry_max");
   c.sync = option<bool>(bus, "sync");
+  c.rpdo_refresh = option<core::Duration>(bus, "rpdo_refresh");
 
   check_whole_ms(m, bus, "heartbeat_period", "a heartbeat consumer (1016h)");
   check_whole_ms(m, bus, "drive_heartbeat", "1017h");

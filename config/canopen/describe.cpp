@@ -96,6 +96,10 @@ void describe_canopen_bus(const BusPlan& b, DescribeRows& rows) {
   rows.emplace_back("CAN", link + ", " + std::to_string(c.bitrate / 1000) + " kbit/s, gateway node-ID " +
                                std::to_string(c.gateway_node_id));
   rows.emplace_back("SYNC", c.sync ? "every " + format_duration(b.cycle_time) : std::string{"off"});
+  if (c.sync)
+    rows.emplace_back("sync RPDOs", c.rpdo_refresh > core::Duration::zero()
+                                        ? "after a SYNC when changed, unchanged every " + format_duration(c.rpdo_refresh)
+                                        : std::string{"after every SYNC"});
 }
 
 }  // namespace drivegate::config

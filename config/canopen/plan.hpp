@@ -136,6 +136,9 @@ struct CanopenBusOptions {
   core::Duration boot_retry = std::chrono::seconds(1);       // first back-off after a failed boot
   core::Duration boot_retry_max = std::chrono::seconds(10);  // back-off doubles up to this
   bool sync = true;                    // produce SYNC every cycle
+  // Synchronous RPDOs go after a SYNC when changed, unchanged at least this often; 0 = after every
+  // SYNC (adapters/canopen/master/pdo.hpp RpdoConfig::refresh).
+  core::Duration rpdo_refresh = std::chrono::milliseconds(100);
 };
 
 // The axis' gateway watch: its own option, else its device profile's.

@@ -61,6 +61,74 @@ TEST(NodePdos, SynchronousRpdosFollowEverySyncWithTheConfiguredDlc) {
   EXPECT_EQ(n.pdos.counters().rpdos_sent, 6U);
 }
 
+// rpdo_refresh: after the drive's first TPDO, a synchronous RPDO goes after a SYNC only when its
+// bytes changed or its refresh ran out; before it, and after every enable(), after every SYNC.
+TEST(NodePdos, SynchronousRpdosWithARefreshGoOnlyWhenChangedOrDue) {
+  NordPdos n;
+  n.rpdos[0].refresh = 20ms;
+  n.rpdos[1].refresh = 20ms;
+  ASSERT_TRUE(n.pdos.configure(n.rpdos, n.tpdos));
+  n.pdos.enable(true, kT0);
+  auto& img = n.pdos.image();
+  img.set(obj::kControlword.id, 0x06);
+  const auto sync = [&](core::Duration at) {
+    n.pdos.after_sync(kT0 + at, n.tx);
+    return drain(n.tx);
+  };
+  // Nothing heard from the drive yet: every SYNC, unchanged or not.
+  EXPECT_EQ(sync(0ms).size(), 2U);
+  EXPECT_EQ(sync(4ms).size(), 2U);
+  ASSERT_TRUE(n.pdos.on_frame(make_frame(0x1A0, {0x37, 0x02, 0, 0, 6, 0, 0}), kT0 + 5ms));
+  EXPECT_TRUE(sync(8ms).empty());  // unchanged since 4 ms
+  img.set(obj::kControlword.id, 0x0F);
+  auto frames = sync(12ms);
+  ASSERT_EQ(frames.size(), 1U);  // only the RPDO whose bytes changed
+  EXPECT_EQ(frames[0].id, 0x220U);
+  EXPECT_EQ(payload(frames[0]), (Bytes{0x0F, 0, 0, 0, 0, 0, 0, 0}));
+  EXPECT_TRUE(sync(16ms).empty());
+  // RPDO2 was last sent at 4 ms: due again at 24 ms; RPDO1 (sent at 12 ms) at 32 ms.
+  EXPECT_TRUE(sync(20ms).empty());
+  frames = sync(24ms);
+  ASSERT_EQ(frames.size(), 1U);
+  EXPECT_EQ(frames[0].id, 0x320U);
+  EXPECT_TRUE(sync(28ms).empty());
+  frames = sync(32ms);
+  ASSERT_EQ(frames.size(), 1U);
+  EXPECT_EQ(frames[0].id, 0x220U);
+  EXPECT_EQ(payload(frames[0]), (Bytes{0x0F, 0, 0, 0, 0, 0, 0, 0}));
+  // A drive that comes back (disable, enable: a new boot) gets every RPDO after every SYNC again
+  // until it speaks.
+  n.pdos.enable(false, kT0 + 33ms);
+  n.pdos.enable(true, kT0 + 34ms);
+  EXPECT_EQ(sync(36ms).size(), 2U);
+  EXPECT_EQ(sync(40ms).size(), 2U);
+  ASSERT_TRUE(n.pdos.on_frame(make_frame(0x1A0, {0x37, 0x02, 0, 0, 6, 0, 0}), kT0 + 41ms));
+  EXPECT_TRUE(sync(44ms).empty());
+}
+
+// A frame the queue had no room for is not taken as sent: it goes at the next SYNC.
+TEST(NodePdos, ARefusedRpdoWithARefreshGoesAtTheNextSync) {
+  NordPdos n;
+  n.rpdos[0].refresh = 1s;
+  n.rpdos[1].refresh = 1s;
+  ASSERT_TRUE(n.pdos.configure(n.rpdos, n.tpdos));
+  n.pdos.enable(true, kT0);
+  n.pdos.after_sync(kT0, n.tx);
+  (void)drain(n.tx);
+  ASSERT_TRUE(n.pdos.on_frame(make_frame(0x1A0, {0x37, 0x02, 0, 0, 6, 0, 0}), kT0 + 1ms));
+  n.pdos.image().set(obj::kControlword.id, 0x0F);
+  CanFrame filler;
+  while (n.tx.push(filler)) {
+  }
+  n.pdos.after_sync(kT0 + 4ms, n.tx);
+  EXPECT_EQ(n.pdos.counters().tx_full, 1U);
+  (void)drain(n.tx);
+  n.pdos.after_sync(kT0 + 8ms, n.tx);
+  const auto frames = drain(n.tx);
+  ASSERT_EQ(frames.size(), 1U);
+  EXPECT_EQ(payload(frames[0]), (Bytes{0x0F, 0, 0, 0, 0, 0, 0, 0}));
+}
+
 TEST(NodePdos, TpdoFramesUpdateTheImageWithTheirTime) {
   NordPdos n;
   n.pdos.enable(true, kT0);

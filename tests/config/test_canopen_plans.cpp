@@ -45,6 +45,7 @@ buses:
       boot_retry: 500ms
       boot_retry_max: 30s
       sync: true
+      rpdo_refresh: 0
 axes:
   - name: x
     bus: can0
@@ -94,8 +95,9 @@ TEST(CanopenPlans, BusOptionsAreTyped) {
   EXPECT_EQ(c.boot_retry, core::Duration{500ms});
   EXPECT_EQ(c.boot_retry_max, core::Duration{30s});
   EXPECT_TRUE(c.sync);
+  EXPECT_EQ(c.rpdo_refresh, core::Duration::zero());  // every SYNC
   EXPECT_EQ(std::get<std::string>(b.options.at("transport")), "udp-multicast");
-  EXPECT_EQ(b.options.size(), 16U);
+  EXPECT_EQ(b.options.size(), 17U);
   EXPECT_TRUE(plan.warnings.empty());
 }
 
@@ -118,6 +120,7 @@ axes: [{ name: x, bus: can0, address: 1, device: kollmorgen-akd }]
   EXPECT_EQ(c.boot_retry, core::Duration{1s});
   EXPECT_EQ(c.boot_retry_max, core::Duration{10s});
   EXPECT_TRUE(c.sync);
+  EXPECT_EQ(c.rpdo_refresh, core::Duration{100ms});
   const AxisPlan& x = plan.buses[0].axes[0];
   EXPECT_EQ(x.section<CanopenAxisOptions>().sdo_channel, 1);
   EXPECT_TRUE(x.section<CanopenAxisOptions>().eds.empty());
@@ -297,7 +300,7 @@ buses:
   - name: b
     type: canopen
     cycle_time: 1000500ns
-    options: { heartbeat_period: 30s, heartbeat_misses: 3, boot_retry: 20s, boot_retry_max: 10s, sync: maybe }
+    options: { heartbeat_period: 30s, heartbeat_misses: 3, boot_retry: 20s, boot_retry_max: 10s, sync: maybe, rpdo_refresh: 11s }
 )");
   EXPECT_REPORTED(e, "t.yaml:5:17: buses[0].cycle_time: must be a duration in 1ms..1s");
   EXPECT_REPORTED(e, "t.yaml:6:34: buses[0].options.heartbeat_period: must be whole milliseconds (a heartbeat "
@@ -311,6 +314,7 @@ buses:
                      "must fit a drive's heartbeat consumer time (1016h: at most 65535ms)");
   EXPECT_REPORTED(e, "t.yaml:10:93: buses[1].options.boot_retry_max: must not be shorter than boot_retry (20s), got 10s");
   EXPECT_REPORTED(e, "t.yaml:10:104: buses[1].options.sync: must be true or false, got \"maybe\"");
+  EXPECT_REPORTED(e, "t.yaml:10:125: buses[1].options.rpdo_refresh: must be a duration in 0..10s");
 }
 
 TEST(CanopenPlanErrors, UdpOptionsOnOtherTransportsAreWarnings) {

@@ -169,6 +169,7 @@ TEST(LoadErrors, OutOfRangeValues) {
   dds: { domain: 300, namespace: a-b }
   log_level: loud
   status_rate_hz: 0
+  status_keepalive: -1s
 buses:
   - name: fast
     type: sim
@@ -196,20 +197,21 @@ axes:
   EXPECT_REPORTED(e, "t.yaml:3:34: gateway.dds.namespace: must be a name of 1 to 63 characters from A-Z a-z 0-9 _");
   EXPECT_REPORTED(e, "t.yaml:4:14: gateway.log_level: must be one of trace, debug, info, warn, error, critical, off, got \"loud\"");
   EXPECT_REPORTED(e, "t.yaml:5:19: gateway.status_rate_hz: must be a number in 1..1000 (Hz), got \"0\"");
-  EXPECT_REPORTED(e, "t.yaml:9:17: buses[0].cycle_time: must be a duration in 100us..1s");
-  EXPECT_REPORTED(e, "t.yaml:10:15: buses[0].priority: must be an integer in 0..99, got \"100\"");
-  EXPECT_REPORTED(e, "t.yaml:11:10: buses[0].cpu: must be an integer in -1..1023, got \"-2\"");
-  EXPECT_REPORTED(e, "t.yaml:12:40: buses[0].options.acyclic_latency_cycles: must be an integer in 1..1000");
-  EXPECT_REPORTED(e, "t.yaml:15:17: buses[1].cycle_time: must be a duration in 100us..1s");
-  EXPECT_REPORTED(e, "t.yaml:19:14: axes[0].address: must be an integer in 1..127, got \"200\"");
-  EXPECT_REPORTED(e, "t.yaml:21:22: axes[0].command_timeout: must be a duration > 0");
-  EXPECT_REPORTED(e, "t.yaml:22:26: axes[0].enable_step_timeout: must be a duration > 0");
-  EXPECT_REPORTED(e, "t.yaml:23:19: axes[0].timeout_stop: must be one of quick_stop, halt, got \"brake\"");
-  EXPECT_REPORTED(e, "t.yaml:24:29: axes[0].limits.min_position: must be less than max_position (10), got 10");
-  EXPECT_REPORTED(e, "t.yaml:24:69: axes[0].limits.max_acceleration: must be a number > 0 and at most 1e+12, got \"-1\"");
-  EXPECT_REPORTED(e, "t.yaml:25:24: axes[0].homing.timeout: must be a duration > 0");
-  EXPECT_REPORTED(e, "t.yaml:26:30: axes[0].mechanics.gear_ratio: must be a number in 1e-06..1000000, got \"0\"");
-  EXPECT_REPORTED(e, "t.yaml:26:39: axes[0].mechanics.feed: must be a number in 1e-06..1000000, got \"-5\"");
+  EXPECT_REPORTED(e, "t.yaml:6:21: gateway.status_keepalive: must be a duration in 0..500ms");
+  EXPECT_REPORTED(e, "t.yaml:10:17: buses[0].cycle_time: must be a duration in 100us..1s");
+  EXPECT_REPORTED(e, "t.yaml:11:15: buses[0].priority: must be an integer in 0..99, got \"100\"");
+  EXPECT_REPORTED(e, "t.yaml:12:10: buses[0].cpu: must be an integer in -1..1023, got \"-2\"");
+  EXPECT_REPORTED(e, "t.yaml:13:40: buses[0].options.acyclic_latency_cycles: must be an integer in 1..1000");
+  EXPECT_REPORTED(e, "t.yaml:16:17: buses[1].cycle_time: must be a duration in 100us..1s");
+  EXPECT_REPORTED(e, "t.yaml:20:14: axes[0].address: must be an integer in 1..127, got \"200\"");
+  EXPECT_REPORTED(e, "t.yaml:22:22: axes[0].command_timeout: must be a duration > 0");
+  EXPECT_REPORTED(e, "t.yaml:23:26: axes[0].enable_step_timeout: must be a duration > 0");
+  EXPECT_REPORTED(e, "t.yaml:24:19: axes[0].timeout_stop: must be one of quick_stop, halt, got \"brake\"");
+  EXPECT_REPORTED(e, "t.yaml:25:29: axes[0].limits.min_position: must be less than max_position (10), got 10");
+  EXPECT_REPORTED(e, "t.yaml:25:69: axes[0].limits.max_acceleration: must be a number > 0 and at most 1e+12, got \"-1\"");
+  EXPECT_REPORTED(e, "t.yaml:26:24: axes[0].homing.timeout: must be a duration > 0");
+  EXPECT_REPORTED(e, "t.yaml:27:30: axes[0].mechanics.gear_ratio: must be a number in 1e-06..1000000, got \"0\"");
+  EXPECT_REPORTED(e, "t.yaml:27:39: axes[0].mechanics.feed: must be a number in 1e-06..1000000, got \"-5\"");
 }
 
 TEST(LoadErrors, NonFiniteNumbers) {

@@ -18,6 +18,7 @@ gateway:
   dds: { domain: 7, namespace: plant_a }
   log_level: debug
   status_rate_hz: 100
+  status_keepalive: 0
 buses:
   - name: sim0
     type: sim
@@ -56,6 +57,7 @@ TEST(LoadValid, GatewayAndBus) {
   EXPECT_EQ(plan.gateway.ns, "plant_a");
   EXPECT_EQ(plan.gateway.log_level, "debug");
   EXPECT_DOUBLE_EQ(plan.gateway.status_rate_hz, 100.0);
+  EXPECT_EQ(plan.gateway.status_keepalive, core::Duration::zero());
   ASSERT_EQ(plan.buses.size(), 1U);
   const BusPlan& bus = plan.buses[0];
   EXPECT_EQ(bus.name, "sim0");

@@ -465,6 +465,31 @@ TEST(DdsBridge, StatesArriveAtAboutTheConfiguredRate) {
   EXPECT_EQ(c.buses()[0].cycles, 42U);
 }
 
+// status_keepalive: an unchanged state is written again only after the keep-alive (seq counts the
+// 50 ms periods), a changed one at the next period.
+TEST(DdsBridge, UnchangedStatesWaitForTheKeepAliveChangedOnesGoAtTheNextPeriod) {
+  FakeRuntime rt("gw1", {"x"});
+  auto options = bridge_options(20);
+  options.status_keepalive = std::chrono::seconds(2);
+  daemon::DdsBridge bridge(rt, options);
+  bridge.start();
+  Client c(client_options());
+  ASSERT_TRUE(c.wait_until([&] { return c.state("x").has_value(); }, kTimeout));
+  const std::uint64_t first = c.state("x")->seq;
+  ASSERT_TRUE(c.wait_until([&] { return c.state("x")->seq != first; }, kTimeout));
+  const auto kept_alive = SteadyClock::now();
+  const std::uint64_t second = c.state("x")->seq;
+  // 2 s at 20 Hz: 40 periods (the first sample may have been a keep-alive already under way).
+  EXPECT_GE(second - first, 30U) << "an unchanged state was published again after " << second - first << " periods";
+  EXPECT_DOUBLE_EQ(c.state("x")->position, 1.5);
+
+  rt.set_position(0, 99.0);
+  ASSERT_TRUE(c.wait_until([&] { return c.state("x")->position == 99.0; }, kTimeout));
+  // The next keep-alive would be 2 s after the last one.
+  EXPECT_LT(SteadyClock::now() - kept_alive, std::chrono::milliseconds(1500));
+  EXPECT_LT(c.state("x")->seq - second, 30U);
+}
+
 // axis_link: written when the link state or its detail changes, with the axis' bus, bus type and
 // address; a client that joins later gets the present one (transient-local).
 TEST(DdsBridge, LinkDetailIsPublishedWhenItChanges) {

@@ -113,6 +113,7 @@ core::AxisSnapshot FakeRuntime::snapshot(std::size_t axis_id) const {
   s.position = 10.0 * static_cast<double>(axis_id) + 1.5;
   s.stamp_ns = kStampNs;
   std::lock_guard lock(mutex_);
+  if (const auto p = positions_.find(axis_id); p != positions_.end()) s.position = p->second;
   const auto it = links_.find(axis_id);
   if (it == links_.end()) {
     s.link = core::LinkState::Operational;
@@ -122,6 +123,11 @@ core::AxisSnapshot FakeRuntime::snapshot(std::size_t axis_id) const {
     s.link_since_ns = it->second.link_since_ns;
   }
   return s;
+}
+
+void FakeRuntime::set_position(std::size_t axis_id, double position) {
+  std::lock_guard lock(mutex_);
+  positions_[axis_id] = position;
 }
 
 void FakeRuntime::set_link(std::size_t axis_id, core::LinkState link, std::string_view detail, std::int64_t since_ns) {

@@ -41,6 +41,8 @@ class FakeRuntime final : public daemon::Runtime {
   void push_event(std::size_t axis_id, core::EventKind kind, std::string_view text);
   // The axis' link from now on (default: operational, no detail, since 0 = not known).
   void set_link(std::size_t axis_id, core::LinkState link, std::string_view detail, std::int64_t since_ns);
+  // The axis' position from now on (default: 10 * axis id + 1.5).
+  void set_position(std::size_t axis_id, double position);
   // The stamp of every snapshot: 100 s of gateway monotonic time.
   static constexpr std::int64_t kStampNs = 100'000'000'000;
   struct Received {
@@ -69,6 +71,7 @@ class FakeRuntime final : public daemon::Runtime {
   daemon::Outbox pending_;
   daemon::WakeSignal signal_;  // notified whenever pending_ grows, as the gateway's cycle threads do
   std::map<std::size_t, core::AxisSnapshot> links_;  // link, link_detail, link_since_ns per axis
+  std::map<std::size_t, double> positions_;
 };
 
 }  // namespace drivegate::dds_test

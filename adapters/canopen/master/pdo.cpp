@@ -128,6 +128,7 @@ void NodePdos::restart() noexcept {
   // Event-driven RPDOs go out at the first poll, and inputs are stale until the drive has sent
   // them again.
   for (std::size_t i = 0; i < rpdo_count_; ++i) rpdos_[i].ever_sent = false;
+  heard_ = false;
   for (std::size_t i = 0; i < tpdo_count_; ++i) {
     auto& t = tpdos_[i];
     t.seen = t.due = t.stale = false;
@@ -170,7 +171,8 @@ void NodePdos::after_sync(core::TimePoint now, TxQueue& tx) noexcept {
     if (!synchronous(r.config.transmission_type)) continue;
     std::array<std::uint8_t, 8> bytes{};
     image_.pack(r.config.layout, bytes);
-    send(r, bytes, now, tx);
+    const bool every_sync = r.config.refresh <= core::Duration::zero() || !heard_ || !r.ever_sent;
+    if (every_sync || bytes != r.sent || now - r.sent_at >= r.config.refresh) send(r, bytes, now, tx);
   }
   send_event_driven(now, tx);
   // The cycle that this SYNC closes: a synchronous TPDO that was due and did not come is missed.
@@ -224,6 +226,7 @@ bool NodePdos::on_frame(const CanFrame& frame, core::TimePoint now) noexcept {
     ++counters_.tpdos_received;
     t.received_at = now;
     last_rx_ = now;
+    heard_ = true;
     t.seen = true;
     t.due = t.stale = false;
     // The drive's SYNC phase is the one its frames show (it counts SYNCs from its own start).

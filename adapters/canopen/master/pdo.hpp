@@ -73,9 +73,15 @@ class ProcessImage {
 struct RpdoConfig {  // master -> drive
   std::uint32_t cob_id = 0;
   PdoLayout layout;
-  std::uint8_t transmission_type = 1;  // 0..240: sent after each SYNC; 254/255: on change / event timer
+  std::uint8_t transmission_type = 1;  // 0..240: sent after a SYNC; 254/255: on change / event timer
   core::Duration event_timer{};        // 254/255: resend at least this often (0 = only on change)
   std::uint8_t dlc = 0;                // frame length to send (0 = the mapped length; NORD pads to 8)
+  // 0..240: zero sends the RPDO after every SYNC. Above zero, after a SYNC only when its bytes
+  // changed, and unchanged at least this often. A drive acts on a synchronous RPDO at the SYNC
+  // after it arrives and keeps the last one it had [CiA 301 §7.2.2.2: for RPDOs, types 0..240
+  // all mean "synchronous"; type 0 is the producer's "acyclic: only when changed"]; the bounded
+  // refresh repairs a lost frame and feeds drives that watch RPDO arrival (1400h:05).
+  core::Duration refresh{};
 };
 
 struct TpdoConfig {  // drive -> master
@@ -110,7 +116,9 @@ class NodePdos {
   ProcessImage& image() noexcept { return image_; }
   [[nodiscard]] const ProcessImage& image() const noexcept { return image_; }
 
-  // After a SYNC: queue the synchronous RPDOs (and due event-driven ones).
+  // After a SYNC: queue the synchronous RPDOs (each unless its refresh lets an unchanged one wait)
+  // and the due event-driven ones. Until the drive's first TPDO since enable() (it may not be
+  // operational yet and drop what it gets), every synchronous RPDO goes after every SYNC.
   void after_sync(core::TimePoint now, TxQueue& tx) noexcept;
   // Without SYNC (or between SYNCs): event-driven RPDOs whose data changed or whose timer ran out.
   void poll(core::TimePoint now, TxQueue& tx) noexcept;
@@ -155,6 +163,7 @@ class NodePdos {
 
   ProcessImage image_;
   bool enabled_ = false;
+  bool heard_ = false;  // a TPDO arrived since enable()
   core::TimePoint last_rx_{};
   PdoCounters counters_;
   std::array<RpdoState, kPdosPerDirection> rpdos_{};
