@@ -78,9 +78,10 @@ struct RpdoConfig {  // master -> drive
   std::uint8_t dlc = 0;                // frame length to send (0 = the mapped length; NORD pads to 8)
   // 0..240: zero sends the RPDO after every SYNC. Above zero, after a SYNC only when its bytes
   // changed, and unchanged at least this often. A drive acts on a synchronous RPDO at the SYNC
-  // after it arrives and keeps the last one it had [CiA 301 §7.2.2.2: for RPDOs, types 0..240
-  // all mean "synchronous"; type 0 is the producer's "acyclic: only when changed"]; the bounded
-  // refresh repairs a lost frame and feeds drives that watch RPDO arrival (1400h:05).
+  // after it arrives and keeps the last one it had [CiA 301, RPDO communication parameter
+  // 1400h:02: for an RPDO, types 0..240 all mean "synchronous"; type 0 is the producer's
+  // "acyclic: only when changed"]; the bounded refresh repairs a lost frame and feeds drives
+  // that watch RPDO arrival (1400h:05).
   core::Duration refresh{};
 };
 
