@@ -49,11 +49,7 @@ bool has_capability(int cap) {
   return false;
 }
 
-RunResult ip(const std::vector<std::string>& args) {
-  std::vector<std::string> argv{ip_path()};
-  argv.insert(argv.end(), args.begin(), args.end());
-  return run_program(argv);
-}
+RunResult ip(const std::vector<std::string>& args) { return run_ip(args); }
 
 void must(const RunResult& r, const std::string& what) {
   if (!r.ok()) throw std::runtime_error(what + " failed: " + r.output);
@@ -145,6 +141,12 @@ RunResult run_program(const std::vector<std::string>& argv) {
   }
   result.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return result;
+}
+
+RunResult run_ip(const std::vector<std::string>& args) {
+  std::vector<std::string> argv{ip_path()};
+  argv.insert(argv.end(), args.begin(), args.end());
+  return run_program(argv);
 }
 
 const std::string& netns_unavailable() {

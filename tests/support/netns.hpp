@@ -30,6 +30,8 @@ struct RunResult {
 };
 // Runs a program (no shell) and waits for it.
 RunResult run_program(const std::vector<std::string>& argv);
+// Runs `ip ARGS...` (iproute2, found in the sbin and bin directories).
+RunResult run_ip(const std::vector<std::string>& args);
 
 // The prefix of every object made here, and a fresh unique name with it: "dgt<pid>_<n><kind>".
 inline constexpr const char* kNetnsPrefix = "dgt";

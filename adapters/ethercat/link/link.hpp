@@ -88,7 +88,7 @@ struct LinkCounters {
   std::uint64_t rx_too_short = 0;       // dropped: shorter than kMinFrameBytes
   std::uint64_t rx_too_long = 0;        // dropped: longer than kMaxFrameBytes
   std::uint64_t rx_wrong_ethertype = 0; // dropped: not 88A4h
-  std::uint64_t rx_own = 0;             // dropped: our own outgoing frame seen back
+  std::uint64_t rx_own = 0;             // dropped: an outgoing frame of this host seen back
   std::uint64_t rx_overflow = 0;        // dropped before we saw it: receive queue full
   std::uint64_t link_downs = 0;         // transitions from Up to any down state
   std::uint64_t link_ups = 0;           // recoveries: transitions back to Up

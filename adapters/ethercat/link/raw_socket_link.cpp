@@ -173,7 +173,7 @@ void RawSocketLink::open() {
 bool RawSocketLink::bind_to(int ifindex) noexcept {
   sockaddr_ll address{};
   address.sll_family = AF_PACKET;
-  address.sll_protocol = htons(kEtherTypeEthercat);
+  address.sll_protocol = htons(options_.all_ethertypes ? std::uint16_t{ETH_P_ALL} : kEtherTypeEthercat);
   address.sll_ifindex = ifindex;
   if (::bind(fd_, reinterpret_cast<const sockaddr*>(&address), sizeof address) != 0) {
     bound_ = false;
@@ -235,6 +235,13 @@ LinkState RawSocketLink::refresh() noexcept {
   if ((r.ifr_flags & IFF_UP) == 0) return LinkState::AdminDown;
   // IFF_RUNNING is the operational state: carrier and, for a veth, the peer up.
   if ((r.ifr_flags & IFF_RUNNING) == 0) return LinkState::NoCarrier;
+  if (state() != LinkState::Up) {
+    // The kernel flagged the socket ENETDOWN when the interface went down; unread, that error would
+    // fail the first send after the recovery. Reading SO_ERROR clears it.
+    int pending = 0;
+    len = sizeof pending;
+    ::getsockopt(fd_, SOL_SOCKET, SO_ERROR, &pending, &len);
+  }
   return LinkState::Up;
 }
 

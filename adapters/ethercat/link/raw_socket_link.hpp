@@ -2,8 +2,10 @@
 // The production link: an AF_PACKET SOCK_RAW socket bound to one named Ethernet interface for
 // EtherType 88A4h (DESIGN.md §5), non-blocking, owned by the bus thread.
 //
-// - Our own outgoing frames are not read back: PACKET_IGNORE_OUTGOING (Linux 4.20+); on older
-//   kernels the frames the kernel marks PACKET_OUTGOING are dropped and counted (rx_own).
+// - Outgoing frames are not read back. The kernel never shows a packet socket its own frames, and
+//   shows the frames other local senders put out on the port only to sockets bound to every
+//   EtherType; PACKET_IGNORE_OUTGOING (Linux 4.20+) keeps those away too, and without it (older
+//   kernels) receive() drops what the kernel marks PACKET_OUTGOING and counts it (rx_own).
 // - I/O is batched: send() writes up to kLinkBatch frames per sendmmsg, receive() reads up to
 //   kLinkBatch per recvmmsg straight into the caller's FrameBuffers.
 // - The link going down is a state, not an error: poll_state() reads the interface flags through
@@ -37,8 +39,12 @@ struct RawSocketOptions {
   // by net.core.rmem_max / wmem_max). 1 MiB holds several hundred full frames.
   int receive_buffer_bytes = 1 << 20;
   int send_buffer_bytes = 1 << 20;
-  // PACKET_IGNORE_OUTGOING; false uses the pkttype fallback (what tests use to exercise it).
+  // PACKET_IGNORE_OUTGOING. Only a socket that sees every EtherType (below) is shown outgoing
+  // frames at all; without the option (or before Linux 4.20) they are dropped by their pkttype.
   bool ignore_outgoing = true;
+  // Bind to every EtherType (ETH_P_ALL) instead of 88A4h and drop the others in receive(), counted:
+  // for diagnosis, and for tests of the drop counters. Costs a copy of every frame on the port.
+  bool all_ethertypes = false;
 };
 
 // The reason text of open() failing for lack of CAP_NET_RAW, with the binary's path in the hint.
