@@ -57,7 +57,7 @@ class RawSocketLink final : public Link {
   RawSocketLink(const RawSocketLink&) = delete;
   RawSocketLink& operator=(const RawSocketLink&) = delete;
 
-  // Fails (LinkError, one line starting "ethercat IFACE: ") without CAP_NET_RAW, for a name that is
+  // Fails (LinkError, one line starting "ethercat: ") without CAP_NET_RAW, for a name that is
   // no interface, an interface that is not Ethernet, and one that is administratively down. An
   // interface without carrier opens (state NoCarrier): the slaves may not be powered yet.
   void open() override;
