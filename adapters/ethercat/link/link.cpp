@@ -1,0 +1,68 @@
+#include "adapters/ethercat/link/link.hpp"
+
+namespace drivegate::ethercat {
+
+const char* to_string(FrameCheck c) noexcept {
+  switch (c) {
+    case FrameCheck::Ok: return "ok";
+    case FrameCheck::TooShort: return "too short";
+    case FrameCheck::TooLong: return "too long";
+    case FrameCheck::WrongEtherType: return "wrong EtherType";
+  }
+  return "?";
+}
+
+FrameCheck check_frame(std::span<const std::uint8_t> frame) noexcept {
+  if (frame.size() < kMinFrameBytes) return FrameCheck::TooShort;
+  if (frame.size() > kMaxFrameBytes) return FrameCheck::TooLong;
+  const auto type = static_cast<std::uint16_t>((frame[12] << 8) | frame[13]);
+  return type == kEtherTypeEthercat ? FrameCheck::Ok : FrameCheck::WrongEtherType;
+}
+
+const char* to_string(LinkState s) noexcept {
+  switch (s) {
+    case LinkState::Closed: return "closed";
+    case LinkState::Up: return "up";
+    case LinkState::AdminDown: return "interface down";
+    case LinkState::NoCarrier: return "no carrier";
+    case LinkState::Gone: return "interface gone";
+  }
+  return "?";
+}
+
+const char* to_string(SendStatus s) noexcept {
+  switch (s) {
+    case SendStatus::Sent: return "sent";
+    case SendStatus::Busy: return "busy";
+    case SendStatus::Down: return "down";
+  }
+  return "?";
+}
+
+LinkCounters LinkCounterCells::snapshot() const noexcept {
+  LinkCounters c;
+  c.tx_frames = tx_frames.get();
+  c.tx_invalid = tx_invalid.get();
+  c.tx_busy = tx_busy.get();
+  c.tx_down = tx_down.get();
+  c.rx_frames = rx_frames.get();
+  c.rx_too_short = rx_too_short.get();
+  c.rx_too_long = rx_too_long.get();
+  c.rx_wrong_ethertype = rx_wrong_ethertype.get();
+  c.rx_own = rx_own.get();
+  c.rx_overflow = rx_overflow.get();
+  c.link_downs = link_downs.get();
+  c.link_ups = link_ups.get();
+  return c;
+}
+
+void LinkCounterCells::count_drop(FrameCheck c) noexcept {
+  switch (c) {
+    case FrameCheck::Ok: break;
+    case FrameCheck::TooShort: rx_too_short.add(); break;
+    case FrameCheck::TooLong: rx_too_long.add(); break;
+    case FrameCheck::WrongEtherType: rx_wrong_ethertype.add(); break;
+  }
+}
+
+}  // namespace drivegate::ethercat

@@ -1,0 +1,153 @@
+#pragma once
+// The link an EtherCAT bus thread sends its frames on and reads them back from (DESIGN.md §2 rule 5,
+// §5): it moves whole Ethernet frames (destination, source, EtherType, payload; no FCS) as bytes and
+// does not interpret them beyond the Ethernet header. Implementations: RawSocketLink (AF_PACKET on a
+// named interface, production and veth tests) and MemoryLink (in-process, unit tests and the
+// in-process simulator).
+//
+// send(), receive(), poll_state(), state() and counters() are the cyclic path: non-blocking, no heap
+// allocation, no lock, no logging. open() may allocate and throws LinkError with one line a person
+// can act on. One thread (the bus thread) uses a link; state() and counters() may be read from any.
+#include <array>
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <stdexcept>
+#include <string>
+
+#include "core/clock.hpp"
+
+namespace drivegate::ethercat {
+
+class LinkError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// EtherCAT frames are Ethernet II frames of EtherType 88A4h (ETG.1000.4, frame structure: Ethernet
+// header, then the 2-byte EtherCAT header, then the datagrams).
+inline constexpr std::uint16_t kEtherTypeEthercat = 0x88A4;
+inline constexpr std::size_t kEthernetHeaderBytes = 14;  // destination 6, source 6, EtherType 2 [IEEE 802.3 §3.1.1]
+inline constexpr std::size_t kEthercatHeaderBytes = 2;   // length 11 bits, reserved 1, type 4 (ETG.1000.4)
+// Shorter than an Ethernet header plus the EtherCAT header cannot be an EtherCAT frame. Frames are
+// not padded to the 60-byte Ethernet minimum here: veth does not pad, a NIC pads on its own.
+inline constexpr std::size_t kMinFrameBytes = kEthernetHeaderBytes + kEthercatHeaderBytes;
+// The largest untagged Ethernet frame without FCS: 1500 bytes of payload [IEEE 802.3 §3.2.7].
+inline constexpr std::size_t kMaxFrameBytes = kEthernetHeaderBytes + 1500;
+
+// What a received frame is, by its length and EtherType only.
+enum class FrameCheck : std::uint8_t { Ok, TooShort, TooLong, WrongEtherType };
+const char* to_string(FrameCheck c) noexcept;
+// The EtherType is big-endian at offset 12 [IEEE 802.3 §3.2.6]. A VLAN-tagged frame (8100h) counts
+// as a wrong EtherType: EtherCAT masters send untagged frames.
+[[nodiscard]] FrameCheck check_frame(std::span<const std::uint8_t> frame) noexcept;
+
+// One received frame in memory the caller owns (the socket writes straight into `bytes`).
+struct FrameBuffer {
+  std::array<std::uint8_t, kMaxFrameBytes> bytes{};
+  std::size_t size = 0;
+
+  [[nodiscard]] std::span<const std::uint8_t> view() const noexcept { return {bytes.data(), size}; }
+};
+
+// One frame to send: the whole Ethernet frame.
+using FrameView = std::span<const std::uint8_t>;
+
+enum class LinkState : std::uint8_t {
+  Closed,     // not opened (or closed)
+  Up,         // interface up with carrier: frames can flow
+  AdminDown,  // the interface is administratively down (`ip link set IFACE down`)
+  NoCarrier,  // up, but no carrier: cable unplugged, the first slave or the veth peer is down
+  Gone,       // the interface no longer exists (unplugged USB adapter, deleted veth)
+};
+const char* to_string(LinkState s) noexcept;
+
+enum class SendStatus : std::uint8_t {
+  Sent,  // every valid frame was handed to the interface
+  Busy,  // the transmit queue was full: that frame and the ones after it were not sent
+  Down,  // the link is down or closed: that frame and the ones after it were not sent
+};
+const char* to_string(SendStatus s) noexcept;
+
+// What send() did with its frames, front first: sent + invalid + unsent == frames given. Invalid
+// frames (shorter than kMinFrameBytes or longer than kMaxFrameBytes) are skipped and the rest go on.
+struct SendResult {
+  std::size_t sent = 0;
+  std::size_t invalid = 0;
+  std::size_t unsent = 0;
+  SendStatus status = SendStatus::Sent;
+};
+
+struct LinkCounters {
+  std::uint64_t tx_frames = 0;
+  std::uint64_t tx_invalid = 0;         // refused by send(): too short or too long
+  std::uint64_t tx_busy = 0;            // not sent: transmit queue full
+  std::uint64_t tx_down = 0;            // not sent: link down or closed
+  std::uint64_t rx_frames = 0;          // delivered by receive()
+  std::uint64_t rx_too_short = 0;       // dropped: shorter than kMinFrameBytes
+  std::uint64_t rx_too_long = 0;        // dropped: longer than kMaxFrameBytes
+  std::uint64_t rx_wrong_ethertype = 0; // dropped: not 88A4h
+  std::uint64_t rx_own = 0;             // dropped: an outgoing frame of this host seen back
+  std::uint64_t rx_overflow = 0;        // dropped before we saw it: receive queue full
+  std::uint64_t link_downs = 0;         // transitions from Up to any down state
+  std::uint64_t link_ups = 0;           // recoveries: transitions back to Up
+};
+
+// LinkCounters as relaxed atomics: the bus thread writes them, any thread may read a snapshot. A
+// single writer needs no read-modify-write, so an increment is a relaxed load and store.
+class LinkCounterCell {
+ public:
+  void add(std::uint64_t n = 1) noexcept { v_.store(v_.load(std::memory_order_relaxed) + n, std::memory_order_relaxed); }
+  [[nodiscard]] std::uint64_t get() const noexcept { return v_.load(std::memory_order_relaxed); }
+
+ private:
+  std::atomic<std::uint64_t> v_{0};
+};
+
+struct LinkCounterCells {
+  LinkCounterCell tx_frames, tx_invalid, tx_busy, tx_down;
+  LinkCounterCell rx_frames, rx_too_short, rx_too_long, rx_wrong_ethertype, rx_own, rx_overflow;
+  LinkCounterCell link_downs, link_ups;
+
+  [[nodiscard]] LinkCounters snapshot() const noexcept;
+  // Counts a received frame that check_frame() refused.
+  void count_drop(FrameCheck c) noexcept;
+};
+
+class Link {
+ public:
+  virtual ~Link() = default;
+
+  // Opens the link; throws LinkError with one line that says what is wrong and what to do.
+  virtual void open() = 0;
+  virtual void close() noexcept = 0;
+  [[nodiscard]] virtual bool is_open() const noexcept = 0;
+
+  // Non-blocking send of whole Ethernet frames in order, in as few system calls as the link allows.
+  virtual SendResult send(std::span<const FrameView> frames) noexcept = 0;
+  SendResult send(FrameView frame) noexcept { return send(std::span<const FrameView>(&frame, 1)); }
+
+  // Non-blocking: fills out[0..n) with everything pending (up to out.size()), oldest first, and
+  // returns n. Frames that check_frame() refuses, and our own outgoing frames, are dropped and
+  // counted, never returned.
+  virtual std::size_t receive(std::span<FrameBuffer> out) noexcept = 0;
+
+  // A file descriptor that becomes readable when frames arrive (and reports POLLERR when the link
+  // goes down), or -1. It stays the same from open() to close().
+  [[nodiscard]] virtual int wait_fd() const noexcept = 0;
+
+  // The link state, cheap enough to call every cycle: it asks the kernel at most once per the
+  // link's check interval (and at once after a send or receive error), and recovers the link when
+  // its interface is back. `now` is the bus thread's time.
+  virtual LinkState poll_state(core::TimePoint now) noexcept = 0;
+  // The state poll_state() last saw; any thread.
+  [[nodiscard]] virtual LinkState state() const noexcept = 0;
+
+  // Any thread.
+  [[nodiscard]] virtual LinkCounters counters() const noexcept = 0;
+  // "raw ethernet eth1", "memory link", ...
+  [[nodiscard]] virtual std::string describe() const = 0;
+};
+
+}  // namespace drivegate::ethercat

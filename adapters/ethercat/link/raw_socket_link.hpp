@@ -1,0 +1,111 @@
+#pragma once
+// The production link: an AF_PACKET SOCK_RAW socket bound to one named Ethernet interface for
+// EtherType 88A4h (DESIGN.md §5), non-blocking, owned by the bus thread.
+//
+// - Outgoing frames are not read back. The kernel never shows a packet socket its own frames, and
+//   shows the frames other local senders put out on the port only to sockets bound to every
+//   EtherType; PACKET_IGNORE_OUTGOING (Linux 4.20+) keeps those away too, and without it (older
+//   kernels) receive() drops what the kernel marks PACKET_OUTGOING and counts it (rx_own).
+// - I/O is batched: send() writes up to kLinkBatch frames per sendmmsg, receive() reads up to
+//   kLinkBatch per recvmmsg straight into the caller's FrameBuffers.
+// - The link going down is a state, not an error: poll_state() reads the interface flags through
+//   the socket (so in the socket's network namespace) at most once per check interval, and at once
+//   after ENETDOWN/ENXIO from a send or receive. An interface that went down and up keeps the socket
+//   (the kernel re-attaches it); one that disappeared and came back under the same name gets the
+//   socket bound to it again. The socket, and wait_fd(), stay the same from open() to close().
+#include <linux/if_packet.h>
+#include <net/if.h>
+#include <sys/socket.h>
+#include <sys/uio.h>
+
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <cstddef>
+#include <string>
+
+#include "adapters/ethercat/link/link.hpp"
+
+namespace drivegate::ethercat {
+
+// Frames per sendmmsg / recvmmsg call.
+inline constexpr std::size_t kLinkBatch = 64;
+
+struct RawSocketOptions {
+  std::string interface;
+  // How often poll_state() asks the kernel for the interface flags while nothing failed.
+  core::Duration state_interval = std::chrono::milliseconds(10);
+  // Socket buffer sizes asked for (SO_RCVBUFFORCE / SO_SNDBUFFORCE with CAP_NET_ADMIN, else capped
+  // by net.core.rmem_max / wmem_max). 1 MiB holds several hundred full frames.
+  int receive_buffer_bytes = 1 << 20;
+  int send_buffer_bytes = 1 << 20;
+  // PACKET_IGNORE_OUTGOING. Only a socket that sees every EtherType (below) is shown outgoing
+  // frames at all; without the option (or before Linux 4.20) they are dropped by their pkttype.
+  bool ignore_outgoing = true;
+  // Bind to every EtherType (ETH_P_ALL) instead of 88A4h and drop the others in receive(), counted:
+  // for diagnosis, and for tests of the drop counters. Costs a copy of every frame on the port.
+  bool all_ethertypes = false;
+};
+
+// The reason text of open() failing for lack of CAP_NET_RAW, with the binary's path in the hint.
+std::string no_raw_permission_text(const std::string& interface);
+
+class RawSocketLink final : public Link {
+ public:
+  explicit RawSocketLink(RawSocketOptions options);
+  ~RawSocketLink() override;
+  RawSocketLink(const RawSocketLink&) = delete;
+  RawSocketLink& operator=(const RawSocketLink&) = delete;
+
+  // Fails (LinkError, one line starting "ethercat: ") without CAP_NET_RAW, for a name that is
+  // no interface, an interface that is not Ethernet, and one that is administratively down. An
+  // interface without carrier opens (state NoCarrier): the slaves may not be powered yet.
+  void open() override;
+  void close() noexcept override;
+  [[nodiscard]] bool is_open() const noexcept override { return fd_ >= 0; }
+
+  using Link::send;
+  SendResult send(std::span<const FrameView> frames) noexcept override;
+  std::size_t receive(std::span<FrameBuffer> out) noexcept override;
+  [[nodiscard]] int wait_fd() const noexcept override { return fd_; }
+  LinkState poll_state(core::TimePoint now) noexcept override;
+  [[nodiscard]] LinkState state() const noexcept override { return state_.load(std::memory_order_relaxed); }
+  [[nodiscard]] LinkCounters counters() const noexcept override { return counters_.snapshot(); }
+  [[nodiscard]] std::string describe() const override;
+
+  // Whether the kernel took PACKET_IGNORE_OUTGOING (false: the pkttype fallback drops own frames).
+  [[nodiscard]] bool ignores_outgoing() const noexcept { return ignore_outgoing_; }
+  // The buffer sizes the kernel granted (it reports twice the payload size it accounts for).
+  [[nodiscard]] int receive_buffer_bytes() const noexcept { return rcvbuf_; }
+
+ private:
+  // Reads the interface's index and flags through the socket, binds again when the interface came
+  // back with another index, reads the kernel's drop count; returns the state seen.
+  LinkState refresh() noexcept;
+  bool bind_to(int ifindex) noexcept;
+  void set_state(LinkState s) noexcept;
+  // A send or receive error: what it says about the link (ENETDOWN, ENXIO, ENODEV) makes the next
+  // poll_state() ask the kernel at once.
+  void note_error(int e) noexcept;
+
+  RawSocketOptions options_;
+  std::array<char, IFNAMSIZ> name_{};
+  int fd_ = -1;
+  int ifindex_ = -1;
+  bool bound_ = false;
+  bool ignore_outgoing_ = false;
+  int rcvbuf_ = 0;
+  bool check_now_ = true;
+  core::TimePoint next_check_{};
+  std::atomic<LinkState> state_{LinkState::Closed};
+  LinkCounterCells counters_;
+
+  std::array<mmsghdr, kLinkBatch> tx_msgs_{};
+  std::array<iovec, kLinkBatch> tx_iov_{};
+  std::array<std::size_t, kLinkBatch> tx_frame_of_{};
+  std::array<mmsghdr, kLinkBatch> rx_msgs_{};
+  std::array<iovec, kLinkBatch> rx_iov_{};
+  std::array<sockaddr_ll, kLinkBatch> rx_from_{};
+};
+
+}  // namespace drivegate::ethercat
