@@ -345,6 +345,14 @@ std::size_t encode_sdo_download_expedited(std::span<std::uint8_t> out, std::uint
                  subindex, value, {});
 }
 
+std::size_t encode_sdo_download_value(std::span<std::uint8_t> out, std::uint8_t counter, std::uint16_t index,
+                                      std::uint8_t subindex, std::uint32_t value, std::size_t size) noexcept {
+  if (size == 0 || size > 4) return 0;
+  std::array<std::uint8_t, 4> bytes{};
+  put_u32(bytes, 0, value);
+  return encode_sdo_download_expedited(out, counter, index, subindex, std::span<const std::uint8_t>(bytes).first(size));
+}
+
 std::size_t encode_sdo_download_normal(std::span<std::uint8_t> out, std::uint8_t counter, std::uint16_t index,
                                        std::uint8_t subindex, std::uint32_t complete_size,
                                        std::span<const std::uint8_t> data, bool complete_access) noexcept {

@@ -173,6 +173,9 @@ SdoView decode_sdo_response(std::span<const std::uint8_t> in) noexcept;
 std::size_t encode_sdo_download_expedited(std::span<std::uint8_t> out, std::uint8_t counter, std::uint16_t index,
                                           std::uint8_t subindex, std::span<const std::uint8_t> value,
                                           bool complete_access = false) noexcept;  // value: 1..4 bytes
+// Expedited download of the low `size` (1..4) bytes of `value`, little-endian.
+std::size_t encode_sdo_download_value(std::span<std::uint8_t> out, std::uint8_t counter, std::uint16_t index,
+                                      std::uint8_t subindex, std::uint32_t value, std::size_t size) noexcept;
 // Normal download: complete size, then as much data as this mailbox carries (segments follow for
 // the rest).
 std::size_t encode_sdo_download_normal(std::span<std::uint8_t> out, std::uint8_t counter, std::uint16_t index,
