@@ -14,7 +14,7 @@ set -euo pipefail
 seconds=${1:-60}
 shift || true
 targets=("$@")
-[ ${#targets[@]} -eq 0 ] && targets=(msgpack_frame sdo can_engines eds config)
+[ ${#targets[@]} -eq 0 ] && targets=(msgpack_frame sdo can_engines eds config ethercat_frame ethercat_mailbox ethercat_sii)
 
 src=$(cd "$(dirname "$0")/.." && pwd)
 build=${BUILD_DIR:-$src/../build-fuzz}
