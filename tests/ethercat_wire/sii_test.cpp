@@ -165,7 +165,8 @@ HandImage hand_image() {
   return h;
 }
 
-std::unique_ptr<SiiInfo> parse(const Bytes& b) {
+// The result's string views point into `b`: callers keep the image alive while they use it.
+std::unique_ptr<SiiInfo> parse(std::span<const std::uint8_t> b) {
   auto info = std::make_unique<SiiInfo>();
   parse_sii(b, *info);
   return info;
@@ -234,7 +235,7 @@ TEST(EcatSii, ChecksumMismatchIsAWarning) {
 TEST(EcatSii, MalformedImages) {
   const HandImage h = hand_image();
   {
-    const auto s = parse(Bytes(h.bytes.begin(), h.bytes.begin() + 127));
+    const auto s = parse(std::span<const std::uint8_t>(h.bytes).first(127));
     EXPECT_TRUE(s->has(SiiProblem::ImageTooShort));
     EXPECT_FALSE(s->ok());
     EXPECT_FALSE(s->header_valid);
@@ -283,13 +284,13 @@ TEST(EcatSii, MalformedImages) {
     EXPECT_FALSE(s->has_general);
   }
   {  // image ends right after the DC category: no end marker
-    const auto s = parse(Bytes(h.bytes.begin(), h.bytes.begin() + static_cast<std::ptrdiff_t>(h.end_at)));
+    const auto s = parse(std::span<const std::uint8_t>(h.bytes).first(h.end_at));
     EXPECT_TRUE(s->has(SiiProblem::NoEndCategory));
     EXPECT_TRUE(s->ok());
     EXPECT_EQ(s->pdo_count, 2U);
   }
   {  // image ends inside a category header (one word of it)
-    const auto s = parse(Bytes(h.bytes.begin(), h.bytes.begin() + static_cast<std::ptrdiff_t>(h.txpdo_at + 2)));
+    const auto s = parse(std::span<const std::uint8_t>(h.bytes).first(h.txpdo_at + 2));
     EXPECT_TRUE(s->has(SiiProblem::NoEndCategory));
   }
   {  // a PDO entry naming string 9 of 4
@@ -352,7 +353,7 @@ TEST(EcatSii, BuilderRoundTrip) {
   const SiiBuildResult r = build_sii(p, img);
   ASSERT_TRUE(r.ok()) << to_string(r.error);
   EXPECT_EQ(r.size, 2048U);
-  const auto s = parse(Bytes(img.begin(), img.end()));
+  const auto s = parse(img);
   EXPECT_TRUE(s->ok());
   EXPECT_EQ(s->issue_count, 0U) << to_string(s->issues[0].problem);
   EXPECT_TRUE(s->checksum_ok());
@@ -417,7 +418,7 @@ TEST(EcatSii, BuilderErrors) {
   SiiProfile empty;
   empty.eeprom_bytes = 128 * 2;
   ASSERT_TRUE(build_sii(empty, img).ok());
-  const auto s = parse(Bytes(img.begin(), img.begin() + 256));
+  const auto s = parse(std::span<const std::uint8_t>(img).first(256));
   EXPECT_TRUE(s->ok());
   EXPECT_TRUE(s->has_general);
   EXPECT_EQ(s->string_count, 0U);

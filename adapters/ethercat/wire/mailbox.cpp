@@ -161,7 +161,8 @@ constexpr std::uint8_t kCa = 0x10;  // complete access (initiate) / toggle (segm
 
 std::uint8_t expedited_command(std::uint8_t cs, std::size_t size, bool ca) noexcept {
   // cs in bits 5-7, n = 4 - size in bits 2-3, e = 1, s = 1
-  return static_cast<std::uint8_t>((cs << 5) | ((4 - size) << 2) | 0x03 | (ca ? kCa : 0));
+  const auto unused = static_cast<unsigned>(4 - size);
+  return static_cast<std::uint8_t>((static_cast<unsigned>(cs) << 5) | (unused << 2) | 0x03U | (ca ? kCa : 0U));
 }
 
 }  // namespace
