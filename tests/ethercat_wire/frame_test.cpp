@@ -34,7 +34,7 @@ Bytes single_frame(Bytes datagram) {
 }
 
 TEST(EcatFrame, CommandNamesAndKinds) {
-  // [ETG.1000.4 §5.4 command table]: mnemonic and value of every command.
+  // [ETG.1000.4 §5.4]: mnemonic and value of every command.
   const std::array<std::pair<Command, const char*>, 15> all{{
       {Command::NOP, "NOP"},   {Command::APRD, "APRD"}, {Command::APWR, "APWR"}, {Command::APRW, "APRW"},
       {Command::FPRD, "FPRD"}, {Command::FPWR, "FPWR"}, {Command::FPRW, "FPRW"}, {Command::BRD, "BRD"},
@@ -55,7 +55,7 @@ TEST(EcatFrame, CommandNamesAndKinds) {
 }
 
 TEST(EcatFrame, ExpectedWorkingCounter) {
-  // [ETG.1000.4 §5.4.3]: read +1, write +1, read-write +3 per slave.
+  // [ETG.1000.4 §5.4, working counter of each command]: read +1, write +1, read-write +3 per slave.
   EXPECT_EQ(expected_wkc(Command::APRD, 1), 1);
   EXPECT_EQ(expected_wkc(Command::FPWR, 1), 1);
   EXPECT_EQ(expected_wkc(Command::FPRW, 1), 3);
@@ -79,7 +79,7 @@ TEST(EcatFrame, AutoIncrementAddress) {
   EXPECT_EQ(physical_address(0x1001, 0x0130), 0x01301001U);
 }
 
-// Every command as the only datagram of a frame, byte for byte [ETG.1000.4 §5.4.1].
+// Every command as the only datagram of a frame, byte for byte [ETG.1000.4 §5.4].
 TEST(EcatFrame, EveryCommandByteExact) {
   struct Case {
     Command cmd;

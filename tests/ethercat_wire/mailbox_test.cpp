@@ -1,6 +1,6 @@
 // Mailbox and CoE codecs against the digest's test vectors (dunker-ethercat-coe.md §13 TV-1, TV-4,
 // TV-6) and vectors derived from the CoE specification [ETG.1000.6 §5.6: CoE header, SDO
-// services, emergency, SDO information] and the mailbox header [ETG.1000.4 §5.6].
+// services, emergency, SDO information] and the mailbox header [ETG.1000.6 Table 29].
 #include <gtest/gtest.h>
 
 #include <array>
@@ -50,7 +50,7 @@ TEST(EcatMailbox, HeaderAndCounter) {
   EXPECT_EQ(v.payload.size(), 10U);
   h.counter = 8;
   EXPECT_FALSE(encode_mailbox_header(h, b));
-  // 1..7 cycling, never 0 [ETG.1000.4 §5.6].
+  // 1..7 cycling, never 0 [ETG.1000.6 mailbox header].
   EXPECT_EQ(next_mailbox_counter(0), 1);
   EXPECT_EQ(next_mailbox_counter(1), 2);
   EXPECT_EQ(next_mailbox_counter(6), 7);
@@ -290,7 +290,7 @@ TEST(EcatMailbox, MalformedInput) {
   }
 }
 
-// Mailbox error reply (type 0): type 0001h, detail [ETG.1000.4 §5.6.3].
+// Mailbox error reply (type 0): type 0001h, detail [ETG.1000.6 mailbox error reply].
 TEST(EcatMailbox, ErrorReply) {
   const Bytes reply = hex("04 00 00 00 00 10 01 00 02 00");
   EXPECT_EQ(encoded([](auto out) { return encode_mailbox_error(out, 1, mailbox_error_code::kUnsupportedProtocol); }),

@@ -1,5 +1,5 @@
 // ESC register map, FMMU/SM entries, AL state and AL status codes. Vectors derived from the ESC
-// register layout [ETG.1000.4 §6.7 FMMU, §6.8 SyncManager] and the AL status code table
+// register layout [ETG.1000.4 Table 56 FMMU, Table 59 SyncManager] and the AL status code table
 // [ETG.1000.6 §5.3.2 Table 11].
 #include <gtest/gtest.h>
 

@@ -1,6 +1,5 @@
-// SII EEPROM parser and builder. The hand-built image follows the SII layout [ETG.1000.6 §5.4
-// Table 16 (header words), Table 17 (category header), Tables 18-26 (strings, general, FMMU, SyncM,
-// TXPDO/RXPDO, DC)], written word by word here without the builder.
+// SII EEPROM parser and builder. The hand-built image follows the SII layout [ETG.1000.6 §5.4: header words,
+// category header, strings (Table 20), general (Table 21), FMMU, SyncM, TXPDO/RXPDO, DC], written word by word here without the builder.
 #include <gtest/gtest.h>
 
 #include <array>

@@ -1,6 +1,6 @@
 #pragma once
 // Little-endian field access for the EtherCAT codecs. Every multi-byte EtherCAT field is
-// little-endian on the wire [ETG.1000.4 §5.1 "octets are transferred LSB first"], except the
+// little-endian on the wire [ETG.1000.4 §5: octets are transferred LSB first], except the
 // Ethernet EtherType, which is big-endian [IEEE 802.3 §3.2.6]. Callers check the span size first;
 // these helpers do no bounds checks of their own beyond what std::span's operator[] implies.
 #include <cstddef>

@@ -15,7 +15,7 @@ struct CommandInfo {
   Access access;
 };
 
-// [ETG.1000.4 §5.4 command table]
+// [ETG.1000.4 §5.4]
 constexpr std::array<CommandInfo, kCommandCount> kCommands{{
     {"NOP", "no operation", Addressing::None, Access::None},
     {"APRD", "auto increment physical read", Addressing::AutoIncrement, Access::Read},
@@ -188,7 +188,7 @@ std::span<std::uint8_t> FrameBuilder::finish() noexcept {
   if (state_error_ != BuildError::None || count_ == 0) return {};
   if (!finished_) {
     const auto ecat_len = static_cast<std::uint16_t>(pos_ - kEthernetHeaderSize - kEcatHeaderSize);
-    // Type 1 in bits 12-15, length in bits 0-10 [ETG.1000.4 §5.3.1].
+    // Type 1 in bits 12-15, length in bits 0-10 [ETG.1000.4 §5.3].
     put_u16(buf_, kEthernetHeaderSize, static_cast<std::uint16_t>(ecat_len | (kEcatTypeCommands << 12)));
     if (pos_ < kMinFrameSize) {
       std::fill(buf_.begin() + static_cast<std::ptrdiff_t>(pos_), buf_.begin() + kMinFrameSize, std::uint8_t{0});

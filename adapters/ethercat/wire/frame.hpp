@@ -4,10 +4,10 @@
 //   Ethernet II header   dst(6) src(6) [TPID 8100h + TCI (802.1Q tag, decode only)] EtherType 88A4h (big-endian)
 //   EtherCAT header      u16 LE: bits 0-10 length of the datagrams, bit 11 reserved, bits 12-15 type
 //                        (1 = EtherCAT commands / DLPDU; 4 network variables and 5 mailbox gateway
-//                        are rejected) [ETG.1000.4 §5.3.1 Table 5]
+//                        are rejected) [ETG.1000.4 §5.3]
 //   datagram × n         cmd(1) idx(1) address(4) len(2: bits 0-10 length, bit 14 C circulating,
 //                        bit 15 M more datagrams follow) IRQ(2) | data(length) | WKC(2)
-//                        [ETG.1000.4 §5.4.1 Table 6]
+//                        [ETG.1000.4 §5.4]
 //   padding              to the 60-byte Ethernet minimum (without FCS); not counted in the length
 //
 // The builder writes into a caller's buffer and the parser reads one in place: no allocation.
@@ -21,7 +21,7 @@ namespace drivegate::ethercat {
 
 using MacAddress = std::array<std::uint8_t, 6>;
 
-inline constexpr std::uint16_t kEtherType = 0x88A4;       // ETG.1000.4 §5.3.1
+inline constexpr std::uint16_t kEtherType = 0x88A4;       // ETG.1000.4 §5.3
 inline constexpr std::uint16_t kVlanTpid = 0x8100;        // IEEE 802.1Q
 inline constexpr std::size_t kEthernetHeaderSize = 14;
 inline constexpr std::size_t kVlanTagSize = 4;
@@ -34,12 +34,12 @@ inline constexpr std::size_t kMaxFrameSize = 1514;  // Ethernet maximum without 
 inline constexpr std::uint16_t kMaxEcatLength = 0x7FF;  // 11-bit length field
 // Largest data of one datagram in an untagged frame: 1514 - 14 - 2 - 12.
 inline constexpr std::size_t kMaxDatagramData = kMaxFrameSize - kEthernetHeaderSize - kEcatHeaderSize - kDatagramOverhead;
-inline constexpr std::uint8_t kEcatTypeCommands = 1;  // ETG.1000.4 §5.3.1: type 1 = EtherCAT DLPDU
+inline constexpr std::uint8_t kEcatTypeCommands = 1;  // ETG.1000.4 §5.3: type 1 = EtherCAT DLPDU
 
 // Broadcast destination: EtherCAT slaves forward any destination; masters commonly use it.
 inline constexpr MacAddress kBroadcastMac{0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF};
 
-// Datagram commands [ETG.1000.4 §5.4 Table 7 (CMD field)].
+// Datagram commands [ETG.1000.4 §5.4, one clause per command (APRD: §5.4.1.2 Table 14)].
 enum class Command : std::uint8_t {
   NOP = 0,
   APRD = 1,
@@ -72,18 +72,18 @@ Addressing addressing_of(Command c) noexcept;
 Access access_of(Command c) noexcept;
 
 // Address field: position addressing (APxx/ARMW, BRD..: ADP = position, ADO = register) or
-// logical (LRD/LWR/LRW: one 32-bit address) [ETG.1000.4 §5.4.1].
+// logical (LRD/LWR/LRW: one 32-bit address) [ETG.1000.4 §5.4].
 constexpr std::uint32_t physical_address(std::uint16_t adp, std::uint16_t ado) noexcept {
   return static_cast<std::uint32_t>(adp) | (static_cast<std::uint32_t>(ado) << 16);
 }
 // Auto-increment ADP for the slave at `position` (0-based): each slave increments ADP and the one
-// that sees 0 is addressed, so the master sends -position [ETG.1000.4 §5.4.1.1].
+// that sees 0 is addressed, so the master sends -position [ETG.1000.4 §5.4].
 constexpr std::uint16_t auto_increment_adp(std::uint16_t position) noexcept {
   return static_cast<std::uint16_t>(0x10000U - position);
 }
 
-// Expected working counter [ETG.1000.4 §5.4.3 Table 11: read +1, write +1, read-write: read +1,
-// write +2] for `slaves` slaves that each execute the command successfully. ARMW/FRMW: the
+// Expected working counter [ETG.1000.4 §5.4, working counter of each command: read +1, write +1,
+// read-write: read +1, write +2] for `slaves` slaves that each execute the command successfully. ARMW/FRMW: the
 // addressed slave reads (+1), every other slave writes (+1), so each counts once.
 std::uint16_t expected_wkc(Command c, std::uint16_t slaves) noexcept;
 // Logical read/write over an image: `readers` slaves with inputs in the addressed range, `writers`

@@ -71,7 +71,7 @@ MailboxView decode_mailbox(std::span<const std::uint8_t> in) noexcept {
 // ---- Mailbox error reply ----------------------------------------------------------------------
 
 std::string_view mailbox_error_text(std::uint16_t detail) noexcept {
-  // [ETG.1000.4 §5.6.3 mailbox error reply, detail codes]
+  // [ETG.1000.6 mailbox error reply, detail codes]
   switch (detail) {
     case mailbox_error_code::kSyntax: return "syntax of the 6-byte mailbox header is wrong";
     case mailbox_error_code::kUnsupportedProtocol: return "mailbox protocol not supported";

@@ -1,6 +1,6 @@
 #pragma once
-// Mailbox and CoE codecs [ETG.1000.4 §5.6 (mailbox header, error reply); ETG.1000.6 §5.6 (CoE:
-// header, SDO, emergency, SDO information)].
+// Mailbox and CoE codecs [ETG.1000.6: the mailbox header (listed with the CoE elements, Table 29)
+// and the mailbox error reply; §5.6 CoE: header, SDO, emergency, SDO information].
 //
 //   mailbox header (6)   length u16 (bytes after the header) | address u16 | channel bits 0-5,
 //                        priority bits 6-7 | type bits 0-3, counter bits 4-6 (1..7, 0 = unused)
@@ -26,7 +26,7 @@ inline constexpr std::size_t kSdoHeaderSize = 8;   // command, index, subindex, 
 inline constexpr std::uint16_t kSdoMinMailboxLength = 10;
 inline constexpr std::size_t kSdoSegmentMinData = 7;
 
-// Mailbox types [ETG.1000.4 §5.6 Table: mailbox type].
+// Mailbox types [ETG.1000.6 mailbox header, type field].
 enum class MailboxType : std::uint8_t {
   Error = 0,
   AoE = 1,
@@ -48,7 +48,7 @@ struct MailboxHeader {
   bool operator==(const MailboxHeader&) const = default;
 };
 
-// Counter of the next new message: 1..7, wrapping 7 -> 1, never 0 [ETG.1000.4 §5.6: 0 is
+// Counter of the next new message: 1..7, wrapping 7 -> 1, never 0 [ETG.1000.6 mailbox header: 0 is
 // reserved; a slave repeats the answer to a request whose counter did not change].
 constexpr std::uint8_t next_mailbox_counter(std::uint8_t previous) noexcept {
   return static_cast<std::uint8_t>(previous >= 7 ? 1 : previous + 1);
@@ -80,7 +80,7 @@ struct MailboxView {
 };
 MailboxView decode_mailbox(std::span<const std::uint8_t> in) noexcept;
 
-// ---- Mailbox error reply (type 0) [ETG.1000.4 §5.6.3] -----------------------------------------
+// ---- Mailbox error reply (type 0) [ETG.1000.6 mailbox error reply] -----------------------------------------
 
 namespace mailbox_error_code {
 inline constexpr std::uint16_t kSyntax = 0x0001;
@@ -104,7 +104,7 @@ struct MailboxErrorReply {
 MailboxErrorReply decode_mailbox_error(std::span<const std::uint8_t> in) noexcept;
 std::size_t encode_mailbox_error(std::span<std::uint8_t> out, std::uint8_t counter, std::uint16_t detail) noexcept;
 
-// ---- CoE header [ETG.1000.6 §5.6.1] -------------------------------------------------------------
+// ---- CoE header [ETG.1000.6 §5.6.1 Table 29] -------------------------------------------------------------
 
 enum class CoeService : std::uint8_t {
   Emergency = 1,

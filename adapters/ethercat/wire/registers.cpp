@@ -28,7 +28,7 @@ AlStatus decode_al_status(std::uint16_t v) noexcept {
   return s;
 }
 
-// FMMU layout [ETG.1000.4 §6.7]: logical start u32, length u16, logical start bit u8 (bits 0-2),
+// FMMU layout [ETG.1000.4 Table 56]: logical start u32, length u16, logical start bit u8 (bits 0-2),
 // logical stop bit u8 (bits 0-2), physical start u16, physical start bit u8 (bits 0-2), type u8
 // (bit 0 read, bit 1 write), activate u8 (bit 0), 3 reserved bytes.
 std::array<std::uint8_t, kFmmuEntrySize> encode_fmmu(const FmmuEntry& f) noexcept {
@@ -58,7 +58,7 @@ std::optional<FmmuEntry> decode_fmmu(std::span<const std::uint8_t> in) noexcept 
   return f;
 }
 
-// SyncManager layout [ETG.1000.4 §6.8]: physical start u16, length u16, control u8, status u8,
+// SyncManager layout [ETG.1000.4 Table 59]: physical start u16, length u16, control u8, status u8,
 // activate u8, PDI control u8.
 std::array<std::uint8_t, kSmEntrySize> encode_sm(const SmEntry& s) noexcept {
   std::array<std::uint8_t, kSmEntrySize> b{};

@@ -1,7 +1,7 @@
 #pragma once
-// ESC registers a master uses [ETG.1000.4 §6 (DL information, station address, DL control and
-// status, watchdogs, SII access, FMMU, SyncManager, distributed clocks); ETG.1000.6 §5.3 (AL
-// control/status/status code, PDI control)], the 16-byte FMMU and 8-byte SyncManager entries, and
+// ESC registers a master uses [ETG.1000.4 §6, register map Table 31 (DL information, station
+// address, DL control and status, watchdogs, SII access, FMMU, SyncManager, distributed clocks);
+// ETG.1000.6 §5.3.2 (AL control/status/status code)], the 16-byte FMMU and 8-byte SyncManager entries, and
 // the AL (EtherCAT) state. All register contents are little-endian.
 #include <array>
 #include <cstddef>
@@ -13,7 +13,7 @@
 namespace drivegate::ethercat {
 
 namespace reg {
-// DL information [ETG.1000.4 §6.1]
+// DL information [ETG.1000.4 Table 31]
 inline constexpr std::uint16_t kType = 0x0000;            // u8
 inline constexpr std::uint16_t kRevision = 0x0001;        // u8
 inline constexpr std::uint16_t kBuild = 0x0002;           // u16
@@ -22,7 +22,7 @@ inline constexpr std::uint16_t kSmsSupported = 0x0005;    // u8
 inline constexpr std::uint16_t kRamSize = 0x0006;         // u8, KiB
 inline constexpr std::uint16_t kPortDescriptor = 0x0007; // u8, 2 bits per port
 inline constexpr std::uint16_t kEscFeatures = 0x0008;     // u16
-// Station address [ETG.1000.4 §6.2]
+// Station address [ETG.1000.4 Table 31]
 inline constexpr std::uint16_t kStationAddress = 0x0010;  // u16 configured station address
 inline constexpr std::uint16_t kStationAlias = 0x0012;    // u16 configured station alias
 // Write protection and reset
@@ -32,7 +32,7 @@ inline constexpr std::uint16_t kEscWriteEnable = 0x0030;
 inline constexpr std::uint16_t kEscWriteProtection = 0x0031;
 inline constexpr std::uint16_t kEscResetEcat = 0x0040;
 inline constexpr std::uint16_t kEscResetPdi = 0x0041;
-// Data link layer [ETG.1000.4 §6.3]
+// Data link layer [ETG.1000.4 Table 31; DL status Table 34]
 inline constexpr std::uint16_t kDlControl = 0x0100;       // u32
 inline constexpr std::uint16_t kPhysicalRwOffset = 0x0108;
 inline constexpr std::uint16_t kDlStatus = 0x0110;        // u16
@@ -42,7 +42,7 @@ inline constexpr std::uint16_t kAlStatus = 0x0130;        // u16
 inline constexpr std::uint16_t kAlStatusCode = 0x0134;    // u16
 inline constexpr std::uint16_t kRunLedOverride = 0x0138;
 inline constexpr std::uint16_t kErrLedOverride = 0x0139;
-// PDI [ETG.1000.4 §6.5]
+// PDI [ETG.1000.4 Table 31]
 inline constexpr std::uint16_t kPdiControl = 0x0140;      // u8
 inline constexpr std::uint16_t kEscConfiguration = 0x0141;
 inline constexpr std::uint16_t kPdiConfiguration = 0x0150;
@@ -59,28 +59,28 @@ inline constexpr std::uint16_t kForwardedRxErrorCounter = 0x0308; // 1 byte per 
 inline constexpr std::uint16_t kProcessingUnitErrorCounter = 0x030C;
 inline constexpr std::uint16_t kPdiErrorCounter = 0x030D;
 inline constexpr std::uint16_t kLostLinkCounter = 0x0310;        // 1 byte per port
-// Watchdogs [ETG.1000.4 §6.6]
+// Watchdogs [ETG.1000.4 Table 31; digest §8.2]
 inline constexpr std::uint16_t kWatchdogDivider = 0x0400;         // u16, in 40 ns units minus 2
 inline constexpr std::uint16_t kWatchdogTimePdi = 0x0410;         // u16, in divider ticks
 inline constexpr std::uint16_t kWatchdogTimeProcessData = 0x0420; // u16 SM watchdog, in divider ticks
 inline constexpr std::uint16_t kWatchdogStatusProcessData = 0x0440;  // u16, bit 0: 0 = expired
 inline constexpr std::uint16_t kWatchdogCounterProcessData = 0x0442; // u8
 inline constexpr std::uint16_t kWatchdogCounterPdi = 0x0443;         // u8
-// SII EEPROM interface [ETG.1000.4 §6.4]
+// SII EEPROM interface [ETG.1000.4 Table 48]
 inline constexpr std::uint16_t kSiiConfig = 0x0500;        // u8 EEPROM configuration
 inline constexpr std::uint16_t kSiiPdiAccess = 0x0501;     // u8 EEPROM PDI access state
 inline constexpr std::uint16_t kSiiControl = 0x0502;       // u16 control/status
 inline constexpr std::uint16_t kSiiAddress = 0x0504;       // u32 word address
 inline constexpr std::uint16_t kSiiData = 0x0508;          // 4 or 8 bytes read data
 inline constexpr std::uint16_t kSiiInterfaceEnd = 0x050F;
-// FMMU and SyncManager blocks [ETG.1000.4 §6.7, §6.8]
+// FMMU and SyncManager blocks [ETG.1000.4 Tables 56-59]
 inline constexpr std::uint16_t kFmmu0 = 0x0600;
 inline constexpr std::uint16_t kFmmuSize = 16;
 inline constexpr std::uint16_t kSm0 = 0x0800;
 inline constexpr std::uint16_t kSmSize = 8;
 constexpr std::uint16_t fmmu(unsigned n) noexcept { return static_cast<std::uint16_t>(kFmmu0 + n * kFmmuSize); }
 constexpr std::uint16_t sm(unsigned n) noexcept { return static_cast<std::uint16_t>(kSm0 + n * kSmSize); }
-// Distributed clocks [ETG.1000.4 §6.9]
+// Distributed clocks [ETG.1000.4 Table 31]
 inline constexpr std::uint16_t kDcReceiveTimePort0 = 0x0900;  // u32 each, ports 0..3 at +4
 inline constexpr std::uint16_t kDcReceiveTimePort1 = 0x0904;
 inline constexpr std::uint16_t kDcReceiveTimePort2 = 0x0908;
@@ -106,18 +106,18 @@ inline constexpr std::uint16_t kDcSync0CycleTime = 0x09A0;              // u32 n
 inline constexpr std::uint16_t kDcSync1CycleTime = 0x09A4;              // u32 ns
 inline constexpr std::uint16_t kDcLatch0Control = 0x09A8;
 inline constexpr std::uint16_t kDcLatch1Control = 0x09A9;
-// Process data RAM starts here on every ESC [ETG.1000.4 §6.10].
+// Process data RAM starts here on every ESC [ETG.1000.4 Table 31].
 inline constexpr std::uint16_t kProcessRam = 0x1000;
 }  // namespace reg
 
-// DC activation register 0x0981 bits [ETG.1000.4 §6.9.3].
+// DC activation register 0x0981 bits [ETG.1000.4 §6, DC registers].
 namespace dc_activation {
 inline constexpr std::uint8_t kCyclicOperation = 0x01;
 inline constexpr std::uint8_t kSync0 = 0x02;
 inline constexpr std::uint8_t kSync1 = 0x04;
 }  // namespace dc_activation
 
-// SII control/status 0x0502 bits [ETG.1000.4 §6.4.3].
+// SII control/status 0x0502 bits [ETG.1000.4 Table 48].
 namespace sii_control {
 inline constexpr std::uint16_t kWriteEnable = 0x0001;
 inline constexpr std::uint16_t kEmulation = 0x0020;
@@ -134,7 +134,7 @@ inline constexpr std::uint16_t kWriteError = 0x4000;
 inline constexpr std::uint16_t kBusy = 0x8000;
 }  // namespace sii_control
 
-// DL status 0x0110 bits [ETG.1000.4 §6.3.2]: link and loop state per port.
+// DL status 0x0110 bits [ETG.1000.4 Table 34]: link and loop state per port.
 namespace dl_status {
 inline constexpr std::uint16_t kPdiOperational = 0x0001;
 inline constexpr std::uint16_t kWatchdogStatus = 0x0002;
@@ -146,7 +146,7 @@ constexpr std::uint16_t communication_on_port(unsigned port) noexcept {
 }
 }  // namespace dl_status
 
-// ---- AL state [ETG.1000.6 §5.3.2 Table 9 / AL control and status] ------------------------------
+// ---- AL state [ETG.1000.6 §5.3.2, Table 9 AL control] ------------------------------
 
 enum class AlState : std::uint8_t {
   None = 0,  // not a valid state; an unread or powerless slave answers 0
@@ -176,7 +176,7 @@ constexpr std::uint16_t al_control(AlState s, bool acknowledge = false) noexcept
   return static_cast<std::uint16_t>(static_cast<std::uint16_t>(s) | (acknowledge ? kAlErrorBit : 0));
 }
 
-// ---- FMMU entry (16 bytes) [ETG.1000.4 §6.7 Table: FMMU register] ---------------------------
+// ---- FMMU entry (16 bytes) [ETG.1000.4 Table 56] ---------------------------
 
 namespace fmmu_type {
 inline constexpr std::uint8_t kRead = 0x01;   // inputs: the ESC copies physical memory into the frame
@@ -200,7 +200,7 @@ std::array<std::uint8_t, kFmmuEntrySize> encode_fmmu(const FmmuEntry& f) noexcep
 // nullopt when `in` is shorter than 16 bytes; reserved bits are ignored (masked off).
 std::optional<FmmuEntry> decode_fmmu(std::span<const std::uint8_t> in) noexcept;
 
-// ---- SyncManager entry (8 bytes) [ETG.1000.4 §6.8 Table: SyncManager register] --------------
+// ---- SyncManager entry (8 bytes) [ETG.1000.4 Table 59] --------------
 
 namespace sm_control {
 inline constexpr std::uint8_t kModeBuffered = 0x00;  // bits 0-1: 00 3-buffer
@@ -250,7 +250,7 @@ std::array<std::uint8_t, kSmEntrySize> encode_sm(const SmEntry& s) noexcept;
 std::optional<SmEntry> decode_sm(std::span<const std::uint8_t> in) noexcept;
 
 // System time difference register 0x092C: sign-magnitude, bit 31 set = local copy smaller than the
-// received time [ETG.1000.4 §6.9]. Returns the signed difference in ns.
+// received time [ETG.1000.4 §6, DC registers]. Returns the signed difference in ns.
 constexpr std::int32_t decode_system_time_difference(std::uint32_t raw) noexcept {
   const auto magnitude = static_cast<std::int32_t>(raw & 0x7FFFFFFFU);
   return (raw & 0x80000000U) ? -magnitude : magnitude;

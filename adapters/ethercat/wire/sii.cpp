@@ -479,7 +479,7 @@ SiiBuildResult build_sii(const SiiProfile& p, std::span<std::uint8_t> out) noexc
   std::fill(img.begin(), img.end(), std::uint8_t{0xFF});
   std::fill(img.begin(), img.begin() + kSiiHeaderBytes, std::uint8_t{0});
   Writer w(img);
-  // Fixed header [ETG.1000.6 Table 16].
+  // Fixed header [ETG.1000.6 §5.4].
   w.u16(p.pdi_control);
   w.u16(p.pdi_configuration);
   w.u16(p.sync_impulse_length);

@@ -1,6 +1,6 @@
 #pragma once
-// SII (slave information interface) EEPROM image [ETG.1000.6 §5.4 "SII", Table 16 (fixed
-// header words 0000h-003Fh) and Tables 17-27 (categories)]. The image is a little-endian word
+// SII (slave information interface) EEPROM image [ETG.1000.6 §5.4 "SII coding": fixed
+// header words 0000h-003Fh and the categories (strings Table 20, general Table 21, ...)]. The image is a little-endian word
 // array. Words 00h-07h are the ESC configuration area with a CRC-8 in the low byte of word 07h;
 // from word 40h on come categories, each a type word, a size word (in words) and the data, up to
 // the end category FFFFh.
@@ -17,7 +17,7 @@
 
 namespace drivegate::ethercat {
 
-// Word addresses of the fixed header [ETG.1000.6 Table 16].
+// Word addresses of the fixed header [ETG.1000.6 §5.4].
 namespace sii_word {
 inline constexpr std::uint16_t kPdiControl = 0x0000;
 inline constexpr std::uint16_t kPdiConfiguration = 0x0001;
@@ -45,7 +45,7 @@ inline constexpr std::uint16_t kFirstCategory = 0x0040;
 
 inline constexpr std::size_t kSiiHeaderBytes = 2 * sii_word::kFirstCategory;  // 128
 
-// Mailbox protocols word 001Ch bits [ETG.1000.6 Table 16].
+// Mailbox protocols word 001Ch bits [ETG.1000.6 §5.4].
 namespace mailbox_protocol {
 inline constexpr std::uint16_t kAoE = 0x0001;
 inline constexpr std::uint16_t kEoE = 0x0002;
@@ -65,7 +65,7 @@ inline constexpr std::uint8_t kUploadAtStartup = 0x10;
 inline constexpr std::uint8_t kSdoCompleteAccess = 0x20;
 }  // namespace coe_details
 
-// Category types [ETG.1000.6 Table 17].
+// Category types [ETG.1000.6 §5.4].
 enum class SiiCategory : std::uint16_t {
   Nop = 0,
   Strings = 10,
@@ -83,7 +83,7 @@ enum class SiiCategory : std::uint16_t {
 std::string_view to_string(SiiCategory c) noexcept;
 
 // CRC-8 of the ESC configuration area: polynomial x^8 + x^2 + x + 1 (07h), initial value FFh, no
-// reflection, no final XOR, over the 14 bytes of words 0-6 [ETG.1000.6 §5.4 Table 16, word 7].
+// reflection, no final XOR, over the 14 bytes of words 0-6 [ETG.1000.6 §5.4, word 7 "checksum"].
 std::uint8_t sii_crc8(std::span<const std::uint8_t> bytes) noexcept;
 
 struct SiiIdentity {
@@ -124,7 +124,7 @@ struct SiiGeneral {
 };
 inline constexpr std::size_t kSiiGeneralBytes = 32;
 
-// FMMU category: one usage byte per FMMU [ETG.1000.6 Table 22].
+// FMMU category: one usage byte per FMMU [ETG.1000.6 §5.4].
 namespace sii_fmmu_usage {
 inline constexpr std::uint8_t kUnused = 0x00;
 inline constexpr std::uint8_t kOutputs = 0x01;
@@ -133,7 +133,7 @@ inline constexpr std::uint8_t kSyncMStatus = 0x03;
 inline constexpr std::uint8_t kUnused2 = 0xFF;
 }  // namespace sii_fmmu_usage
 
-// SyncM category element, 8 bytes [ETG.1000.6 Table 23].
+// SyncM category element, 8 bytes [ETG.1000.6 §5.4].
 namespace sii_sm_type {
 inline constexpr std::uint8_t kUnused = 0;
 inline constexpr std::uint8_t kMailboxOut = 1;
@@ -152,7 +152,7 @@ struct SiiSyncManager {
 };
 inline constexpr std::size_t kSiiSyncManagerBytes = 8;
 
-// TXPDO/RXPDO categories: an 8-byte PDO header then 8 bytes per entry [ETG.1000.6 Tables 24, 25].
+// TXPDO/RXPDO categories: an 8-byte PDO header then 8 bytes per entry [ETG.1000.6 §5.4].
 struct SiiPdoEntry {
   std::uint16_t index = 0;
   std::uint8_t subindex = 0;
@@ -176,7 +176,7 @@ struct SiiPdo {
 inline constexpr std::size_t kSiiPdoHeaderBytes = 8;
 inline constexpr std::size_t kSiiPdoEntryBytes = 8;
 
-// DC category element, 24 bytes [ETG.1000.6 Table 26].
+// DC category element, 24 bytes [ETG.1000.6 §5.4].
 struct SiiDc {
   std::uint32_t cycle_time0 = 0;
   std::uint32_t shift_time0 = 0;
