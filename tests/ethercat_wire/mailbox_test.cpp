@@ -241,6 +241,15 @@ TEST(EcatMailbox, ExpeditedUploadAndCompleteAccess) {
   EXPECT_TRUE(decode_sdo_request(cad).sdo.complete_access);
 }
 
+// Abort texts come from the one table CANopen also uses; CoE adds 0601000[3-6]h [ETG.1000.6
+// §5.6.2.7.2].
+TEST(EcatMailbox, AbortTexts) {
+  EXPECT_EQ(sdo_abort_text(0x06020000), "object does not exist in the object dictionary");
+  EXPECT_EQ(sdo_abort_text(0x06010004), "complete access not supported for objects of variable length");
+  EXPECT_EQ(sdo_abort_text(0x06010006), "object mapped to an RxPDO, SDO download blocked");
+  EXPECT_EQ(sdo_abort_text(0x12345678), "unknown abort code");
+}
+
 TEST(EcatMailbox, EncodersRefuseBadArguments) {
   std::array<std::uint8_t, 15> small{};
   EXPECT_EQ(encode_sdo_upload_request(small, 1, 0x1000, 0), 0U);  // needs 16

@@ -235,9 +235,9 @@ FrameParser::FrameParser(std::span<const std::uint8_t> frame) noexcept : frame_(
   std::uint16_t type = be16(at);
   if (type == kVlanTpid) {
     if (frame_.size() < kEthernetHeaderSize + kVlanTagSize) {
-    fail(FrameError::TruncatedEthernet);
-    return;
-  }
+      fail(FrameError::TruncatedEthernet);
+      return;
+    }
     info_.vlan = true;
     info_.vlan_tci = be16(at + 2);
     at += kVlanTagSize;
