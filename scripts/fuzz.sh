@@ -3,6 +3,7 @@
 # on a scratch copy of its seed corpus (fuzz/README.md).
 #
 #   scripts/fuzz.sh [SECONDS] [TARGET...]      TARGET: msgpack_frame sdo can_engines eds config
+#                                              ethercat_frame ethercat_mailbox ethercat_sii
 #
 # Environment: BUILD_DIR (default build-fuzz next to the source tree), WORK_DIR (scratch, default
 # a new mktemp -d), JOBS (ninja -j, default 2).
