@@ -10,12 +10,15 @@ can_engines:   frame records (format in fuzz_can_engines.cpp) for each persona: 
 eds:           copies of tests/config/devices/akd-canopen.eds and of the EDS test corpus
                tests/config/eds/*.eds (number forms, data types, CompactSubObj, a file in the wild).
 config:        a copy of config/demo.yaml.
+ethercat_frame:   EtherCAT frames (ETG.1000.4 §5 layout): one APRD, a multi-datagram frame, a
+                  VLAN-tagged frame, a cyclic LRW + FRMW frame, a frame with C bit, truncated ones.
+ethercat_mailbox: SM1 mailboxes: the digest's TV-6 SDO download, TV-4 emergencies, SDO responses
+                  (expedited, normal, segments, abort), SDO information replies, a mailbox error.
+ethercat_sii:     SII images: a minimal one and one with every category the parser reads.
 """
+import struct
 import pathlib
 import shutil
-
-from can import Message
-from can.interfaces.udp_multicast.utils import pack_message
 
 HERE = pathlib.Path(__file__).resolve().parent
 ROOT = HERE.parent
@@ -29,6 +32,10 @@ def write(target, name, data):
 
 
 def msgpack_seeds():
+    # python-can only here, so the other corpora can be written without it.
+    from can import Message
+    from can.interfaces.udp_multicast.utils import pack_message
+
     msgs = {
         "tpdo": Message(timestamp=1700000000.125, arbitration_id=0x181, is_extended_id=False, data=bytes(range(1, 9))),
         "extended": Message(timestamp=0.0, arbitration_id=0x1ABCDE0, is_extended_id=True, data=b"\xde\xad"),
@@ -101,7 +108,111 @@ def copies():
     shutil.copy(ROOT / "config/demo.yaml", d / "demo.yaml")
 
 
+def ecat_frame(datagrams, vlan=False):
+    """datagrams: (cmd, idx, address, data, wkc, circulating). Ethernet II + EtherCAT header."""
+    body = b""
+    for i, (cmd, idx, adr, data, wkc, circ) in enumerate(datagrams):
+        word = len(data) | (0x4000 if circ else 0) | (0x8000 if i + 1 < len(datagrams) else 0)
+        body += struct.pack("<BBIHH", cmd, idx, adr, word, 0) + data + struct.pack("<H", wkc)
+    eth = b"\xff" * 6 + bytes([2, 0, 0, 0, 0, 1])
+    if vlan:
+        eth += bytes([0x81, 0x00, 0x00, 0x05])
+    f = eth + b"\x88\xa4" + struct.pack("<H", len(body) | 0x1000) + body
+    return f + bytes(max(0, 60 - len(f)))
+
+
+def ethercat_frame_seeds():
+    aprd = ecat_frame([(1, 5, 0x0130FFFF, bytes([0x02, 0x00]), 1, False)])
+    multi = ecat_frame([(7, 0, 0, bytes([0x11]), 3, False), (5, 1, 0x01201001, bytes([2, 0]), 1, False),
+                        (12, 2, 0x00010000, bytes([0x0F, 0, 0x45, 0x23, 0x27, 0]), 3, False)])
+    cyclic = ecat_frame([(14, 3, 0x09101001, bytes(8), 2, False), (12, 4, 0x00010000, bytes(24), 9, False)])
+    write("ethercat_frame", "aprd_al_status", aprd)
+    write("ethercat_frame", "multi_datagram", multi)
+    write("ethercat_frame", "vlan", ecat_frame([(7, 9, 0, bytes(2), 2, False)], vlan=True))
+    write("ethercat_frame", "cyclic_frmw_lrw", cyclic)
+    write("ethercat_frame", "circulating", ecat_frame([(8, 1, 0x01200000, bytes([1, 0]), 0, True)]))
+    write("ethercat_frame", "truncated", multi[:40])
+    write("ethercat_frame", "wrong_ethertype", aprd[:12] + b"\x08\x00" + aprd[14:])
+
+
+def mbx(counter, mtype, payload):
+    return struct.pack("<HHBB", len(payload), 0, 0, (counter << 4) | mtype) + payload
+
+
+def coe(counter, service, body):
+    return mbx(counter, 3, struct.pack("<H", service << 12) + body)
+
+
+def ethercat_mailbox_seeds():
+    h = bytes.fromhex
+    seeds = {
+        # dunker-ethercat-coe.md §13 TV-6 step 3, TV-4 8100h and A000h
+        "tv6_step3": h("0A000000001300202300160110004060"),
+        "tv4_emcy_8100": h("0A000000003300100081110000000000"),
+        "tv4_emcy_a000": coe(1, 1, h("00A0010000000000")),
+        "sdo_download_resp": coe(2, 3, h("6000160100000000")),
+        "sdo_upload_expedited": coe(3, 3, h("4B121C0100160000")),
+        "sdo_upload_normal": coe(4, 3, h("410810000C000000") + b"driv"),
+        "sdo_upload_segment_last": coe(5, 3, h("192D663100000000")),
+        "sdo_download_segment": coe(6, 2, h("01") + b"vegate-f1"),
+        "sdo_abort": coe(7, 2, h("80121C0010000706")),
+        "sdo_upload_ca": coe(1, 2, h("50121C0000000000")),
+        "info_od_list": coe(2, 8, h("82000100") + h("0100") + h("001018104060")),
+        "info_object": coe(3, 8, h("04000000") + h("406006000007") + b"Controlword"),
+        "info_entry": coe(4, 8, h("06000000") + h("60600078030010007F00") + h("000000FBFF0A00") + b"Modes"),
+        "info_error": coe(5, 8, h("07000000") + h("00000206")),
+        "mailbox_error": mbx(1, 0, h("01000200")),
+        "padded_sm1": h("0A000000001300306000160100000000") + bytes([0xFF] * 112),
+    }
+    for name, data in seeds.items():
+        write("ethercat_mailbox", name, data)
+
+
+def crc8(data):
+    crc = 0xFF
+    for b in data:
+        crc ^= b
+        for _ in range(8):
+            crc = ((crc << 1) ^ 0x07) & 0xFF if crc & 0x80 else (crc << 1) & 0xFF
+    return crc
+
+
+def sii_image(categories, size=2048):
+    """ETG.1000.6 §5.4: header words 0-3Fh with the CRC-8 in word 7, then categories."""
+    head = struct.pack("<7H", 0x0C08, 0, 0, 0, 0, 0, 0)
+    head += struct.pack("<H", crc8(head))
+    head += struct.pack("<4I", 0x0F, 0x1A63, 1, 42) + bytes(8)
+    head += struct.pack("<9H", 0, 0, 0, 0, 0x1000, 128, 0x1080, 128, 0x0004)
+    head += bytes(2 * 0x3E - len(head)) + struct.pack("<HH", size // 128 - 1, 1)
+    body = b""
+    for ctype, data in categories:
+        if len(data) % 2:
+            data += b"\x00"
+        body += struct.pack("<HH", ctype, len(data) // 2) + data
+    img = head + body + b"\xff\xff"
+    return img + b"\xff" * (size - len(img))
+
+
+def ethercat_sii_seeds():
+    strings = bytes([3]) + b"\x06Drives" + b"\x09TrioDrive" + b"\x0aStatusword"
+    general = bytes([1, 0, 2, 2, 0, 0x0F, 0, 0, 0, 1, 0, 1]) + bytes(4) + struct.pack("<HH", 0x11, 0) + bytes(12)
+    sms = (struct.pack("<HHBBBB", 0x1000, 128, 0x26, 0, 1, 1) + struct.pack("<HHBBBB", 0x1080, 128, 0x22, 0, 1, 2)
+           + struct.pack("<HHBBBB", 0x1100, 6, 0x64, 0, 1, 3) + struct.pack("<HHBBBB", 0x1180, 6, 0x20, 0, 1, 4))
+    txpdo = struct.pack("<HBBBBH", 0x1A00, 2, 3, 0, 0, 0) + struct.pack("<HBBBBH", 0x6041, 0, 3, 6, 16, 0) \
+        + struct.pack("<HBBBBH", 0x6063, 0, 0, 4, 32, 0)
+    rxpdo = struct.pack("<HBBBBH", 0x1600, 2, 2, 0, 0, 0) + struct.pack("<HBBBBH", 0x6040, 0, 0, 6, 16, 0) \
+        + struct.pack("<HBBBBH", 0x60C1, 1, 0, 4, 32, 0)
+    dc = struct.pack("<IIIhHhBB", 1000000, 0, 0, 0, 0x0300, 1, 0, 0) + bytes(4)
+    write("ethercat_sii", "minimal", sii_image([], size=256))
+    write("ethercat_sii", "full", sii_image([(10, strings), (30, general), (40, bytes([1, 2, 3])), (41, sms),
+                                             (50, txpdo), (51, rxpdo), (60, dc)]))
+    write("ethercat_sii", "header_only", sii_image([])[:128])
+
+
 if __name__ == "__main__":
+    ethercat_frame_seeds()
+    ethercat_mailbox_seeds()
+    ethercat_sii_seeds()
     msgpack_seeds()
     sdo_seeds()
     engines_seeds()

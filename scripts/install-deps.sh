@@ -14,6 +14,7 @@ PACKAGES=(
   openssl                                # scripts/make-pki.sh (DDS Security certificates)
   python3-can                            # reference peer for the UDP multicast CAN bus (tests)
   cyclonedds-dev cyclonedds-tools        # a second DDS implementation: the interoperability test
+  tshark                                 # dissects the EtherCAT frames the codecs write (tests)
 )
 
 missing=()

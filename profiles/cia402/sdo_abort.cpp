@@ -22,6 +22,11 @@ constexpr std::array kAborts = {
     AbortText{0x06010000, "unsupported access to an object"},
     AbortText{0x06010001, "attempt to read a write-only object"},
     AbortText{0x06010002, "attempt to write a read-only object"},
+    // CoE additions [ETG.1000.6 §5.6.2.7.2]; reserved in CiA 301, so shared without conflict.
+    AbortText{0x06010003, "subindex cannot be written, subindex 0 must be 0 for write access"},
+    AbortText{0x06010004, "complete access not supported for objects of variable length"},
+    AbortText{0x06010005, "object length exceeds the mailbox size"},
+    AbortText{0x06010006, "object mapped to an RxPDO, SDO download blocked"},
     AbortText{0x06020000, "object does not exist in the object dictionary"},
     AbortText{0x06040041, "object cannot be mapped to the PDO"},
     AbortText{0x06040042, "the number and length of the objects to be mapped would exceed PDO length"},

@@ -1,0 +1,33 @@
+#pragma once
+// Little-endian field access for the EtherCAT codecs. Every multi-byte EtherCAT field is
+// little-endian on the wire [ETG.1000.4 §5: octets are transferred LSB first], except the
+// Ethernet EtherType, which is big-endian [IEEE 802.3 §3.2.6]. Callers check the span size first;
+// these helpers do no bounds checks of their own beyond what std::span's operator[] implies.
+#include <cstddef>
+#include <cstdint>
+#include <span>
+
+namespace drivegate::ethercat {
+
+inline std::uint16_t get_u16(std::span<const std::uint8_t> b, std::size_t at) noexcept {
+  return static_cast<std::uint16_t>(b[at] | (b[at + 1] << 8));
+}
+inline std::uint32_t get_u32(std::span<const std::uint8_t> b, std::size_t at) noexcept {
+  return static_cast<std::uint32_t>(b[at]) | (static_cast<std::uint32_t>(b[at + 1]) << 8) |
+         (static_cast<std::uint32_t>(b[at + 2]) << 16) | (static_cast<std::uint32_t>(b[at + 3]) << 24);
+}
+inline std::uint64_t get_u64(std::span<const std::uint8_t> b, std::size_t at) noexcept {
+  return static_cast<std::uint64_t>(get_u32(b, at)) | (static_cast<std::uint64_t>(get_u32(b, at + 4)) << 32);
+}
+inline void put_u16(std::span<std::uint8_t> b, std::size_t at, std::uint16_t v) noexcept {
+  b[at] = static_cast<std::uint8_t>(v & 0xFF);
+  b[at + 1] = static_cast<std::uint8_t>(v >> 8);
+}
+inline void put_u32(std::span<std::uint8_t> b, std::size_t at, std::uint32_t v) noexcept {
+  for (std::size_t i = 0; i < 4; ++i) b[at + i] = static_cast<std::uint8_t>((v >> (8 * i)) & 0xFF);
+}
+inline void put_u64(std::span<std::uint8_t> b, std::size_t at, std::uint64_t v) noexcept {
+  for (std::size_t i = 0; i < 8; ++i) b[at + i] = static_cast<std::uint8_t>((v >> (8 * i)) & 0xFF);
+}
+
+}  // namespace drivegate::ethercat
