@@ -297,6 +297,7 @@ TEST_F(RawSocketLinkTest, PeerDownIsNoCarrierAndTheLinkRecovers) {
   EXPECT_EQ(a->counters().link_downs, 1U);
 
   veth_->set_up(VethPair::End::B, true);
+  veth_->wait_up();
   ASSERT_TRUE(wait_state(*a, LinkState::Up, 2000ms)) << to_string(a->state());
   EXPECT_EQ(a->counters().link_ups, 1U);
   ASSERT_TRUE(wait_state(*b, LinkState::Up, 2000ms));
@@ -325,6 +326,7 @@ TEST_F(RawSocketLinkTest, OwnEndDownIsReportedBySendAndStateAndRecovers) {
   EXPECT_EQ(a->receive(out), 0U);
 
   veth_->set_up(VethPair::End::A, true);
+  veth_->wait_up();
   ASSERT_TRUE(wait_state(*a, LinkState::Up, 2000ms)) << to_string(a->state());
   ASSERT_TRUE(wait_state(*b, LinkState::Up, 2000ms));
   EXPECT_EQ(a->send(FrameView(f)).sent, 1U);

@@ -16,6 +16,7 @@
 #include <fstream>
 #include <mutex>
 #include <stdexcept>
+#include <thread>
 
 namespace drivegate::test {
 namespace {
@@ -251,6 +252,24 @@ void VethPair::create() {
   if (ns_b_ != nullptr) must(ip({"link", "set", b_, "netns", ns_b_->name()}), "ip link set " + b_ + " netns");
   set_up(End::A, true);
   set_up(End::B, true);
+  wait_up();
+}
+
+void VethPair::wait_up(std::chrono::milliseconds timeout) const {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  for (;;) {
+    bool up = true;
+    for (const End e : {End::A, End::B}) {
+      const RunResult r = ip_in(e, {"-o", "link", "show", "dev", name(e)});
+      up = up && r.ok() && r.output.find("state UP") != std::string::npos;
+    }
+    if (up) return;
+    if (std::chrono::steady_clock::now() >= deadline)
+      throw std::runtime_error("veth pair " + a_ + "/" + b_ + " not operationally up after " +
+                               std::to_string(timeout.count()) + " ms");
+    // The operational state comes from the kernel's link watch: there is nothing to wait on.
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
 }
 
 void VethPair::remove() {

@@ -89,6 +89,10 @@ class VethPair {
   // Deletes the pair (both ends go), and makes it again with the same names, both up.
   void remove();
   void create();
+  // Waits until both ends are operationally up (`state UP`): the kernel's link watch attaches the
+  // transmit queue only then, some time after `ip link set up`, and drops what is sent before.
+  // create() waits; after set_up(e, true) a test waits with this. Throws after `timeout`.
+  void wait_up(std::chrono::milliseconds timeout = std::chrono::milliseconds(5000)) const;
 
  private:
   RunResult ip_in(End e, const std::vector<std::string>& args) const;
