@@ -28,6 +28,7 @@ const std::vector<std::string>& known_quirks() {
       "mode_object_always_valid",           // NORD §13 step 6, quirk 18: 6060h in RxPDO1 must always
                                             // hold a valid mode (0 is reserved), even before enabling
       "no_transmission_type_255",           // SD6 quirk 3: PDO transmission type 255 is reserved
+      "mode_objects_16bit",                 // ESR/Dunker quirk 1: 6060h/6061h are INTEGER16
   };
   return kQuirks;
 }

@@ -4,6 +4,7 @@
 #include "adapters/canopen/bus_type.hpp"
 #include "adapters/sim/bus_type.hpp"
 #include "config/bus_types.hpp"
+#include "config/ethercat/bus_type.hpp"
 
 namespace drivegate::config {
 
@@ -23,8 +24,8 @@ BusTypeRegistry BusTypeRegistry::builtin() {
   BusTypeRegistry r;
   r.add(sim::bus_type());
   r.add(canopen::bus_type());
-  // EtherCAT configured station addresses; PROFINET device numbers.
-  r.add(known("ethercat", 65535));
+  r.add(ethercat_bus_type());  // profiles' ethercat: sections; no adapter yet
+  // PROFINET device numbers.
   r.add(known("profinet", 65535));
   return r;
 }

@@ -13,6 +13,7 @@
 #include "adapters/canopen/wire/cob_id.hpp"
 #include "config/canopen/bus_options.hpp"
 #include "config/canopen/bus_type.hpp"
+#include "config/ethercat/bus_type.hpp"
 #include "config/canopen/plan.hpp"
 #include "config/loader.hpp"
 #include "profiles/cia402/sdo_abort.hpp"
@@ -387,6 +388,8 @@ const config::BusTypeRegistry& scan_types() {
   static const config::BusTypeRegistry types = [] {
     config::BusTypeRegistry r;
     r.add(config::canopen_bus_type());
+    // Profiles also carry other buses' sections: they are read (and checked) like the daemon does.
+    r.add(config::ethercat_bus_type());
     return r;
   }();
   return types;

@@ -67,8 +67,16 @@ void check_known_type(const YAML::Node& n, const std::string& path, const Source
               hex_text(id) + " is " + std::string{to_string(*known)} + " in CiA 402, got " + std::string{to_string(type)});
 }
 
-// One map entry "INDEX[:SUB] TYPE".
+// One map entry "INDEX[:SUB] TYPE", its type checked against CiA 402.
 std::optional<PdoEntrySpec> read_entry(const YAML::Node& n, const std::string& path, const Source& src) {
+  const auto entry = read_pdo_entry(n, path, src);
+  if (entry) check_known_type(n, path, src, entry->object, entry->type);
+  return entry;
+}
+
+}  // namespace
+
+std::optional<PdoEntrySpec> read_pdo_entry(const YAML::Node& n, const std::string& path, const Source& src) {
   static const std::string kForm =
       "must be \"INDEX[:SUB] TYPE\" such as \"0x6040 u16\" or \"0x60C1:1 i32\" (TYPE one of i8 u8 i16 u16 i32 u32)";
   if (!n.IsScalar()) {
@@ -91,9 +99,10 @@ std::optional<PdoEntrySpec> read_entry(const YAML::Node& n, const std::string& p
                                   did_you_mean(type_word, data_type_names()));
     return std::nullopt;
   }
-  check_known_type(n, path, src, *id, *type);
   return PdoEntrySpec{*id, static_cast<std::uint8_t>(size_of(*type) * 8), *type};
 }
+
+namespace {
 
 struct Mapped {
   cia402::ObjectId id;

@@ -22,6 +22,10 @@ void read_canopen_device(const MapReader& root, DeviceProfile& p, bool cyclic_gi
 // when absent or wrong (the error names the allowed values).
 std::optional<GatewayWatch> read_gateway_watch(const MapReader& parent);
 
+// One PDO map entry "INDEX[:SUB] TYPE" (TYPE i8 u8 i16 u16 i32 u32); the type is not checked
+// against CiA 402 here (the bus type's reader does that, with its device's quirks).
+std::optional<PdoEntrySpec> read_pdo_entry(const YAML::Node& n, const std::string& path, const Source& src);
+
 void read_startup_writes(const MapReader& parent, std::string_view key, const std::optional<ParameterNaming>& naming,
                          std::vector<StartupWrite>& out);
 

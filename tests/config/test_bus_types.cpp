@@ -21,14 +21,14 @@ struct ModuleSection {
   std::string module;
 };
 
-// "ethercat" is known but has no adapter in this build; this registration gives it one.
+// A bus type the build does not have, made by one registration.
 BusTypeInfo ring_bus_type(int& buses_made) {
   BusTypeInfo t;
-  t.name = "ethercat";
+  t.name = "ringbus";
   t.available = true;
   t.max_address = 65535;
-  t.axis_section = "ethercat";
-  t.device_section = "ethercat";
+  t.axis_section = "ringbus";
+  t.device_section = "ringbus";
   t.address_name = "station";
   t.options.push_back({"ring", OptionKind::Integer, 1, 4, std::int64_t{1}, "ring number", {}});
   t.read_bus = [](const MapReader&, const MapReader&, BusPlan& bus) {
@@ -36,14 +36,14 @@ BusTypeInfo ring_bus_type(int& buses_made) {
   };
   t.read_axis = [](const MapReader& axis, const BusPlan&, const DeviceProfile* device, const std::filesystem::path&,
                    AxisPlan& a) {
-    const MapReader m = axis.map("ethercat", Need::Required);
+    const MapReader m = axis.map("ringbus", Need::Required);
     m.check_keys({"slot"});
     a.sections.edit<SlotSection>().slot = static_cast<int>(m.integer("slot", Need::Required, 0, 9).value_or(0));
     if (device && device->section<ModuleSection>().module.empty())
-      axis.error("device", "device \"" + device->name + "\" has no ethercat section");
+      axis.error("device", "device \"" + device->name + "\" has no ringbus section");
   };
   t.read_device = [](const MapReader& root, DeviceProfile& p, bool) {
-    const MapReader m = root.map("ethercat", Need::Optional);
+    const MapReader m = root.map("ringbus", Need::Optional);
     m.check_keys({"module"});
     p.sections.edit<ModuleSection>().module = m.string("module", Need::Required).value_or("");
   };
@@ -73,12 +73,12 @@ units:
   velocity: { unit: position_per_s }
   acceleration: { unit: position_per_s2 }
 cyclic_objects: ["0x6040", "0x6041", "0x607A"]
-ethercat:
+ringbus:
   module: XR-7
 )";
 
 std::string ring_config(const std::string& axes) {
-  return "gateway: { name: g }\nbuses:\n  - { name: r0, type: ethercat, cycle_time: 1ms, options: { ring: 3 } }\n"
+  return "gateway: { name: g }\nbuses:\n  - { name: r0, type: ringbus, cycle_time: 1ms, options: { ring: 3 } }\n"
          "axes:\n" + axes;
 }
 
@@ -97,7 +97,7 @@ TEST_F(BusTypes, OneRegistrationAddsABusType) {
   write("ring-drive.yaml", kProfile);
   const std::string yaml = ring_config(
       "  - { name: x, bus: r0, address: 1001, device: ring-drive, mechanics: { encoder_counts_per_rev: 4096 }, "
-      "ethercat: { slot: 7 } }\n");
+      "ringbus: { slot: 7 } }\n");
   const Plan plan = load_plan_from_string(yaml, "t.yaml", options());
   const BusPlan& bus = plan.buses.at(0);
   EXPECT_EQ(bus.section<RingOptions>().ring, 3);
@@ -118,11 +118,11 @@ TEST_F(BusTypes, OneRegistrationAddsABusType) {
 TEST_F(BusTypes, ItsChecksAndSectionsAreEnforced) {
   write("ring-drive.yaml", kProfile);
   const std::string e = errors_of(
-      ring_config("  - { name: x, bus: r0, address: 1, device: ring-drive, ethercat: { slot: 12 } }\n"
-                  "  - { name: y, bus: r0, address: 1, device: ring-drive, sim: {}, ethercat: { slot: 1 } }\n"),
+      ring_config("  - { name: x, bus: r0, address: 1, device: ring-drive, ringbus: { slot: 12 } }\n"
+                  "  - { name: y, bus: r0, address: 1, device: ring-drive, sim: {}, ringbus: { slot: 1 } }\n"),
       options());
-  EXPECT_REPORTED(e, "t.yaml:5:75: axes[0].ethercat.slot: must be an integer in 0..9, got \"12\"");
-  EXPECT_REPORTED(e, "t.yaml:6:62: axes[1].sim: only allowed for axes on a sim bus; bus is of type ethercat");
+  EXPECT_REPORTED(e, "t.yaml:5:74: axes[0].ringbus.slot: must be an integer in 0..9, got \"12\"");
+  EXPECT_REPORTED(e, "t.yaml:6:62: axes[1].sim: only allowed for axes on a sim bus; bus is of type ringbus");
   EXPECT_REPORTED(e, "t.yaml:6:34: axes[1].address: station 1 on bus \"r0\" is already used by axes[0].address");
   EXPECT_REPORTED(e, "t.yaml:3:5: buses[0]: one axis per ring");
 }
@@ -137,12 +137,12 @@ TEST_F(BusTypes, ProfilesReadTheSectionsOfTheRegisteredTypes) {
     return out;
   };
   EXPECT_FALSE(parse_device_profile(file, problems, types));  // without the registration: an unknown key
-  EXPECT_REPORTED(errors(problems), file.string() + ":9:1: ethercat: unknown field");
+  EXPECT_REPORTED(errors(problems), file.string() + ":9:1: ringbus: unknown field");
   int made = 0;
   types.add(ring_bus_type(made));
   Problems again;
   EXPECT_FALSE(parse_device_profile(file, again, types));
-  EXPECT_REPORTED(errors(again), file.string() + ":11:3: ethercat.slot: unknown field (allowed: module)");
+  EXPECT_REPORTED(errors(again), file.string() + ":11:3: ringbus.slot: unknown field (allowed: module)");
 }
 
 }  // namespace

@@ -1,0 +1,255 @@
+#include "config/ethercat/device_section.hpp"
+
+#include <algorithm>
+#include <cstdio>
+
+#include "config/canopen/device_section.hpp"
+#include "config/object_text.hpp"
+#include "config/text_util.hpp"
+#include "profiles/cia402/standard_types.hpp"
+
+namespace drivegate::config {
+
+namespace {
+
+std::string hex_text(cia402::ObjectId id) {
+  char buf[16];
+  if (id.sub == 0)
+    std::snprintf(buf, sizeof buf, "0x%04X", id.index);
+  else
+    std::snprintf(buf, sizeof buf, "0x%04X:%u", id.index, static_cast<unsigned>(id.sub));
+  return buf;
+}
+
+std::string hex16(std::uint16_t v) {
+  char buf[8];
+  std::snprintf(buf, sizeof buf, "0x%04X", v);
+  return buf;
+}
+
+bool is_mode_object(cia402::ObjectId id) {
+  return id == cia402::obj::kModesOfOperation.id || id == cia402::obj::kModesOfOperationDisplay.id;
+}
+
+// The entry's size against CiA 402, except 6060h/6061h on a device with quirk mode_objects_16bit
+// (ESR/Dunker: INTEGER16, dunker-ethercat-coe.md quirk 1).
+void check_entry_type(const YAML::Node& n, const std::string& path, const Source& src, const PdoEntrySpec& e,
+                      const DeviceProfile& p) {
+  if (is_mode_object(e.object) && p.quirk("mode_objects_16bit")) {
+    if (e.type != cia402::DataType::I16)
+      src.error(n.Mark(), path, hex_text(e.object) + " is INTEGER16 on this device (quirk mode_objects_16bit), got " +
+                                    std::string{to_string(e.type)});
+    return;
+  }
+  const auto known = cia402::profile_object_type(e.object);
+  if (known && size_of(*known) != size_of(e.type))
+    src.error(n.Mark(), path,
+              hex_text(e.object) + " is " + std::string{to_string(*known)} + " in CiA 402, got " +
+                  std::string{to_string(e.type)} +
+                  (is_mode_object(e.object) ? " (a device with 16-bit mode objects needs quirk mode_objects_16bit)" : ""));
+}
+
+std::vector<std::uint16_t> read_indexes(const MapReader& m, const std::string& key, std::uint16_t lo, std::uint16_t hi) {
+  std::vector<std::uint16_t> out;
+  const auto list = m.list(key, Need::Optional);
+  if (!list) return out;
+  for (std::size_t i = 0; i < list->size(); ++i) {
+    const auto v = read_integer((*list)[i], indexed(m.field(key), i), m.source(), lo, hi);
+    if (!v) continue;
+    if (std::find(out.begin(), out.end(), *v) != out.end())
+      m.source().error((*list)[i].Mark(), indexed(m.field(key), i), hex16(static_cast<std::uint16_t>(*v)) + " is listed twice");
+    else
+      out.push_back(static_cast<std::uint16_t>(*v));
+  }
+  return out;
+}
+
+std::vector<cia402::ObjectId> read_objects(const MapReader& m, const std::string& key) {
+  std::vector<cia402::ObjectId> out;
+  const auto list = m.list(key, Need::Optional);
+  if (!list) return out;
+  for (std::size_t i = 0; i < list->size(); ++i) {
+    const YAML::Node n = (*list)[i];
+    const auto id = n.IsScalar() ? parse_object_id(n.Scalar()) : std::nullopt;
+    if (!id)
+      m.source().error(n.Mark(), indexed(m.field(key), i),
+                       "must be an object as \"0x6040\" or \"0x60C1:1\", got " + describe_value(n));
+    else
+      out.push_back(*id);
+  }
+  return out;
+}
+
+void read_identities(const MapReader& e, EthercatDeviceSpec& spec) {
+  const auto list = e.list("identities", Need::Optional);
+  if (!list) return;
+  if (list->size() == 0) e.error("identities", "must list at least one identity (vendor_id, product_code), or be left out");
+  for (std::size_t i = 0; i < list->size(); ++i) {
+    const MapReader m{(*list)[i], indexed(e.field("identities"), i), e.source()};
+    if (!m.present()) continue;
+    m.check_keys({"vendor_id", "product_code", "revision", "name"});
+    const auto vendor = m.integer("vendor_id", Need::Required, 0, 0xFFFFFFFF);
+    const auto product = m.integer("product_code", Need::Required, 0, 0xFFFFFFFF);
+    const auto revision = m.integer("revision", Need::Optional, 0, 0xFFFFFFFF);
+    const auto name = m.string("name", Need::Optional);
+    if (!vendor || !product) continue;
+    EthercatIdentity id;
+    id.vendor_id = static_cast<std::uint32_t>(*vendor);
+    id.product_code = static_cast<std::uint32_t>(*product);
+    if (revision) id.revision = static_cast<std::uint32_t>(*revision);
+    id.name = name.value_or("");
+    spec.identities.push_back(id);
+  }
+}
+
+struct Mapped {
+  cia402::ObjectId id;
+  std::string path;
+};
+
+// rxpdos / txpdos: [{ index: 0x1600, map: ["0x6040 u16", ...] }]
+void read_pdos(const MapReader& e, bool receive, const DeviceProfile& p, EthercatDeviceSpec& spec,
+               std::vector<Mapped>& mapped) {
+  const std::string key = receive ? "rxpdos" : "txpdos";
+  const auto list = e.list(key, Need::Optional);
+  if (!list) return;
+  const Source& src = e.source();
+  // Mapping objects: RxPDO 1600h..17FFh, TxPDO 1A00h..1BFFh [ETG.1000.6 CoE object dictionary].
+  const std::uint16_t lo = receive ? 0x1600 : 0x1A00;
+  const std::uint16_t hi = receive ? 0x17FF : 0x1BFF;
+  const auto& allowed = receive ? spec.rx_pdo_indexes : spec.tx_pdo_indexes;
+  const auto& mappable = receive ? spec.rx_mappable : spec.tx_mappable;
+  auto& out = receive ? spec.rxpdos : spec.txpdos;
+  for (std::size_t i = 0; i < list->size(); ++i) {
+    const MapReader m{(*list)[i], indexed(e.field(key), i), src};
+    if (!m.present()) continue;
+    m.check_keys({"index", "map"});
+    EthercatPdoSpec pdo;
+    if (const auto index = m.integer("index", Need::Required, lo, hi)) {
+      pdo.index = static_cast<std::uint16_t>(*index);
+      if (!allowed.empty() && std::find(allowed.begin(), allowed.end(), pdo.index) == allowed.end()) {
+        std::vector<std::string> names;
+        for (const auto a : allowed) names.push_back(hex16(a));
+        m.error("index", hex16(pdo.index) + " is not a mapping object of this device; it has " + join(names, ", "));
+      }
+      for (const auto& other : out)
+        if (other.index == pdo.index) m.error("index", hex16(pdo.index) + " is assigned twice");
+    }
+    if (const auto entries = m.list("map", Need::Required)) {
+      if (entries->size() == 0) m.error("map", "must map at least one object (leave the PDO out instead)");
+      if (static_cast<int>(entries->size()) > spec.max_entries)
+        m.error("map", std::to_string(entries->size()) + " entries mapped, a PDO of this device holds at most " +
+                           std::to_string(spec.max_entries));
+      for (std::size_t k = 0; k < entries->size(); ++k) {
+        const std::string path = indexed(m.field("map"), k);
+        const auto entry = read_pdo_entry((*entries)[k], path, src);
+        if (!entry) continue;
+        check_entry_type((*entries)[k], path, src, *entry, p);
+        if (!mappable.empty() && std::find(mappable.begin(), mappable.end(), entry->object) == mappable.end()) {
+          src.error((*entries)[k].Mark(), path,
+                    hex_text(entry->object) + " may not be mapped into " + (receive ? "an RxPDO" : "a TxPDO") +
+                        " of this device (its " + (receive ? "rx_mappable" : "tx_mappable") + " list)");
+          continue;
+        }
+        const auto dup = std::find_if(mapped.begin(), mapped.end(), [&](const Mapped& x) { return x.id == entry->object; });
+        if (dup != mapped.end()) {
+          src.error((*entries)[k].Mark(), path, hex_text(entry->object) + " is already mapped in " + dup->path);
+          continue;
+        }
+        mapped.push_back({entry->object, path});
+        pdo.entries.push_back(*entry);
+      }
+    }
+    out.push_back(std::move(pdo));
+  }
+}
+
+bool maps(const std::vector<EthercatPdoSpec>& pdos, cia402::ObjectId id) {
+  return std::any_of(pdos.begin(), pdos.end(), [id](const EthercatPdoSpec& p) {
+    return std::any_of(p.entries.begin(), p.entries.end(), [id](const PdoEntrySpec& e) { return e.object == id; });
+  });
+}
+
+// PDO objects belong to the gateway: a start-up write may not touch them.
+void check_startup_writes(const MapReader& e, const EthercatDeviceSpec& spec) {
+  for (std::size_t i = 0; i < spec.startup_writes.size(); ++i) {
+    const auto id = spec.startup_writes[i].def.id;
+    if ((id.index >= 0x1600 && id.index <= 0x17FF) || (id.index >= 0x1A00 && id.index <= 0x1BFF) ||
+        (id.index >= 0x1C00 && id.index <= 0x1C3F))
+      e.error("startup_writes", hex_text(id) + " is a PDO mapping or assignment object; the PDOs come from rxpdos/txpdos");
+  }
+}
+
+void reconcile_cyclic_objects(const MapReader& root, DeviceProfile& p, bool cyclic_given) {
+  const auto& spec = p.section<EthercatDeviceSpec>();
+  std::vector<cia402::ObjectId> mapped;
+  for (const auto* pdos : {&spec.rxpdos, &spec.txpdos})
+    for (const auto& pdo : *pdos)
+      for (const auto& e : pdo.entries) mapped.push_back(e.object);
+  if (mapped.empty()) return;
+  if (!cyclic_given) {
+    // A profile with a canopen section too derived its image from the canopen maps already: both
+    // buses must then carry the same objects.
+    if (p.cyclic_objects.empty()) {
+      p.cyclic_objects = mapped;
+      return;
+    }
+  }
+  std::vector<std::string> unmapped;
+  std::vector<std::string> unlisted;
+  for (const auto& id : p.cyclic_objects)
+    if (std::find(mapped.begin(), mapped.end(), id) == mapped.end()) unmapped.push_back(hex_text(id));
+  for (const auto& id : mapped)
+    if (std::find(p.cyclic_objects.begin(), p.cyclic_objects.end(), id) == p.cyclic_objects.end())
+      unlisted.push_back(hex_text(id));
+  if (unmapped.empty() && unlisted.empty()) return;
+  std::string message = "the ethercat PDOs must carry exactly the cyclic objects:";
+  if (!unmapped.empty()) message += " not mapped: " + join(unmapped, " ") + (unlisted.empty() ? "" : ";");
+  if (!unlisted.empty()) message += " mapped but not cyclic: " + join(unlisted, " ");
+  root.error("ethercat", message);
+}
+
+}  // namespace
+
+void read_ethercat_device(const MapReader& root, DeviceProfile& p, bool cyclic_given) {
+  const MapReader e = root.map("ethercat", Need::Optional);
+  if (!e.present()) return;
+  auto& spec = p.sections.edit<EthercatDeviceSpec>();
+  spec.present = true;
+  e.check_keys({"identities", "persona", "distributed_clocks", "coe_store", "axes", "axis_offset", "pdo_indexes",
+                "max_entries", "mappable", "rxpdos", "txpdos", "startup_writes", "ignored_writes"});
+  read_identities(e, spec);
+  spec.persona = e.name("persona", Need::Optional).value_or(spec.persona);
+  spec.distributed_clocks = e.boolean("distributed_clocks", Need::Optional).value_or(false);
+  spec.coe_store = e.boolean("coe_store", Need::Optional).value_or(true);
+  spec.axes = static_cast<int>(e.integer("axes", Need::Optional, 1, 8).value_or(1));
+  spec.axis_offset = static_cast<std::uint16_t>(e.integer("axis_offset", Need::Optional, 0x100, 0x800).value_or(0x800));
+  const MapReader indexes = e.map("pdo_indexes", Need::Optional);
+  indexes.check_keys({"rx", "tx"});
+  spec.rx_pdo_indexes = read_indexes(indexes, "rx", 0x1600, 0x17FF);
+  spec.tx_pdo_indexes = read_indexes(indexes, "tx", 0x1A00, 0x1BFF);
+  spec.max_entries = static_cast<int>(e.integer("max_entries", Need::Optional, 1, 254).value_or(254));
+  const MapReader mappable = e.map("mappable", Need::Optional);
+  mappable.check_keys({"rx", "tx"});
+  spec.rx_mappable = read_objects(mappable, "rx");
+  spec.tx_mappable = read_objects(mappable, "tx");
+  std::vector<Mapped> rx;
+  std::vector<Mapped> tx;
+  read_pdos(e, true, p, spec, rx);
+  read_pdos(e, false, p, spec, tx);
+  for (const auto& t : tx)
+    if (const auto r = std::find_if(rx.begin(), rx.end(), [&](const Mapped& x) { return x.id == t.id; }); r != rx.end())
+      e.error("txpdos", hex_text(t.id) + " is also mapped in " + r->path + "; an object is either sent or received");
+  if (!spec.rxpdos.empty() || !spec.txpdos.empty()) {
+    if (!maps(spec.rxpdos, cia402::obj::kControlword.id))
+      e.error("rxpdos", "must map 0x6040 (controlword): the gateway drives every axis through it");
+    if (!maps(spec.txpdos, cia402::obj::kStatusword.id))
+      e.error("txpdos", "must map 0x6041 (statusword): the gateway follows every axis through it");
+  }
+  read_startup_writes(e, "startup_writes", std::nullopt, spec.startup_writes);
+  check_startup_writes(e, spec);
+  spec.ignored_writes = read_objects(e, "ignored_writes");
+  reconcile_cyclic_objects(root, p, cyclic_given);
+}
+
+}  // namespace drivegate::config

@@ -1,0 +1,59 @@
+#pragma once
+// The plan parts of the `ethercat` bus type held in Sections: a device profile's `ethercat:`
+// section (EthercatDeviceSpec; profiles/devices/README.md "EtherCAT"). The bus options and the
+// axis section come with the adapter.
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "config/canopen/plan.hpp"  // PdoEntrySpec, StartupWrite: CoE shares CANopen's objects
+#include "profiles/cia402/objects.hpp"
+
+namespace drivegate::config {
+
+// One identity the slave may show in its SII and 1018h (ETG.1000.6; the ESR and Dunkermotoren
+// brandings of one drive differ: dunker-ethercat-coe.md §10, quirk 17).
+struct EthercatIdentity {
+  std::uint32_t vendor_id = 0;
+  std::uint32_t product_code = 0;
+  std::optional<std::uint32_t> revision;  // absent: any revision
+  std::string name;                       // shown in the scan and mismatch reports
+};
+
+// A PDO of the assignment (1C12h for SM2 outputs, 1C13h for SM3 inputs), its mapping object and
+// entries, written over CoE in PRE-OP: count 0, entries, count [ETG.1000.6 PDO assignment].
+struct EthercatPdoSpec {
+  std::uint16_t index = 0;  // 1600h..17FFh (RxPDO) or 1A00h..1BFFh (TxPDO)
+  std::vector<PdoEntrySpec> entries;
+  [[nodiscard]] int bits() const noexcept {
+    int b = 0;
+    for (const auto& e : entries) b += e.bits;
+    return b;
+  }
+};
+
+struct EthercatDeviceSpec {
+  bool present = false;
+  // The identities it may show; empty: any slave whose 1000h names CiA 402 (generic profiles).
+  std::vector<EthercatIdentity> identities;
+  std::vector<EthercatPdoSpec> rxpdos;       // master -> slave, in 1C12h order
+  std::vector<EthercatPdoSpec> txpdos;       // slave -> master, in 1C13h order
+  // What the device takes: the mapping objects it has, the entries per PDO, and the objects it lets
+  // map per direction (empty: any). ESR/Dunker: 1600h/1601h, 1A00h/1A01h, 8 entries, a whitelist
+  // (dunker-ethercat-coe.md §7.1-§7.3, quirks 3 and 5).
+  std::vector<std::uint16_t> rx_pdo_indexes;
+  std::vector<std::uint16_t> tx_pdo_indexes;
+  int max_entries = 254;  // a mapping object's sub-index 0 is UNSIGNED8; 255 is reserved
+  std::vector<cia402::ObjectId> rx_mappable;
+  std::vector<cia402::ObjectId> tx_mappable;
+  bool distributed_clocks = false;  // csp/csv/cst run on SYNC0; false: free run (ESR/Dunker quirk 9)
+  bool coe_store = true;            // 1010h works; false: everything is written again at every start
+  std::vector<StartupWrite> startup_writes;  // CoE writes in PRE-OP, each read back
+  std::vector<cia402::ObjectId> ignored_writes;  // accepted and silently ignored (quirk 8): read back
+  int axes = 1;                      // axes on one slave, objects offset by axis_offset per axis
+  std::uint16_t axis_offset = 0x800;  // ETG.6010 multi-axis: 6000h + 800h per axis
+  std::string persona = "generic-cia402";  // simulator persona
+};
+
+}  // namespace drivegate::config
