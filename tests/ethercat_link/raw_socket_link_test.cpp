@@ -325,6 +325,16 @@ TEST_F(RawSocketLinkTest, OwnEndDownIsReportedBySendAndStateAndRecovers) {
   std::array<FrameBuffer, 2> out{};
   EXPECT_EQ(a->receive(out), 0U);
 
+  // An invalid frame among them is counted once, as invalid, and the valid ones as unsent.
+  const auto shorty = make_frame(6, 12);
+  const std::array<FrameView, 3> mixed{FrameView(f), FrameView(shorty), FrameView(f)};
+  const SendResult m = a->send(mixed);
+  EXPECT_EQ(m.sent, 0U);
+  EXPECT_EQ(m.invalid, 1U);
+  EXPECT_EQ(m.unsent, 2U);
+  EXPECT_EQ(a->counters().tx_invalid, 1U);
+  EXPECT_EQ(a->counters().tx_down, 4U);
+
   veth_->set_up(VethPair::End::A, true);
   veth_->wait_up();
   ASSERT_TRUE(wait_state(*a, LinkState::Up, 2000ms)) << to_string(a->state());

@@ -139,6 +139,10 @@ TEST(EcatAlStatus, Texts) {
   EXPECT_EQ(al_status_text(0xFFFF), "vendor specific");
   EXPECT_EQ(al_status_text(0x0008), "reserved");
   EXPECT_EQ(al_status_text(0x7FFF), "reserved");
+  // 002Eh as the ETG slave stack code defines it now; 0080h..0083h are in its table; 0005h is not.
+  EXPECT_EQ(al_status_text(0x002E), "cycle time smaller than the minimum cycle time the slave supports");
+  EXPECT_EQ(al_status_text(0x0083), "temperature too high");
+  EXPECT_FALSE(al_status_known(0x0005));
   EXPECT_TRUE(al_status_known(0x001B));
   EXPECT_FALSE(al_status_known(0x8001));
   // Every code from 0x0000 to 0x0070 has a text (table, or "reserved").

@@ -181,6 +181,13 @@ bool RawSocketLink::bind_to(int ifindex) noexcept {
   }
   ifindex_ = ifindex;
   bound_ = true;
+  // Slaves pass a frame on with its destination unchanged: a master that sends to any address
+  // but broadcast or the port's own still gets its frames back. Promiscuous for as long as this
+  // socket lives (the kernel drops the membership with it); without it only such frames are lost.
+  packet_mreq promisc{};
+  promisc.mr_ifindex = ifindex;
+  promisc.mr_type = PACKET_MR_PROMISC;
+  (void)::setsockopt(fd_, SOL_PACKET, PACKET_ADD_MEMBERSHIP, &promisc, sizeof promisc);
   return true;
 }
 
@@ -248,21 +255,28 @@ LinkState RawSocketLink::refresh() noexcept {
 SendResult RawSocketLink::send(std::span<const FrameView> frames) noexcept {
   SendResult r;
   const auto valid = [](FrameView f) { return f.size() >= kMinFrameBytes && f.size() <= kMaxFrameBytes; };
-  // The frames from `from` on are not sent: each counted invalid or unsent.
-  const auto stop = [&](std::size_t from, SendStatus why) {
-    for (std::size_t i = from; i < frames.size(); ++i) {
+  // What is not sent: the staged frames of the batch from position `staged_from` to `staged_end`
+  // (valid ones; the invalid ones among them are counted already) and every frame from `next` on,
+  // not looked at yet (each counted invalid or unsent). Every frame is counted once.
+  const auto stop = [&](std::size_t staged_from, std::size_t staged_end, std::size_t next, SendStatus why) {
+    auto& cell = why == SendStatus::Busy ? counters_.tx_busy : counters_.tx_down;
+    for (std::size_t k = staged_from; k < staged_end; ++k) {
+      ++r.unsent;
+      cell.add();
+    }
+    for (std::size_t i = next; i < frames.size(); ++i) {
       if (!valid(frames[i])) {
         ++r.invalid;
         counters_.tx_invalid.add();
       } else {
         ++r.unsent;
-        (why == SendStatus::Busy ? counters_.tx_busy : counters_.tx_down).add();
+        cell.add();
       }
     }
     r.status = why;
   };
   if (fd_ < 0) {
-    stop(0, SendStatus::Down);
+    stop(0, 0, 0, SendStatus::Down);
     return r;
   }
 
@@ -300,7 +314,7 @@ SendResult RawSocketLink::send(std::span<const FrameView> frames) noexcept {
       }
       note_error(e);
       // A full queue (EAGAIN, ENOBUFS) is Busy; ENETDOWN, ENXIO and anything else is Down.
-      stop(tx_frame_of_[done], (e == EAGAIN || e == EWOULDBLOCK || e == ENOBUFS) ? SendStatus::Busy : SendStatus::Down);
+      stop(done, count, next, (e == EAGAIN || e == EWOULDBLOCK || e == ENOBUFS) ? SendStatus::Busy : SendStatus::Down);
       return r;
     }
   }

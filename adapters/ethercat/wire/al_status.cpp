@@ -10,7 +10,7 @@ struct CodeText {
   std::string_view text;
 };
 
-// [ETG.1000.6 §5.3.2 Table 11; ETG.1020 for 0x0004, 0x0006, 0x0007, 0x000E, 0x002E, 0x0052, 0x0070].
+// [ETG.1000.6 §5.3.2 Table 11; ETG.1020 for 0x0004, 0x0006, 0x0007, 0x000E, 0x002E, 0x0052, 0x0070, 0x0080-0x0083].
 // Sorted by code.
 constexpr std::array kCodes = {
     CodeText{0x0000, "no error"},
@@ -18,7 +18,6 @@ constexpr std::array kCodes = {
     CodeText{0x0002, "no memory"},
     CodeText{0x0003, "invalid device setup"},
     CodeText{0x0004, "invalid revision"},
-    CodeText{0x0005, "reserved (compatibility)"},
     CodeText{0x0006, "SII/EEPROM information does not match the firmware"},
     CodeText{0x0007, "firmware update failed, old firmware still running"},
     CodeText{0x000E, "license error"},
@@ -51,7 +50,9 @@ constexpr std::array kCodes = {
     CodeText{0x002B, "no valid inputs and outputs"},
     CodeText{0x002C, "fatal sync error"},
     CodeText{0x002D, "no sync error"},
-    CodeText{0x002E, "invalid input FMMU configuration"},
+    // Formerly "invalid input FMMU configuration" (as 002Dh was "invalid output FMMU
+    // configuration"); the ETG's slave stack code has this meaning.
+    CodeText{0x002E, "cycle time smaller than the minimum cycle time the slave supports"},
     CodeText{0x0030, "invalid DC SYNC configuration"},
     CodeText{0x0031, "invalid DC latch configuration"},
     CodeText{0x0032, "PLL error"},
@@ -72,6 +73,10 @@ constexpr std::array kCodes = {
     CodeText{0x0060, "slave restarted locally"},
     CodeText{0x0061, "device identification value updated"},
     CodeText{0x0070, "detected module ident list does not match"},
+    CodeText{0x0080, "supply voltage too low"},
+    CodeText{0x0081, "supply voltage too high"},
+    CodeText{0x0082, "temperature too low"},
+    CodeText{0x0083, "temperature too high"},
     CodeText{0x00F0, "application controller available"},
 };
 
