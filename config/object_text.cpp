@@ -1,9 +1,11 @@
 #include "config/object_text.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 
 #include "config/scalars.hpp"
+#include "config/text_util.hpp"
 
 namespace drivegate::config {
 
@@ -53,6 +55,32 @@ std::string_view to_string(cia402::DataType type) noexcept {
   for (const auto& [name, t] : kTypes)
     if (t == type) return name;
   return "?";
+}
+
+std::string object_hex(cia402::ObjectId id) {
+  char buf[16];
+  if (id.sub == 0)
+    std::snprintf(buf, sizeof buf, "0x%04X", id.index);
+  else
+    std::snprintf(buf, sizeof buf, "0x%04X:%u", id.index, static_cast<unsigned>(id.sub));
+  return buf;
+}
+
+std::string cyclic_image_difference(const std::vector<cia402::ObjectId>& mapped,
+                                    const std::vector<cia402::ObjectId>& cyclic, std::string_view cyclic_word) {
+  const auto contains = [](const std::vector<cia402::ObjectId>& v, cia402::ObjectId id) {
+    return std::find(v.begin(), v.end(), id) != v.end();
+  };
+  std::vector<std::string> unmapped;
+  std::vector<std::string> unlisted;
+  for (const auto& id : cyclic)
+    if (!contains(mapped, id)) unmapped.push_back(object_hex(id));
+  for (const auto& id : mapped)
+    if (!contains(cyclic, id)) unlisted.push_back(object_hex(id));
+  std::string out;
+  if (!unmapped.empty()) out += " not mapped: " + join(unmapped, " ") + (unlisted.empty() ? "" : ";");
+  if (!unlisted.empty()) out += " mapped but not " + std::string{cyclic_word} + ": " + join(unlisted, " ");
+  return out;
 }
 
 std::string object_text(cia402::ObjectId id) {

@@ -19,6 +19,12 @@ const std::vector<std::string>& data_type_names();
 std::string_view to_string(cia402::DataType type) noexcept;
 // "6040h", "6099h:1": the form the digests and --check-config use.
 std::string object_text(cia402::ObjectId id);
+// "0x6040", "0x6099:1": the form configuration files write (parse_object_id reads it back).
+std::string object_hex(cia402::ObjectId id);
+// What tells a bus' mapped objects from a profile's cyclic objects, "" when they are the same set:
+// " not mapped: 0x6040 0x6041; mapped but not <cyclic_word>: 0x6064".
+std::string cyclic_image_difference(const std::vector<cia402::ObjectId>& mapped,
+                                    const std::vector<cia402::ObjectId>& cyclic, std::string_view cyclic_word);
 // Lowest and highest value of a type.
 std::int64_t type_min(cia402::DataType type) noexcept;
 std::int64_t type_max(cia402::DataType type) noexcept;

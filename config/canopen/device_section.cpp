@@ -16,15 +16,6 @@ namespace {
 
 using namespace std::chrono_literals;
 
-std::string hex_text(cia402::ObjectId id) {
-  char buf[16];
-  if (id.sub == 0)
-    std::snprintf(buf, sizeof buf, "0x%04X", id.index);
-  else
-    std::snprintf(buf, sizeof buf, "0x%04X:%u", id.index, static_cast<unsigned>(id.sub));
-  return buf;
-}
-
 // Objects a start-up write must not touch, and why: the gateway owns them.
 std::optional<std::string> forbidden_write(cia402::ObjectId id) {
   const auto i = id.index;
@@ -64,7 +55,7 @@ void check_known_type(const YAML::Node& n, const std::string& path, const Source
   const auto known = cia402::profile_object_type(id);  // a profile that gives 6060h another size is caught
   if (known && size_of(*known) != size_of(type))
     src.error(n.Mark(), path,
-              hex_text(id) + " is " + std::string{to_string(*known)} + " in CiA 402, got " + std::string{to_string(type)});
+              object_hex(id) + " is " + std::string{to_string(*known)} + " in CiA 402, got " + std::string{to_string(type)});
 }
 
 // One map entry "INDEX[:SUB] TYPE", its type checked against CiA 402.
@@ -154,7 +145,7 @@ void read_pdos(const MapReader& c, const std::string& key, bool receive, const D
         if (!entry) continue;
         const auto dup = std::find_if(mapped.begin(), mapped.end(), [&](const Mapped& x) { return x.id == entry->object; });
         if (dup != mapped.end()) {
-          src.error((*entries)[e].Mark(), path, hex_text(entry->object) + " is already mapped in " + dup->path);
+          src.error((*entries)[e].Mark(), path, object_hex(entry->object) + " is already mapped in " + dup->path);
           continue;
         }
         mapped.push_back({entry->object, path, (*entries)[e].Mark()});
@@ -191,7 +182,7 @@ void check_directions(const MapReader& c, const DeviceProfile& p) {
   const auto& co = p.section<CanopenDeviceSpec>();
   if (co.rpdos.empty() && co.tpdos.empty()) return;
   const auto need = [&](const std::vector<PdoSpec>& pdos, const char* key, cia402::ObjectId id, const std::string& why) {
-    if (!maps(pdos, id)) c.error(key, "must map " + hex_text(id) + " " + why);
+    if (!maps(pdos, id)) c.error(key, "must map " + object_hex(id) + " " + why);
   };
   need(co.rpdos, "rpdos", cia402::obj::kControlword.id, "(controlword): the gateway drives every axis through it");
   need(co.tpdos, "tpdos", cia402::obj::kStatusword.id, "(statusword): the gateway follows every axis through it");
@@ -206,7 +197,7 @@ void check_one_way(const MapReader& c, const std::vector<Mapped>& rx, const std:
   for (const auto& t : tx) {
     const auto r = std::find_if(rx.begin(), rx.end(), [&](const Mapped& x) { return x.id == t.id; });
     if (r != rx.end())
-      c.source().error(t.mark, t.path, hex_text(t.id) + " is also mapped in " + r->path +
+      c.source().error(t.mark, t.path, object_hex(t.id) + " is also mapped in " + r->path +
                                            "; an object is either sent or received");
   }
 }
@@ -279,20 +270,9 @@ void reconcile_cyclic_objects(const MapReader& root, DeviceProfile& p, bool cycl
     p.cyclic_objects = mapped;
     return;
   }
-  const auto contains = [](const std::vector<cia402::ObjectId>& v, cia402::ObjectId id) {
-    return std::find(v.begin(), v.end(), id) != v.end();
-  };
-  std::vector<std::string> unmapped;
-  std::vector<std::string> unlisted;
-  for (const auto& id : p.cyclic_objects)
-    if (!contains(mapped, id)) unmapped.push_back(hex_text(id));
-  for (const auto& id : mapped)
-    if (!contains(p.cyclic_objects, id)) unlisted.push_back(hex_text(id));
-  if (unmapped.empty() && unlisted.empty()) return;
-  std::string message = "must list exactly the objects of the canopen PDO maps (or be left out to derive them):";
-  if (!unmapped.empty()) message += " not mapped: " + join(unmapped, " ") + (unlisted.empty() ? "" : ";");
-  if (!unlisted.empty()) message += " mapped but not listed: " + join(unlisted, " ");
-  root.error("cyclic_objects", message);
+  if (const auto d = cyclic_image_difference(mapped, p.cyclic_objects, "listed"); !d.empty())
+    root.error("cyclic_objects",
+               "must list exactly the objects of the canopen PDO maps (or be left out to derive them):" + d);
 }
 
 }  // namespace
@@ -326,13 +306,13 @@ void read_startup_writes(const MapReader& parent, std::string_view key, const st
     if (why && why->empty()) w.error("why", "must say why the drive needs this write (it is shown when the write fails)");
     if (!id) continue;
     if (const auto reason = forbidden_write(*id)) {
-      w.error("object", hex_text(*id) + " " + *reason);
+      w.error("object", object_hex(*id) + " " + *reason);
       continue;
     }
     if (has_type) check_known_type(object_node, w.field("object"), src, *id, type);
     const auto dup = std::find_if(written.begin(), written.end(), [&](const Mapped& x) { return x.id == *id; });
     if (dup != written.end()) {
-      w.error("object", hex_text(*id) + " is already written by " + dup->path);
+      w.error("object", object_hex(*id) + " is already written by " + dup->path);
       continue;
     }
     written.push_back({*id, w.path(), object_node.Mark()});

@@ -12,15 +12,6 @@ namespace drivegate::config {
 
 namespace {
 
-std::string hex_text(cia402::ObjectId id) {
-  char buf[16];
-  if (id.sub == 0)
-    std::snprintf(buf, sizeof buf, "0x%04X", id.index);
-  else
-    std::snprintf(buf, sizeof buf, "0x%04X:%u", id.index, static_cast<unsigned>(id.sub));
-  return buf;
-}
-
 std::string hex16(std::uint16_t v) {
   char buf[8];
   std::snprintf(buf, sizeof buf, "0x%04X", v);
@@ -37,14 +28,14 @@ void check_entry_type(const YAML::Node& n, const std::string& path, const Source
                       const DeviceProfile& p) {
   if (is_mode_object(e.object) && p.quirk("mode_objects_16bit")) {
     if (e.type != cia402::DataType::I16)
-      src.error(n.Mark(), path, hex_text(e.object) + " is INTEGER16 on this device (quirk mode_objects_16bit), got " +
+      src.error(n.Mark(), path, object_hex(e.object) + " is INTEGER16 on this device (quirk mode_objects_16bit), got " +
                                     std::string{to_string(e.type)});
     return;
   }
   const auto known = cia402::profile_object_type(e.object);
   if (known && size_of(*known) != size_of(e.type))
     src.error(n.Mark(), path,
-              hex_text(e.object) + " is " + std::string{to_string(*known)} + " in CiA 402, got " +
+              object_hex(e.object) + " is " + std::string{to_string(*known)} + " in CiA 402, got " +
                   std::string{to_string(e.type)} +
                   (is_mode_object(e.object) ? " (a device with 16-bit mode objects needs quirk mode_objects_16bit)" : ""));
 }
@@ -147,13 +138,13 @@ void read_pdos(const MapReader& e, bool receive, const DeviceProfile& p, Etherca
         check_entry_type((*entries)[k], path, src, *entry, p);
         if (!mappable.empty() && std::find(mappable.begin(), mappable.end(), entry->object) == mappable.end()) {
           src.error((*entries)[k].Mark(), path,
-                    hex_text(entry->object) + " may not be mapped into " + (receive ? "an RxPDO" : "a TxPDO") +
+                    object_hex(entry->object) + " may not be mapped into " + (receive ? "an RxPDO" : "a TxPDO") +
                         " of this device (its " + (receive ? "rx_mappable" : "tx_mappable") + " list)");
           continue;
         }
         const auto dup = std::find_if(mapped.begin(), mapped.end(), [&](const Mapped& x) { return x.id == entry->object; });
         if (dup != mapped.end()) {
-          src.error((*entries)[k].Mark(), path, hex_text(entry->object) + " is already mapped in " + dup->path);
+          src.error((*entries)[k].Mark(), path, object_hex(entry->object) + " is already mapped in " + dup->path);
           continue;
         }
         mapped.push_back({entry->object, path});
@@ -176,7 +167,7 @@ void check_startup_writes(const MapReader& e, const EthercatDeviceSpec& spec) {
     const auto id = spec.startup_writes[i].def.id;
     if ((id.index >= 0x1600 && id.index <= 0x17FF) || (id.index >= 0x1A00 && id.index <= 0x1BFF) ||
         (id.index >= 0x1C00 && id.index <= 0x1C3F))
-      e.error("startup_writes", hex_text(id) + " is a PDO mapping or assignment object; the PDOs come from rxpdos/txpdos");
+      e.error("startup_writes", object_hex(id) + " is a PDO mapping or assignment object; the PDOs come from rxpdos/txpdos");
   }
 }
 
@@ -195,18 +186,8 @@ void reconcile_cyclic_objects(const MapReader& root, DeviceProfile& p, bool cycl
       return;
     }
   }
-  std::vector<std::string> unmapped;
-  std::vector<std::string> unlisted;
-  for (const auto& id : p.cyclic_objects)
-    if (std::find(mapped.begin(), mapped.end(), id) == mapped.end()) unmapped.push_back(hex_text(id));
-  for (const auto& id : mapped)
-    if (std::find(p.cyclic_objects.begin(), p.cyclic_objects.end(), id) == p.cyclic_objects.end())
-      unlisted.push_back(hex_text(id));
-  if (unmapped.empty() && unlisted.empty()) return;
-  std::string message = "the ethercat PDOs must carry exactly the cyclic objects:";
-  if (!unmapped.empty()) message += " not mapped: " + join(unmapped, " ") + (unlisted.empty() ? "" : ";");
-  if (!unlisted.empty()) message += " mapped but not cyclic: " + join(unlisted, " ");
-  root.error("ethercat", message);
+  if (const auto d = cyclic_image_difference(mapped, p.cyclic_objects, "cyclic"); !d.empty())
+    root.error("ethercat", "the ethercat PDOs must carry exactly the cyclic objects:" + d);
 }
 
 }  // namespace
@@ -239,7 +220,7 @@ void read_ethercat_device(const MapReader& root, DeviceProfile& p, bool cyclic_g
   read_pdos(e, false, p, spec, tx);
   for (const auto& t : tx)
     if (const auto r = std::find_if(rx.begin(), rx.end(), [&](const Mapped& x) { return x.id == t.id; }); r != rx.end())
-      e.error("txpdos", hex_text(t.id) + " is also mapped in " + r->path + "; an object is either sent or received");
+      e.error("txpdos", object_hex(t.id) + " is also mapped in " + r->path + "; an object is either sent or received");
   if (!spec.rxpdos.empty() || !spec.txpdos.empty()) {
     if (!maps(spec.rxpdos, cia402::obj::kControlword.id))
       e.error("rxpdos", "must map 0x6040 (controlword): the gateway drives every axis through it");

@@ -16,7 +16,7 @@
 
 #include "adapters/canopen/canopen_bus.hpp"
 #include "adapters/canopen/sim/threaded_wire.hpp"
-#include "adapters/canopen/transport/fd_guard.hpp"
+#include "core/fd_guard.hpp"
 #include "adapters/canopen/wire/bit_timing.hpp"
 #include "config/loader.hpp"
 #include "core/bus_runner.hpp"
@@ -246,7 +246,7 @@ struct Script {
   explicit Script(int wait_fd) : fd(wait_fd) {}
   std::vector<CanFrame> inbox;
   std::vector<std::pair<core::TimePoint, CanFrame>> sent;
-  FdGuard fd;
+  core::FdGuard fd;
 };
 
 class ScriptedTransport final : public Transport {

@@ -79,22 +79,7 @@ SimProcess::~SimProcess() {
 }
 
 std::optional<std::string> SimProcess::next_line(std::chrono::milliseconds timeout) {
-  const auto end = Clock::now() + timeout;
-  for (;;) {
-    if (const auto nl = buffer_.find('\n'); nl != std::string::npos) {
-      std::string line = buffer_.substr(0, nl);
-      buffer_.erase(0, nl + 1);
-      return line;
-    }
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(end - Clock::now()).count();
-    if (left <= 0) return std::nullopt;
-    pollfd p{stdout_, POLLIN, 0};
-    if (::poll(&p, 1, static_cast<int>(left)) <= 0) continue;
-    char chunk[512];
-    const ssize_t n = ::read(stdout_, chunk, sizeof chunk);
-    if (n <= 0) return std::nullopt;  // the simulator ended
-    buffer_.append(chunk, static_cast<std::size_t>(n));
-  }
+  return lines_.next(stdout_, timeout);
 }
 
 std::optional<std::string> SimProcess::wait_ready(std::chrono::milliseconds timeout) {

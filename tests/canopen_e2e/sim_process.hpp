@@ -11,6 +11,8 @@
 #include <optional>
 #include <string>
 
+#include "tests/support/pipe_lines.hpp"
+
 namespace drivegate::test {
 
 // The virtual CAN bus of one test: a 239.x group of the test process and a port that no DDS
@@ -48,7 +50,7 @@ class SimProcess {
   int stdin_ = -1;
   int stdout_ = -1;
   std::string log_path_;
-  std::string buffer_;
+  PipeLines lines_;
 };
 
 // The part of a `status` answer about one node ("can0:3 stoeber-sd6 nmt=operational

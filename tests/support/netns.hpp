@@ -17,6 +17,8 @@
 #include <string>
 #include <vector>
 
+#include "tests/support/pipe_lines.hpp"
+
 namespace drivegate::test {
 
 // "" when this process can make network namespaces and veth pairs; otherwise the reason (not
@@ -123,7 +125,7 @@ class ChildProcess {
  private:
   pid_t pid_ = -1;
   int out_ = -1;
-  std::string buffer_;
+  PipeLines lines_;
   std::optional<int> status_;
 };
 

@@ -18,7 +18,7 @@
 #include <thread>
 
 #include "adapters/canopen/sim/sim_network.hpp"
-#include "adapters/canopen/transport/fd_guard.hpp"
+#include "core/fd_guard.hpp"
 #include "adapters/canopen/transport/inproc_bus.hpp"
 #include "config/plan.hpp"
 
@@ -57,8 +57,8 @@ class ThreadedSimWire {
     std::unique_ptr<InprocEndpoint> drives_end;
     std::unique_ptr<InprocEndpoint> gateway_end;
     SimNetwork network;
-    FdGuard gateway_ready;  // eventfd: readable while the gateway's end has frames
-    FdGuard wire_changed;   // eventfd: the gateway sent a frame (wakes the drive thread)
+    core::FdGuard gateway_ready;  // eventfd: readable while the gateway's end has frames
+    core::FdGuard wire_changed;   // eventfd: the gateway sent a frame (wakes the drive thread)
     bool gateway_signalled = false;
   };
 

@@ -14,7 +14,7 @@
 #include <utility>
 
 #include "adapters/canopen/transport/batch_send.hpp"
-#include "adapters/canopen/transport/fd_guard.hpp"
+#include "core/fd_guard.hpp"
 
 namespace drivegate::canopen {
 namespace {
@@ -128,7 +128,7 @@ void SocketCanTransport::open() {
   const std::string& name = options_.interface;
   const std::string bring_up = "ip link set " + name + " up type can bitrate " + std::to_string(options_.bitrate);
 
-  FdGuard fd(::socket(PF_CAN, SOCK_RAW | SOCK_NONBLOCK | SOCK_CLOEXEC, CAN_RAW));
+  core::FdGuard fd(::socket(PF_CAN, SOCK_RAW | SOCK_NONBLOCK | SOCK_CLOEXEC, CAN_RAW));
   if (fd.get() < 0) {
     const int e = errno;
     if (e == EAFNOSUPPORT) {

@@ -10,7 +10,7 @@
 #include <utility>
 
 #include "adapters/canopen/transport/batch_send.hpp"
-#include "adapters/canopen/transport/fd_guard.hpp"
+#include "core/fd_guard.hpp"
 
 namespace drivegate::canopen {
 namespace {
@@ -75,7 +75,7 @@ void UdpMulticastTransport::open() {
   if (options_.port == 0) fail("port 0 is not a port a bus can share (1..65535)");
   if (options_.ttl < 0 || options_.ttl > 255) fail("TTL " + std::to_string(options_.ttl) + " is not in 0..255");
 
-  FdGuard rx(udp_socket());
+  core::FdGuard rx(udp_socket());
   // Every process on the bus binds the same port.
   set_option(rx.get(), SOL_SOCKET, SO_REUSEADDR, int{1}, "SO_REUSEADDR");
   sockaddr_in any{};
@@ -100,7 +100,7 @@ void UdpMulticastTransport::open() {
   // sockets on the host joined on the same port.
   set_option(rx.get(), IPPROTO_IP, IP_MULTICAST_ALL, int{0}, "IP_MULTICAST_ALL");
 
-  FdGuard tx(udp_socket());
+  core::FdGuard tx(udp_socket());
   // Bound to the interface address (the kernel picks the port); 0.0.0.0 leaves the address to the
   // route, chosen at connect() below.
   sockaddr_in source{};

@@ -12,6 +12,8 @@
 #include <system_error>
 #include <utility>
 
+#include "core/fd_guard.hpp"
+
 namespace drivegate::ethercat {
 namespace {
 
@@ -24,22 +26,6 @@ namespace {
 std::string errno_text(int e) { return std::system_category().message(e); }
 
 [[noreturn]] void fail(const std::string& what) { throw LinkError("ethercat: " + what); }
-
-// Closes a descriptor unless released, so that a failing open() leaves nothing behind.
-class FdGuard {
- public:
-  explicit FdGuard(int fd) noexcept : fd_(fd) {}
-  ~FdGuard() {
-    if (fd_ >= 0) ::close(fd_);
-  }
-  FdGuard(const FdGuard&) = delete;
-  FdGuard& operator=(const FdGuard&) = delete;
-  [[nodiscard]] int get() const noexcept { return fd_; }
-  int release() noexcept { return std::exchange(fd_, -1); }
-
- private:
-  int fd_;
-};
 
 std::string link_type_name(unsigned type) {
   switch (type) {
@@ -104,7 +90,7 @@ void RawSocketLink::open() {
 
   // Protocol 0: no frames are queued until bind() names the interface and the EtherType, so none
   // from other interfaces slip in between.
-  FdGuard fd(::socket(AF_PACKET, SOCK_RAW | SOCK_NONBLOCK | SOCK_CLOEXEC, 0));
+  core::FdGuard fd(::socket(AF_PACKET, SOCK_RAW | SOCK_NONBLOCK | SOCK_CLOEXEC, 0));
   if (fd.get() < 0) {
     const int e = errno;
     if (e == EPERM || e == EACCES) throw LinkError(no_raw_permission_text(name));

@@ -4,7 +4,7 @@
 
 #include <utility>
 
-namespace drivegate::canopen {
+namespace drivegate::core {
 
 class FdGuard {
  public:
@@ -21,4 +21,4 @@ class FdGuard {
   int fd_;
 };
 
-}  // namespace drivegate::canopen
+}  // namespace drivegate::core
