@@ -1,0 +1,422 @@
+#include "adapters/ethercat/master/coe_sdo_client.hpp"
+
+#include <algorithm>
+
+#include "adapters/ethercat/wire/bytes.hpp"
+#include "adapters/ethercat/wire/registers.hpp"
+
+namespace drivegate::ethercat {
+namespace {
+
+// CiA 301 §7.2.4.3.17 abort codes the client raises itself (CoE reuses them, ETG.1000.6 §5.6.2.7.2).
+constexpr std::uint32_t kAbortToggle = 0x05030000;
+constexpr std::uint32_t kAbortTimeout = 0x05040000;
+constexpr std::uint32_t kAbortOutOfMemory = 0x05040005;
+constexpr std::uint32_t kAbortGeneral = 0x08000000;
+
+// Bytes in front of the data: mailbox header 6 + CoE header 2 + SDO command, index, subindex, size
+// (8) for a normal initiate; + command byte (1) for a segment [ETG.1000.6 §5.6.2.2-§5.6.2.5].
+constexpr std::size_t kInitiateOverhead = kMailboxHeaderSize + kCoeHeaderSize + kSdoHeaderSize;
+constexpr std::size_t kSegmentOverhead = kMailboxHeaderSize + kCoeHeaderSize + 1;
+
+constexpr std::uint16_t kSm1Status = reg::sm(1) + 5;     // 080Dh
+constexpr std::uint16_t kSm1Activate = reg::sm(1) + 6;   // 080Eh
+constexpr std::uint16_t kSm1PdiControl = reg::sm(1) + 7; // 080Fh
+
+}  // namespace
+
+std::string_view to_string(CoeSdoStatus s) noexcept {
+  switch (s) {
+    case CoeSdoStatus::Unknown: return "unknown";
+    case CoeSdoStatus::Queued: return "queued";
+    case CoeSdoStatus::InFlight: return "in flight";
+    case CoeSdoStatus::Done: return "done";
+    case CoeSdoStatus::Failed: return "failed";
+  }
+  return "?";
+}
+
+CoeSdoClient::CoeSdoClient(std::uint16_t station, const SiiMailbox& mailbox, CoeSdoTiming timing,
+                           EmergencySink* emergencies) noexcept
+    : station_(station), mailbox_(mailbox), timing_(timing), emergencies_(emergencies) {
+  valid_ = mailbox.rx_size >= kInitiateOverhead && mailbox.tx_size >= kInitiateOverhead &&
+           mailbox.rx_size <= kMaxMailbox && mailbox.tx_size <= kMaxMailbox;
+}
+
+CoeSdoId CoeSdoClient::submit(bool upload, std::uint16_t index, std::uint8_t subindex, std::uint8_t* into,
+                              const std::uint8_t* from, std::size_t size) noexcept {
+  if (!valid_) {
+    ++counters_.queue_full;
+    return 0;
+  }
+  for (std::size_t i = 0; i < slots_.size(); ++i) {
+    Slot& s = slots_[i];
+    if (s.state != SlotState::Free) continue;
+    const std::uint16_t gen = static_cast<std::uint16_t>(s.generation + 1 == 0 ? 1 : s.generation + 1);
+    s = Slot{};
+    s.generation = gen;
+    s.state = SlotState::Queued;
+    s.upload = upload;
+    s.order = next_order_++;
+    s.index = index;
+    s.subindex = subindex;
+    s.into = into != nullptr ? into : (upload ? s.inline_bytes.data() : nullptr);
+    s.from = from;
+    s.capacity = size;
+    s.result.status = CoeSdoStatus::Queued;
+    ++counters_.requests;
+    return (static_cast<CoeSdoId>(gen) << 8) | static_cast<CoeSdoId>(i + 1);
+  }
+  ++counters_.queue_full;
+  return 0;
+}
+
+CoeSdoId CoeSdoClient::upload(std::uint16_t index, std::uint8_t subindex, std::span<std::uint8_t> into) noexcept {
+  if (into.empty()) return 0;
+  return submit(true, index, subindex, into.data(), nullptr, into.size());
+}
+
+CoeSdoId CoeSdoClient::upload_value(std::uint16_t index, std::uint8_t subindex) noexcept {
+  return submit(true, index, subindex, nullptr, nullptr, kInline);
+}
+
+CoeSdoId CoeSdoClient::download(std::uint16_t index, std::uint8_t subindex, std::span<const std::uint8_t> data) noexcept {
+  if (data.empty() || data.size() > 0xFFFFFFFFU) return 0;
+  return submit(false, index, subindex, nullptr, data.data(), data.size());
+}
+
+CoeSdoId CoeSdoClient::download_value(std::uint16_t index, std::uint8_t subindex, std::uint32_t value,
+                                      std::size_t size) noexcept {
+  if (size == 0 || size > 4) return 0;
+  const CoeSdoId id = submit(false, index, subindex, nullptr, nullptr, size);
+  if (id == 0) return 0;
+  Slot& s = slots_[(id & 0xFF) - 1];
+  put_u32(s.inline_bytes, 0, value);
+  s.from = s.inline_bytes.data();
+  return id;
+}
+
+const CoeSdoClient::Slot* CoeSdoClient::find(CoeSdoId id) const noexcept {
+  const std::size_t i = id & 0xFF;
+  if (i == 0 || i > slots_.size()) return nullptr;
+  const Slot& s = slots_[i - 1];
+  if (s.state == SlotState::Free || s.generation != static_cast<std::uint16_t>(id >> 8)) return nullptr;
+  return &s;
+}
+
+CoeSdoResult CoeSdoClient::result(CoeSdoId id) const noexcept {
+  const Slot* s = find(id);
+  return s != nullptr ? s->result : CoeSdoResult{};
+}
+
+std::span<const std::uint8_t> CoeSdoClient::data(CoeSdoId id) const noexcept {
+  const Slot* s = find(id);
+  if (s == nullptr || !s->upload || s->state != SlotState::Done) return {};
+  return {s->into, s->done};
+}
+
+CoeSdoResult CoeSdoClient::take(CoeSdoId id) noexcept {
+  const Slot* s = find(id);
+  if (s == nullptr || (s->state != SlotState::Done && s->state != SlotState::Failed)) return result(id);
+  const CoeSdoResult r = s->result;
+  slots_[(id & 0xFF) - 1].state = SlotState::Free;
+  return r;
+}
+
+void CoeSdoClient::finish(Slot& s, SlotState state, std::uint32_t abort_code) noexcept {
+  s.state = state;
+  s.result.status = state == SlotState::Done ? CoeSdoStatus::Done : CoeSdoStatus::Failed;
+  s.result.abort_code = abort_code;
+  if (s.upload) {
+    s.result.size = s.done;
+    std::uint32_t v = 0;
+    for (std::size_t i = 0; i < std::min<std::size_t>(s.done, 4); ++i) v |= static_cast<std::uint32_t>(s.into[i]) << (8 * i);
+    s.result.value = v;
+  }
+  if (state == SlotState::Done) {
+    ++counters_.completed;
+  } else {
+    ++counters_.failed;
+  }
+  active_ = nullptr;
+  phase_ = Phase::Idle;
+  write_due_ = false;
+}
+
+void CoeSdoClient::prepare_initiate(Slot& s) noexcept {
+  counter_ = next_mailbox_counter(counter_);
+  std::fill(out_.begin(), out_.end(), std::uint8_t{0});
+  const std::span<std::uint8_t> out(out_.data(), mailbox_.rx_size);
+  std::size_t n = 0;
+  if (s.upload) {
+    n = encode_sdo_upload_request(out, counter_, s.index, s.subindex);
+  } else if (s.capacity <= 4) {  // expedited [ETG.1000.6 §5.6.2.1]
+    n = encode_sdo_download_expedited(out, counter_, s.index, s.subindex, {s.from, s.capacity});
+    s.done = s.capacity;
+  } else {  // normal: as much as the mailbox carries, segments for the rest
+    const std::size_t first = std::min(s.capacity, static_cast<std::size_t>(mailbox_.rx_size) - kInitiateOverhead);
+    n = encode_sdo_download_normal(out, counter_, s.index, s.subindex, static_cast<std::uint32_t>(s.capacity),
+                                   {s.from, first});
+    s.done = first;
+  }
+  out_size_ = n == 0 ? 0 : mailbox_.rx_size;
+  expect_ = Expect::Initiate;
+  toggle_ = false;
+  phase_ = Phase::Write;
+  write_due_ = true;
+}
+
+void CoeSdoClient::prepare_download_segment(Slot& s) noexcept {
+  counter_ = next_mailbox_counter(counter_);
+  std::fill(out_.begin(), out_.end(), std::uint8_t{0});
+  const std::size_t chunk = std::min(s.capacity - s.done, static_cast<std::size_t>(mailbox_.rx_size) - kSegmentOverhead);
+  const bool last = s.done + chunk >= s.capacity;
+  (void)encode_sdo_download_segment(std::span<std::uint8_t>(out_.data(), mailbox_.rx_size), counter_, toggle_, last,
+                                    {s.from + s.done, chunk});
+  s.done += chunk;
+  out_size_ = mailbox_.rx_size;
+  expect_ = Expect::Segment;
+  phase_ = Phase::Write;
+  write_due_ = true;
+}
+
+void CoeSdoClient::prepare_upload_segment() noexcept {
+  counter_ = next_mailbox_counter(counter_);
+  std::fill(out_.begin(), out_.end(), std::uint8_t{0});
+  (void)encode_sdo_upload_segment_request(std::span<std::uint8_t>(out_.data(), mailbox_.rx_size), counter_, toggle_);
+  out_size_ = mailbox_.rx_size;
+  expect_ = Expect::Segment;
+  phase_ = Phase::Write;
+  write_due_ = true;
+}
+
+void CoeSdoClient::start_next(core::TimePoint now) noexcept {
+  Slot* next = nullptr;
+  for (auto& s : slots_) {
+    if (s.state == SlotState::Queued && (next == nullptr || s.order < next->order)) next = &s;
+  }
+  if (next == nullptr) return;
+  active_ = next;
+  next->state = SlotState::InFlight;
+  next->result.status = CoeSdoStatus::InFlight;
+  deadline_ = now + timing_.timeout;
+  prepare_initiate(*next);
+}
+
+bool CoeSdoClient::queue(Transactions& tx, Command c, std::uint16_t ado, std::uint16_t length,
+                         std::span<const std::uint8_t> data) noexcept {
+  ++seq_;
+  if (!tx.queue(this, seq_, c, physical_address(station_, ado), length, data)) return false;
+  waiting_ = true;
+  return true;
+}
+
+void CoeSdoClient::poll(core::TimePoint now, Transactions& tx) noexcept {
+  now_ = now;
+  if (waiting_) return;
+  if (active_ != nullptr && now >= deadline_) {
+    ++counters_.timeouts;
+    finish(*active_, SlotState::Failed, kAbortTimeout);
+  }
+  if (active_ == nullptr) start_next(now);
+  switch (phase_) {
+    case Phase::Idle:
+      // Nothing of ours in flight: still look for emergencies now and then.
+      if (emergencies_ != nullptr && now >= next_status_poll_) {
+        if (queue(tx, Command::FPRD, kSm1Status, 1)) next_status_poll_ = now + timing_.poll_interval;
+      }
+      return;
+    case Phase::Write:
+      if (write_due_ && out_size_ != 0) {
+        ++counters_.mailbox_writes;
+        (void)queue(tx, Command::FPWR, mailbox_.rx_offset, static_cast<std::uint16_t>(out_size_),
+                    std::span<const std::uint8_t>(out_.data(), out_size_));
+      } else if (out_size_ == 0 && active_ != nullptr) {
+        finish(*active_, SlotState::Failed, kAbortGeneral);  // could not encode (cannot happen when valid())
+      }
+      return;
+    case Phase::Wait:
+      if (now >= next_status_poll_ && queue(tx, Command::FPRD, kSm1Status, 1)) {
+        next_status_poll_ = now + timing_.poll_interval;
+      }
+      return;
+    case Phase::Read:
+      (void)queue(tx, Command::FPRD, mailbox_.tx_offset, mailbox_.tx_size);
+      return;
+    case Phase::RepeatWrite: {
+      // Toggle the repeat request in SM1's activate register [ETG.1000.4 §6 SyncManager: repeat].
+      const std::array<std::uint8_t, 1> act{
+          static_cast<std::uint8_t>(sm_activate::kEnable | (repeat_bit_ ? sm_activate::kRepeat : 0))};
+      (void)queue(tx, Command::FPWR, kSm1Activate, 1, act);
+      return;
+    }
+    case Phase::RepeatWait:
+      if (now >= next_status_poll_ && queue(tx, Command::FPRD, kSm1PdiControl, 1)) {
+        next_status_poll_ = now + timing_.poll_interval;
+      }
+      return;
+  }
+}
+
+void CoeSdoClient::on_result(std::uint32_t tag, const DatagramAnswer& a) noexcept {
+  if (!waiting_ || tag != seq_) return;
+  waiting_ = false;
+  const bool lost = a.outcome == DatagramOutcome::Lost;
+  switch (phase_) {
+    case Phase::Idle:
+      if (!lost && a.wkc == 1 && !a.data.empty() && (a.data[0] & sm_status::kMailboxFull) != 0) phase_ = Phase::Read;
+      return;
+    case Phase::Write:
+      if (lost || a.wkc != 1) {  // not taken (mailbox still full) or lost: write again, same counter
+        if (!lost) ++counters_.mailbox_busy;
+        return;
+      }
+      write_due_ = false;
+      phase_ = Phase::Wait;
+      next_status_poll_ = now_;
+      return;
+    case Phase::Wait:
+      if (!lost && a.wkc == 1 && !a.data.empty() && (a.data[0] & sm_status::kMailboxFull) != 0) phase_ = Phase::Read;
+      return;
+    case Phase::Read:
+      if (lost) {  // the slave may have freed SM1 already: ask it to repeat
+        ++counters_.repeats;
+        repeat_bit_ = !repeat_bit_;
+        phase_ = Phase::RepeatWrite;
+        return;
+      }
+      if (a.wkc != 1) {  // empty after all
+        phase_ = active_ != nullptr ? Phase::Wait : Phase::Idle;
+        return;
+      }
+      phase_ = active_ != nullptr ? Phase::Wait : Phase::Idle;
+      on_mailbox(a.data);
+      return;
+    case Phase::RepeatWrite:
+      if (!lost && a.wkc == 1) {
+        phase_ = Phase::RepeatWait;
+        next_status_poll_ = now_;
+      }
+      return;
+    case Phase::RepeatWait:
+      if (!lost && a.wkc == 1 && !a.data.empty() && ((a.data[0] & 0x02) != 0) == repeat_bit_) phase_ = Phase::Read;
+      return;
+  }
+}
+
+void CoeSdoClient::on_mailbox(std::span<const std::uint8_t> mb) noexcept {
+  const MailboxView m = decode_mailbox(mb);
+  if (m.error != MailboxError::None) {
+    ++counters_.malformed;
+    return;
+  }
+  // A repeated reply (same counter as the last one taken) is a duplicate [ETG.1000.6 mailbox
+  // header counter].
+  if (m.header.counter != 0 && m.header.counter == last_reply_counter_) {
+    ++counters_.unexpected;
+    return;
+  }
+  last_reply_counter_ = m.header.counter;
+  if (m.header.type == static_cast<std::uint8_t>(MailboxType::Error)) {
+    const MailboxErrorReply e = decode_mailbox_error(mb);
+    if (active_ != nullptr) {
+      active_->result.mailbox_error = e.detail;
+      finish(*active_, SlotState::Failed, kAbortGeneral);
+    } else {
+      ++counters_.unexpected;
+    }
+    return;
+  }
+  const CoeView coe = decode_coe(mb);
+  if (coe.error != MailboxError::None) {
+    if (m.header.type != static_cast<std::uint8_t>(MailboxType::CoE)) {
+      ++counters_.unexpected;  // another protocol's mailbox: not ours
+    } else {
+      ++counters_.malformed;
+    }
+    return;
+  }
+  if (coe.service == static_cast<std::uint8_t>(CoeService::Emergency)) {
+    const EmergencyView e = decode_emergency(mb);
+    if (e.error != MailboxError::None) {
+      ++counters_.malformed;
+      return;
+    }
+    ++counters_.emergencies;
+    if (emergencies_ != nullptr) emergencies_->on_emergency(station_, e.emergency);
+    return;
+  }
+  const SdoView sdo = decode_sdo_response(mb);
+  if (sdo.error != MailboxError::None) {
+    ++counters_.malformed;
+    return;
+  }
+  if (active_ == nullptr) {
+    ++counters_.unexpected;
+    return;
+  }
+  on_sdo(*active_, sdo.sdo);
+}
+
+void CoeSdoClient::on_sdo(Slot& s, const CoeSdo& sdo) noexcept {
+  if (sdo.command == SdoCommand::Abort) {
+    ++counters_.aborts;
+    finish(s, SlotState::Failed, sdo.abort_code);
+    return;
+  }
+  const bool initiate = sdo.command == SdoCommand::UploadInitiateResponse ||
+                        sdo.command == SdoCommand::DownloadInitiateResponse;
+  const bool wanted = s.upload ? (expect_ == Expect::Initiate ? sdo.command == SdoCommand::UploadInitiateResponse
+                                                              : sdo.command == SdoCommand::UploadSegmentResponse)
+                               : (expect_ == Expect::Initiate ? sdo.command == SdoCommand::DownloadInitiateResponse
+                                                              : sdo.command == SdoCommand::DownloadSegmentResponse);
+  if (!wanted || (initiate && (sdo.index != s.index || sdo.subindex != s.subindex))) {
+    ++counters_.unexpected;
+    return;
+  }
+  if (!initiate && sdo.toggle != toggle_) {  // CiA 301 §7.2.4.3: toggle alternates per segment
+    finish(s, SlotState::Failed, kAbortToggle);
+    return;
+  }
+  if (!s.upload) {
+    if (!initiate) toggle_ = !toggle_;
+    if (s.done >= s.capacity) {
+      finish(s, SlotState::Done, 0);
+    } else {
+      prepare_download_segment(s);
+    }
+    return;
+  }
+  // Upload: copy what came.
+  if (s.done + sdo.data.size() > s.capacity) {
+    finish(s, SlotState::Failed, kAbortOutOfMemory);
+    return;
+  }
+  std::copy(sdo.data.begin(), sdo.data.end(), s.into + s.done);
+  s.done += sdo.data.size();
+  if (initiate) {
+    if (sdo.expedited) {
+      finish(s, SlotState::Done, 0);
+      return;
+    }
+    s.total = sdo.size;
+    if (s.total > s.capacity) {
+      finish(s, SlotState::Failed, kAbortOutOfMemory);
+      return;
+    }
+    if (s.done >= s.total) {
+      finish(s, SlotState::Done, 0);
+    } else {
+      prepare_upload_segment();
+    }
+    return;
+  }
+  toggle_ = !toggle_;
+  if (sdo.last) {
+    finish(s, SlotState::Done, 0);
+  } else {
+    prepare_upload_segment();
+  }
+}
+
+}  // namespace drivegate::ethercat

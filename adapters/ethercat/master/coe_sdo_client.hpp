@@ -1,0 +1,155 @@
+#pragma once
+// CoE SDO client of one slave over its mailbox [ETG.1000.6 §5.6.2 SDO, mailbox header and counter;
+// ETG.1000.4 §6 SyncManager (1-buffer mode, SM status "mailbox full", repeat request/acknowledge)]:
+//
+//   request:  FPWR of the whole SM0 buffer (mailbox out); WKC 0 = the slave has not read the last
+//             one yet: written again at the next poll. The counter runs 1..7 per new message; a
+//             write sent again keeps its counter.
+//   reply:    FPRD 080Dh (SM1 status) at most once per poll_interval until "mailbox full" (bit 3),
+//             then FPRD of the whole SM1 buffer (mailbox in).
+//   lost reply: the slave freed SM1 when it was read, but the frame did not come back: toggle the
+//             repeat bit (080Eh bit 1, FPWR), poll until the slave's repeat acknowledge (080Fh bit 1)
+//             equals it, then read SM1 again: the slave has put the last reply back.
+//   transfers: expedited / normal / segmented upload and download, toggle checked; a server abort
+//             fails the request with its code (sdo_abort_text() for the words).
+//   emergencies (CoE service 1) arriving in the mailbox go to the EmergencySink, any time.
+//
+// One request in flight per slave, a FIFO of kQueueDepth. Each request has a timeout from its
+// start: then it fails with 05040000h (SDO protocol timed out); nothing is sent to the slave (its
+// late reply, if any, is read and dropped as unexpected). Uploads go into the caller's buffer (or
+// the request's 8 inline bytes); a reply longer than the buffer fails with 05040005h (out of
+// memory). Downloads come from the caller's buffer (must stay valid until the result is taken) or
+// 1..4 inline bytes (download_value). Nothing allocates.
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+
+#include "adapters/ethercat/master/transactions.hpp"
+#include "adapters/ethercat/wire/mailbox.hpp"
+#include "adapters/ethercat/wire/sii.hpp"
+#include "core/clock.hpp"
+
+namespace drivegate::ethercat {
+
+class EmergencySink {
+ public:
+  virtual void on_emergency(std::uint16_t station, const CoeEmergency& e) noexcept = 0;
+
+ protected:
+  EmergencySink() = default;
+  EmergencySink(const EmergencySink&) = default;
+  EmergencySink& operator=(const EmergencySink&) = default;
+  ~EmergencySink() = default;
+};
+
+struct CoeSdoTiming {
+  core::Duration timeout = std::chrono::seconds(1);             // per request
+  core::Duration poll_interval = std::chrono::milliseconds(1);  // SM1 status reads at most this often
+};
+
+using CoeSdoId = std::uint32_t;  // 0 = refused
+enum class CoeSdoStatus : std::uint8_t { Unknown, Queued, InFlight, Done, Failed };
+std::string_view to_string(CoeSdoStatus s) noexcept;
+
+struct CoeSdoResult {
+  CoeSdoStatus status = CoeSdoStatus::Unknown;
+  std::uint32_t abort_code = 0;      // Failed: the server's code, 05040000h timeout, 05030000h toggle, ...
+  std::uint16_t mailbox_error = 0;   // Failed by a mailbox error reply (its detail code), else 0
+  std::size_t size = 0;              // uploads: bytes received
+  std::uint32_t value = 0;           // uploads of 1..4 bytes: little-endian value
+};
+
+struct CoeSdoCounters {
+  std::uint64_t requests = 0, completed = 0, failed = 0, timeouts = 0, aborts = 0;
+  std::uint64_t mailbox_writes = 0, mailbox_busy = 0;  // writes, and those the slave refused (WKC 0)
+  std::uint64_t repeats = 0;                            // repeat requests after a lost reply
+  std::uint64_t emergencies = 0, unexpected = 0, malformed = 0, queue_full = 0;
+};
+
+class CoeSdoClient final : public DatagramOwner {
+ public:
+  static constexpr std::size_t kQueueDepth = 8;
+  static constexpr std::size_t kMaxMailbox = 1024;  // SM0/SM1 sizes beyond this are refused (valid() false)
+  static constexpr std::size_t kInline = 8;
+
+  CoeSdoClient(std::uint16_t station, const SiiMailbox& mailbox, CoeSdoTiming timing = {},
+               EmergencySink* emergencies = nullptr) noexcept;
+  // The mailbox sizes can carry an SDO (at least 16 bytes each) and fit kMaxMailbox.
+  [[nodiscard]] bool valid() const noexcept { return valid_; }
+
+  CoeSdoId upload(std::uint16_t index, std::uint8_t subindex, std::span<std::uint8_t> into) noexcept;
+  CoeSdoId upload_value(std::uint16_t index, std::uint8_t subindex) noexcept;  // up to 8 bytes inline
+  CoeSdoId download(std::uint16_t index, std::uint8_t subindex, std::span<const std::uint8_t> data) noexcept;
+  CoeSdoId download_value(std::uint16_t index, std::uint8_t subindex, std::uint32_t value, std::size_t size) noexcept;
+
+  [[nodiscard]] CoeSdoResult result(CoeSdoId id) const noexcept;
+  [[nodiscard]] std::span<const std::uint8_t> data(CoeSdoId id) const noexcept;  // upload bytes
+  CoeSdoResult take(CoeSdoId id) noexcept;  // frees a finished request
+
+  void poll(core::TimePoint now, Transactions& tx) noexcept;
+  void on_result(std::uint32_t tag, const DatagramAnswer& answer) noexcept override;
+
+  [[nodiscard]] const CoeSdoCounters& counters() const noexcept { return counters_; }
+  [[nodiscard]] bool idle() const noexcept { return phase_ == Phase::Idle; }
+
+ private:
+  enum class SlotState : std::uint8_t { Free, Queued, InFlight, Done, Failed };
+  struct Slot {
+    SlotState state = SlotState::Free;
+    bool upload = true;
+    std::uint16_t generation = 0;
+    std::uint64_t order = 0;
+    std::uint16_t index = 0;
+    std::uint8_t subindex = 0;
+    std::uint8_t* into = nullptr;          // upload target (caller's or inline)
+    const std::uint8_t* from = nullptr;    // download source (caller's or inline)
+    std::size_t capacity = 0;              // of into / size of from
+    std::size_t done = 0;                  // bytes received / sent
+    std::size_t total = 0;                 // upload: size the server indicated
+    std::array<std::uint8_t, kInline> inline_bytes{};
+    CoeSdoResult result{};
+  };
+  enum class Phase : std::uint8_t { Idle, Write, Wait, Read, RepeatWrite, RepeatWait };
+  enum class Expect : std::uint8_t { Initiate, Segment };
+
+  CoeSdoId submit(bool upload, std::uint16_t index, std::uint8_t subindex, std::uint8_t* into,
+                  const std::uint8_t* from, std::size_t size) noexcept;
+  [[nodiscard]] const Slot* find(CoeSdoId id) const noexcept;
+  void start_next(core::TimePoint now) noexcept;
+  void prepare_initiate(Slot& s) noexcept;
+  void prepare_download_segment(Slot& s) noexcept;
+  void prepare_upload_segment() noexcept;
+  void on_mailbox(std::span<const std::uint8_t> mb) noexcept;
+  void on_sdo(Slot& s, const CoeSdo& sdo) noexcept;
+  void finish(Slot& s, SlotState state, std::uint32_t abort_code) noexcept;
+  bool queue(Transactions& tx, Command c, std::uint16_t ado, std::uint16_t length,
+             std::span<const std::uint8_t> data = {}) noexcept;
+
+  std::uint16_t station_;
+  SiiMailbox mailbox_;
+  CoeSdoTiming timing_;
+  EmergencySink* emergencies_;
+  bool valid_ = false;
+
+  std::array<Slot, kQueueDepth> slots_{};
+  std::uint64_t next_order_ = 0;
+  Slot* active_ = nullptr;
+  Phase phase_ = Phase::Idle;
+  Expect expect_ = Expect::Initiate;
+  bool toggle_ = false;
+  bool waiting_ = false;        // a datagram of ours is in flight
+  std::uint16_t seq_ = 0;
+  bool write_due_ = false;
+  std::uint8_t counter_ = 0;    // mailbox counter of the last message written
+  std::uint8_t last_reply_counter_ = 0;
+  bool repeat_bit_ = false;
+  core::TimePoint deadline_{};
+  core::TimePoint next_status_poll_{};
+  core::TimePoint now_{};
+  std::array<std::uint8_t, kMaxMailbox> out_{};   // the request written to SM0
+  std::size_t out_size_ = 0;
+  CoeSdoCounters counters_{};
+};
+
+}  // namespace drivegate::ethercat

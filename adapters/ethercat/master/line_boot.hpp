@@ -1,0 +1,189 @@
+#pragma once
+// Start-up of an EtherCAT line, from an unknown line to every configured slave in PRE-OP
+// (dunker-ethercat-coe.md "What an EtherCAT master must do", steps 1-2; ETG.1000.4 §6 registers,
+// ETG.1000.6 §5.3 ESM, §5.4 SII):
+//
+//   1. count:    BRD 0000h; the working counter is the number of slaves [ETG.1000.4 §5.4 BRD].
+//   2. reset:    one frame of broadcast writes: AL control = INIT with error acknowledge, FMMUs and
+//                SyncManagers cleared, DC activation off, DC system time / offset / delay cleared,
+//                DC speed counter start 1000h and filter depths 0Ch, EEPROM access to EtherCAT.
+//   3. address:  APWR 0010h = first_station + position (0x1001, 0x1002, ...).
+//   4. per slave, all slaves in parallel, one datagram in flight each:
+//      SII:      through the EEPROM interface [ETG.1000.4 Table 48]: FPRD 0502h (busy? 4 or 8 byte
+//                reads?), FPWR 0502h = read command + word address, FPRD 0502h until not busy,
+//                FPRD 0508h (4 or 8 bytes), until the category list ends (FFFFh) [ETG.1000.6 §5.4];
+//                then parse_sii().
+//      identity: vendor, product, revision against the expected slave at that position (revision
+//                0 = any). A difference fails the slave and names both identities; a slave beyond
+//                the configured ones is reported and left in INIT.
+//      mailbox:  SM0/SM1 from the SII standard mailbox (FPWR 0800h, 16 bytes) when it has one.
+//      PRE-OP:   AL control = 2, then AL status read until the state is reached, the error bit is
+//                set (then 0134h is read for the AL status code and the error acknowledged), or the
+//                transition's timeout passes [ETG.1000.6 §5.3.2].
+//
+// request_state() runs a later transition (SAFE-OP, OP, back down) on a slave the same way; part 2
+// (PDO mapping, process data) calls it once the SMs/FMMUs are set.
+//
+// Each failing slave stops at its step with one sentence, e.g.
+//   "slave 2 (0x1002, ESR TrioDrive): PRE-OP -> SAFE-OP refused: 0x001D invalid output configuration"
+// Slaves are numbered from 1 in texts (slave n = position n - 1, station first_station + n - 1).
+//
+// A lost datagram is sent again up to `retries` times, then the step fails with "no answer". The
+// engine is driven by poll(now, tx) (queues what is due) and on_result() (Transactions calls it);
+// it never blocks. LineBoot is large (SII images and parsed SiiInfo per slave): allocate it once.
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string_view>
+
+#include "adapters/ethercat/master/transactions.hpp"
+#include "adapters/ethercat/wire/registers.hpp"
+#include "adapters/ethercat/wire/sii.hpp"
+#include "core/clock.hpp"
+#include "core/fixed_string.hpp"
+
+namespace drivegate::ethercat {
+
+struct ExpectedSlave {
+  std::uint32_t vendor_id = 0;
+  std::uint32_t product_code = 0;
+  std::uint32_t revision = 0;  // 0 = any revision
+  std::string_view name{};     // for texts; the SII name when empty
+};
+
+struct LineBootConfig {
+  std::uint16_t first_station = 0x1001;
+  core::Duration sii_timeout = std::chrono::milliseconds(100);       // one EEPROM read (busy)
+  core::Duration init_to_preop = std::chrono::seconds(3);
+  core::Duration preop_to_safeop = std::chrono::seconds(10);
+  core::Duration safeop_to_op = std::chrono::seconds(10);
+  core::Duration to_lower_state = std::chrono::seconds(5);           // any transition downwards
+  int retries = 3;  // a lost datagram is sent again this often
+};
+
+enum class BootStep : std::uint8_t { Count, Reset, Address, Sii, Identity, Mailbox, Transition };
+std::string_view to_string(BootStep s) noexcept;
+
+enum class SlaveStatus : std::uint8_t {
+  Pending,  // not started (line steps still running)
+  Busy,     // a step or transition is running
+  Ready,    // in `state`, nothing running
+  Failed,   // stopped at `step`, `text` says why
+  Extra,    // not configured: left in INIT
+};
+std::string_view to_string(SlaveStatus s) noexcept;
+
+struct SlaveReport {
+  std::uint16_t position = 0;
+  std::uint16_t station = 0;
+  SlaveStatus status = SlaveStatus::Pending;
+  BootStep step = BootStep::Sii;
+  AlState state = AlState::Init;  // last state read (INIT after the reset)
+  AlState target = AlState::Init; // of the last transition requested
+  std::uint16_t al_code = 0;      // AL status code of a refused transition
+  bool identity_mismatch = false;
+  SiiIdentity found{};
+  core::FixedString<240> text{};  // the failure / extra-slave sentence; empty when fine
+};
+
+enum class LineStatus : std::uint8_t { Idle, Running, Done, Failed };
+
+class LineBoot final : public DatagramOwner {
+ public:
+  static constexpr std::size_t kMaxSlaves = 16;
+  static constexpr std::size_t kMaxSiiBytes = 8192;
+
+  // `expected`: one entry per configured position, front first (at most kMaxSlaves are used;
+  // name views must outlive the boot).
+  LineBoot(std::span<const ExpectedSlave> expected, LineBootConfig config) noexcept;
+
+  // (Re)starts the boot from the count.
+  void start(core::TimePoint now) noexcept;
+  // Queues the datagrams that are due and runs timeouts.
+  void poll(core::TimePoint now, Transactions& tx) noexcept;
+  void on_result(std::uint32_t tag, const DatagramAnswer& answer) noexcept override;
+
+  // Done: the line steps finished and no slave is busy; Failed: a line step failed (count, reset,
+  // addresses). Slave failures leave the line Done: see ok() and the reports.
+  [[nodiscard]] LineStatus status() const noexcept;
+  // Done, every configured slave found with its identity and Ready in PRE-OP (or later), no extra
+  // and no missing slave.
+  [[nodiscard]] bool ok() const noexcept;
+  // Line-level sentence: the failed line step, or the missing slaves.
+  [[nodiscard]] std::string_view line_text() const noexcept { return line_text_.view(); }
+  [[nodiscard]] std::size_t slave_count() const noexcept { return found_; }
+  [[nodiscard]] std::size_t missing() const noexcept { return expected_count_ > found_ ? expected_count_ - found_ : 0; }
+  [[nodiscard]] const SlaveReport& slave(std::size_t position) const noexcept { return slaves_[position].report; }
+  [[nodiscard]] const SiiInfo& sii(std::size_t position) const noexcept { return slaves_[position].info; }
+
+  // Starts a transition of a Ready slave (SAFE-OP, OP, or down). False when the slave is not Ready.
+  bool request_state(std::size_t position, AlState target, core::TimePoint now) noexcept;
+
+ private:
+  // One datagram an actor (the line or a slave) waits for, kept to be sent again when lost.
+  struct Pending {
+    bool due = false;      // to be queued by the next poll()
+    bool waiting = false;  // queued, result not yet in
+    std::uint16_t seq = 0;
+    int retries_left = 0;
+    Command command = Command::NOP;
+    std::uint32_t address = 0;
+    std::uint16_t length = 0;
+    std::array<std::uint8_t, 16> data{};
+    std::size_t data_size = 0;
+  };
+  enum class LinePhase : std::uint8_t { Idle, Count, Reset, Address, Slaves, Done, Failed };
+  enum class Phase : std::uint8_t {
+    Idle, SiiStatus, SiiCommand, SiiBusy, SiiData, Mailbox, AlRequest, AlPoll, AlCode, AlAck,
+  };
+  struct Slave {
+    SlaveReport report{};
+    Phase phase = Phase::Idle;
+    Pending pending{};
+    core::TimePoint deadline{};
+    AlState from = AlState::Init;
+    std::uint16_t al_status_raw = 0;
+    bool eight_byte_reads = false;
+    std::uint32_t sii_word = 0;  // next word address to read
+    std::size_t image_size = 0;
+    std::array<std::uint8_t, kMaxSiiBytes> image{};
+    SiiInfo info{};
+  };
+  static constexpr std::uint32_t kLineActor = 0xFF;
+
+  void set(Pending& p, Command command, std::uint32_t address, std::uint16_t length,
+           std::span<const std::uint8_t> data = {}) noexcept;
+  void send(Pending& p, std::uint32_t actor, Transactions& tx) noexcept;
+  void line_answer(const DatagramAnswer& a) noexcept;
+  void line_group_done() noexcept;
+  void queue_reset(Transactions& tx) noexcept;
+  void queue_addresses(Transactions& tx) noexcept;
+  void slave_answer(Slave& s, const DatagramAnswer& a) noexcept;
+  void slave_phase(Slave& s) noexcept;  // sets the pending datagram of the phase just entered
+  void sii_chunk(Slave& s, std::span<const std::uint8_t> data) noexcept;
+  void identify(Slave& s) noexcept;
+  void begin_transition(Slave& s, AlState target) noexcept;
+  void fail(Slave& s, BootStep step, const char* fmt, ...) noexcept __attribute__((format(printf, 4, 5)));
+  void fail_line(const char* fmt, ...) noexcept __attribute__((format(printf, 2, 3)));
+  [[nodiscard]] std::string_view name_of(const Slave& s) const noexcept;
+  [[nodiscard]] core::Duration timeout_of(AlState from, AlState to) const noexcept;
+
+  std::array<ExpectedSlave, kMaxSlaves> expected_{};
+  std::size_t expected_count_ = 0;
+  LineBootConfig config_;
+  LinePhase line_ = LinePhase::Idle;
+  Pending line_pending_{};      // count
+  std::size_t group_left_ = 0;  // reset / address: datagrams of the group not yet answered
+  bool group_lost_ = false;
+  bool group_bad_ = false;
+  int group_retries_ = 0;
+  bool group_due_ = false;
+  std::uint16_t group_seq_ = 0;
+  std::size_t found_ = 0;
+  core::TimePoint now_{};
+  core::FixedString<240> line_text_{};
+  std::array<Slave, kMaxSlaves> slaves_{};
+};
+
+}  // namespace drivegate::ethercat

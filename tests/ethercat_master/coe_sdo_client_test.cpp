@@ -1,0 +1,323 @@
+// CoeSdoClient against a fake slave mailbox (fake_line.hpp) and a small scripted SDO server in
+// this file: expedited and segmented upload/download, server abort, timeout, lost reply with the
+// SM1 repeat procedure, emergency in the mailbox, no allocation while polling. Request bytes are
+// checked against ETG.1000.6 §5.6.2 (digest TV-6 for the expedited download layout).
+#include <gtest/gtest.h>
+
+#include <map>
+#include <vector>
+
+#include "adapters/ethercat/master/coe_sdo_client.hpp"
+#include "tests/ethercat_master/fake_line.hpp"
+#include "tests/support/alloc_counter.hpp"
+
+namespace drivegate::ethercat {
+namespace {
+
+using namespace std::chrono_literals;
+using test::FakeEsc;
+using test::FakeLine;
+
+constexpr SiiMailbox kMailbox{0x1000, 64, 0x1080, 64};
+
+// SDO server: an object dictionary, segmented transfers, scripted aborts / silence / emergencies.
+struct Server {
+  std::map<std::pair<std::uint16_t, std::uint8_t>, std::vector<std::uint8_t>> od;
+  std::map<std::pair<std::uint16_t, std::uint8_t>, std::uint32_t> aborts;
+  int ignore = 0;  // requests left unanswered
+  bool emergency_first = false;
+  std::uint8_t counter = 0;
+  // segmented state
+  std::pair<std::uint16_t, std::uint8_t> key{};
+  std::vector<std::uint8_t> up;     // remaining upload bytes
+  std::vector<std::uint8_t> down;   // download bytes so far
+  std::size_t down_total = 0;
+
+  std::uint8_t next() { return counter = next_mailbox_counter(counter); }
+
+  void handle(FakeEsc& esc, std::span<const std::uint8_t> req) {
+    if (ignore > 0) {
+      --ignore;
+      return;
+    }
+    std::array<std::uint8_t, 64> out{};
+    if (emergency_first) {
+      emergency_first = false;
+      // Dunker 8100h communication error (digest §8.1 / TV-4), error register 11h.
+      const std::size_t n = encode_emergency(out, next(), CoeEmergency{0x8100, 0x11, {}});
+      esc.reply(std::span<const std::uint8_t>(out.data(), n));
+      // The SDO reply follows once the master has read the emergency: keep the request.
+      pending.assign(req.begin(), req.end());
+      return;
+    }
+    const SdoView v = decode_sdo_request(req);
+    ASSERT_EQ(v.error, MailboxError::None);
+    const CoeSdo& s = v.sdo;
+    std::size_t n = 0;
+    if (s.command == SdoCommand::UploadInitiateRequest || s.command == SdoCommand::DownloadInitiateRequest) {
+      key = {s.index, s.subindex};
+      if (auto a = aborts.find(key); a != aborts.end()) {
+        n = encode_sdo_abort(out, next(), s.index, s.subindex, a->second);
+        esc.reply(std::span<const std::uint8_t>(out.data(), n));
+        return;
+      }
+    }
+    switch (s.command) {
+      case SdoCommand::UploadInitiateRequest: {
+        const auto& value = od.at(key);
+        if (value.size() <= 4) {
+          n = encode_sdo_upload_expedited_response(out, next(), s.index, s.subindex, value);
+        } else {
+          const std::size_t first = std::min<std::size_t>(value.size(), 64 - 16);
+          n = encode_sdo_upload_normal_response(out, next(), s.index, s.subindex,
+                                                static_cast<std::uint32_t>(value.size()),
+                                                std::span<const std::uint8_t>(value).first(first));
+          up.assign(value.begin() + static_cast<std::ptrdiff_t>(first), value.end());
+        }
+        break;
+      }
+      case SdoCommand::UploadSegmentRequest: {
+        const std::size_t chunk = std::min<std::size_t>(up.size(), 64 - 9);
+        const bool last = chunk == up.size();
+        n = encode_sdo_upload_segment_response(out, next(), s.toggle, last, std::span<const std::uint8_t>(up).first(chunk));
+        up.erase(up.begin(), up.begin() + static_cast<std::ptrdiff_t>(chunk));
+        break;
+      }
+      case SdoCommand::DownloadInitiateRequest:
+        down.assign(s.data.begin(), s.data.end());
+        down_total = s.expedited ? s.data.size() : s.size;
+        if (down.size() >= down_total) od[key] = down;
+        n = encode_sdo_download_response(out, next(), s.index, s.subindex);
+        break;
+      case SdoCommand::DownloadSegmentRequest:
+        down.insert(down.end(), s.data.begin(), s.data.end());
+        if (s.last) od[key] = down;
+        n = encode_sdo_download_segment_response(out, next(), s.toggle);
+        break;
+      default:
+        FAIL() << "unexpected command";
+    }
+    esc.reply(std::span<const std::uint8_t>(out.data(), n));
+  }
+  std::vector<std::uint8_t> pending;
+};
+
+struct Emergencies final : EmergencySink {
+  std::vector<std::pair<std::uint16_t, CoeEmergency>> got;
+  void on_emergency(std::uint16_t station, const CoeEmergency& e) noexcept override { got.emplace_back(station, e); }
+};
+
+struct Harness {
+  FakeLine line;
+  Server server;
+  Transactions tx;
+  Emergencies emcy;
+  CoeSdoClient client;
+  core::TimePoint now{};
+  bool drop_next_sm1_read = false;
+
+  explicit Harness(CoeSdoTiming timing = {}) : client(0x1001, kMailbox, timing, &emcy) {
+    FakeEsc esc;
+    put_u16(esc.mem, reg::kStationAddress, 0x1001);
+    const auto sm0 = encode_sm(SmEntry{0x1000, 64, 0x26, 0, 1, 0});
+    const auto sm1 = encode_sm(SmEntry{0x1080, 64, 0x22, 0, 1, 0});
+    std::copy(sm0.begin(), sm0.end(), esc.mem.begin() + 0x0800);
+    std::copy(sm1.begin(), sm1.end(), esc.mem.begin() + 0x0808);
+    esc.on_mailbox = [this](FakeEsc& e, std::span<const std::uint8_t> req) { server.handle(e, req); };
+    line.slaves.push_back(std::move(esc));
+  }
+
+  void cycle() {
+    client.poll(now, tx);
+    std::vector<std::vector<std::uint8_t>> out;
+    for (const auto& f : tx.take_frames(now + 1ms)) out.emplace_back(f.begin(), f.end());
+    for (auto& f : out) {
+      const bool reads_sm1 = f.size() > 20 && f[16] == static_cast<std::uint8_t>(Command::FPRD) &&
+                             get_u16(f, 20) == kMailbox.tx_offset;
+      line.process(f);
+      if (reads_sm1 && drop_next_sm1_read) {
+        drop_next_sm1_read = false;
+        continue;
+      }
+      tx.on_frame(f);
+    }
+    // An emergency read: now the SDO reply the server held back.
+    FakeEsc& esc = line.slaves[0];
+    if (!server.pending.empty() && !esc.sm1_full) {
+      const auto req = server.pending;
+      server.pending.clear();
+      server.handle(esc, req);
+    }
+    now += 1ms;
+    tx.expire(now);
+  }
+  CoeSdoResult run(CoeSdoId id, int max = 5000) {
+    for (int i = 0; i < max; ++i) {
+      const auto r = client.result(id);
+      if (r.status == CoeSdoStatus::Done || r.status == CoeSdoStatus::Failed) return r;
+      cycle();
+    }
+    return client.result(id);
+  }
+};
+
+TEST(EthercatCoeSdo, ExpeditedDownloadWritesTheWholeSm0Buffer) {
+  Harness h;
+  const CoeSdoId id = h.client.download_value(0x6060, 0x00, 7, 2);  // 6060h is 16 bits (quirk 1)
+  ASSERT_NE(id, 0U);
+  const auto r = h.run(id);
+  EXPECT_EQ(r.status, CoeSdoStatus::Done);
+  ASSERT_EQ(h.line.slaves[0].requests.size(), 1U);
+  const auto& req = h.line.slaves[0].requests[0];
+  ASSERT_EQ(req.size(), 64U);  // the whole SM0 length, so the SyncManager sees the buffer complete
+  // Mailbox header: length 10, address 0, channel/priority 0, type 3 (CoE) counter 1 -> 13h;
+  // CoE header 2000h (SDO request); SDO 2Bh (expedited, size indicated, 2 bytes), 6060h:00, 07 00.
+  EXPECT_EQ(std::vector<std::uint8_t>(req.begin(), req.begin() + 16),
+            (std::vector<std::uint8_t>{0x0A, 0x00, 0x00, 0x00, 0x00, 0x13, 0x00, 0x20, 0x2B, 0x60, 0x60, 0x00, 0x07,
+                                       0x00, 0x00, 0x00}));
+  EXPECT_EQ(h.server.od.at({0x6060, 0}), (std::vector<std::uint8_t>{0x07, 0x00}));
+}
+
+TEST(EthercatCoeSdo, ExpeditedUploadAndCounterRunsOneToSeven) {
+  Harness h;
+  h.server.od[{0x1000, 0}] = {0x92, 0x01, 0x02, 0x00};  // digest TV-2: device type 00020192h
+  for (int i = 0; i < 8; ++i) {
+    const CoeSdoId id = h.client.upload_value(0x1000, 0);
+    const auto r = h.run(id);
+    ASSERT_EQ(r.status, CoeSdoStatus::Done);
+    EXPECT_EQ(r.value, 0x00020192U);
+    EXPECT_EQ(r.size, 4U);
+    (void)h.client.take(id);
+  }
+  std::vector<std::uint8_t> counters;
+  for (const auto& q : h.line.slaves[0].requests) counters.push_back(static_cast<std::uint8_t>(q[5] >> 4));
+  EXPECT_EQ(counters, (std::vector<std::uint8_t>{1, 2, 3, 4, 5, 6, 7, 1}));
+}
+
+TEST(EthercatCoeSdo, SegmentedUploadAndDownload) {
+  Harness h;
+  std::vector<std::uint8_t> name(150);
+  for (std::size_t i = 0; i < name.size(); ++i) name[i] = static_cast<std::uint8_t>('A' + i % 26);
+  h.server.od[{0x1008, 0}] = name;
+  std::array<std::uint8_t, 200> into{};
+  const CoeSdoId up = h.client.upload(0x1008, 0, into);
+  const auto r = h.run(up);
+  ASSERT_EQ(r.status, CoeSdoStatus::Done) << std::hex << r.abort_code;
+  EXPECT_EQ(r.size, 150U);
+  const auto got = h.client.data(up);
+  EXPECT_EQ(std::vector<std::uint8_t>(got.begin(), got.end()), name);
+  // 48 bytes in the initiate response, then segments of up to 55 bytes: 2 segment requests.
+  EXPECT_EQ(h.line.slaves[0].requests.size(), 3U);
+
+  std::vector<std::uint8_t> blob(130);
+  for (std::size_t i = 0; i < blob.size(); ++i) blob[i] = static_cast<std::uint8_t>(i);
+  const CoeSdoId down = h.client.download(0x2000, 1, blob);
+  ASSERT_EQ(h.run(down).status, CoeSdoStatus::Done);
+  EXPECT_EQ(h.server.od.at({0x2000, 1}), blob);
+  // Toggle bits of the two download segments (bit 4 of the command byte): 0 then 1.
+  const auto& q = h.line.slaves[0].requests;
+  // 48 bytes in the initiate request, then 55 + 27 in two segments.
+  ASSERT_EQ(q.size(), 6U);
+  EXPECT_EQ(q[4][8] & 0x11, 0x00);
+  EXPECT_EQ(q[5][8] & 0x11, 0x11);  // toggle 1, c = 1: last segment
+}
+
+TEST(EthercatCoeSdo, ServerAbortFailsWithItsCode) {
+  Harness h;
+  h.server.aborts[{0x60C2, 2}] = 0x06010002;  // attempt to write a read-only object
+  const CoeSdoId id = h.client.download_value(0x60C2, 2, 0xFD, 1);
+  const auto r = h.run(id);
+  EXPECT_EQ(r.status, CoeSdoStatus::Failed);
+  EXPECT_EQ(r.abort_code, 0x06010002U);
+  EXPECT_FALSE(sdo_abort_text(r.abort_code).empty());
+  EXPECT_EQ(h.client.counters().aborts, 1U);
+}
+
+TEST(EthercatCoeSdo, SilentServerTimesOutAndTheQueueMovesOn) {
+  CoeSdoTiming t;
+  t.timeout = 20ms;
+  Harness h(t);
+  h.server.ignore = 1;
+  h.server.od[{0x1000, 0}] = {1, 2, 3, 4};
+  const CoeSdoId first = h.client.upload_value(0x1000, 0);
+  const CoeSdoId second = h.client.upload_value(0x1000, 0);
+  EXPECT_EQ(h.client.result(second).status, CoeSdoStatus::Queued);
+  const auto t0 = h.now;
+  const auto r = h.run(first);
+  EXPECT_EQ(r.status, CoeSdoStatus::Failed);
+  EXPECT_EQ(r.abort_code, 0x05040000U);
+  EXPECT_GE(h.now - t0, 20ms);
+  EXPECT_LT(h.now - t0, 30ms);
+  EXPECT_EQ(h.run(second).status, CoeSdoStatus::Done);
+}
+
+TEST(EthercatCoeSdo, LostReplyIsFetchedAgainWithTheRepeatBit) {
+  Harness h;
+  h.server.od[{0x1018, 1}] = {0x0F, 0, 0, 0};
+  h.drop_next_sm1_read = true;
+  const CoeSdoId id = h.client.upload_value(0x1018, 1);
+  const auto r = h.run(id);
+  ASSERT_EQ(r.status, CoeSdoStatus::Done);
+  EXPECT_EQ(r.value, 0x0FU);
+  EXPECT_EQ(h.client.counters().repeats, 1U);
+  EXPECT_EQ(h.line.slaves[0].requests.size(), 1U);  // not asked again: the slave repeated its reply
+  EXPECT_EQ(h.line.slaves[0].sm1_reads, 2);
+  EXPECT_EQ(h.line.slaves[0].mem[0x080E] & 0x02, 0x02);  // repeat request toggled
+  EXPECT_EQ(h.line.slaves[0].mem[0x080F] & 0x02, 0x02);  // and acknowledged
+}
+
+TEST(EthercatCoeSdo, EmergencyInTheMailboxGoesToTheSink) {
+  Harness h;
+  h.server.od[{0x1001, 0}] = {0x11};
+  h.server.emergency_first = true;
+  const CoeSdoId id = h.client.upload_value(0x1001, 0);
+  const auto r = h.run(id);
+  ASSERT_EQ(r.status, CoeSdoStatus::Done);
+  EXPECT_EQ(r.value, 0x11U);
+  ASSERT_EQ(h.emcy.got.size(), 1U);
+  EXPECT_EQ(h.emcy.got[0].first, 0x1001);
+  EXPECT_EQ(h.emcy.got[0].second.error_code, 0x8100);
+  EXPECT_EQ(h.emcy.got[0].second.error_register, 0x11);
+}
+
+TEST(EthercatCoeSdo, UploadLongerThanTheBufferFails) {
+  Harness h;
+  h.server.od[{0x1008, 0}] = std::vector<std::uint8_t>(40, 'x');
+  std::array<std::uint8_t, 10> small{};
+  const auto r = h.run(h.client.upload(0x1008, 0, small));
+  EXPECT_EQ(r.status, CoeSdoStatus::Failed);
+  EXPECT_EQ(r.abort_code, 0x05040005U);
+}
+
+TEST(EthercatCoeSdo, QueueHasAFixedSize) {
+  Harness h;
+  for (std::size_t i = 0; i < CoeSdoClient::kQueueDepth; ++i) EXPECT_NE(h.client.upload_value(0x1000, 0), 0U);
+  EXPECT_EQ(h.client.upload_value(0x1000, 0), 0U);
+  EXPECT_EQ(h.client.counters().queue_full, 1U);
+  EXPECT_FALSE(CoeSdoClient(0x1001, SiiMailbox{0x1000, 8, 0x1080, 8}).valid());
+}
+
+TEST(EthercatCoeSdo, PollingDoesNotAllocate) {
+  // Client and transactions alone, the slave's answers written by hand: the fake allocates.
+  Transactions tx;
+  CoeSdoClient client(0x1001, kMailbox);
+  const CoeSdoId id = client.upload_value(0x1000, 0);
+  std::array<std::uint8_t, kMaxFrameSize> echo{};
+  core::TimePoint now{};
+  drivegate::test::AllocationScope scope;
+  for (int i = 0; i < 50; ++i) {
+    client.poll(now, tx);
+    for (const auto& f : tx.take_frames(now + 1ms)) {
+      std::copy(f.begin(), f.end(), echo.begin());
+      put_u16(echo, 16 + 10 + (get_u16(echo, 22) & 0x7FFU), 1);  // one datagram per frame: WKC 1
+      (void)tx.on_frame(std::span<const std::uint8_t>(echo.data(), f.size()));
+    }
+    now += 1ms;
+    tx.expire(now);
+  }
+  EXPECT_EQ(scope.count(), 0U);
+  EXPECT_EQ(client.result(id).status, CoeSdoStatus::InFlight);
+}
+
+}  // namespace
+}  // namespace drivegate::ethercat

@@ -1,0 +1,243 @@
+// LineBoot against a scripted fake line (fake_line.hpp): count, reset, station addresses, SII read
+// through the EEPROM interface (build_sii images), identity check, SM0/SM1 from the SII, PRE-OP,
+// a refused SAFE-OP with AL status code 001Dh, identity mismatch, extra and missing slaves, a
+// transition timeout and lost frames.
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <vector>
+
+#include "adapters/ethercat/master/line_boot.hpp"
+#include "tests/ethercat_master/fake_line.hpp"
+
+namespace drivegate::ethercat {
+namespace {
+
+using namespace std::chrono_literals;
+using test::FakeEsc;
+using test::FakeLine;
+
+constexpr std::uint32_t kVendor = 0x0000000F;  // dunker-ethercat-coe.md §1: vendor "15"
+constexpr std::uint32_t kProduct = 6755;
+
+std::vector<std::uint8_t> image(std::uint32_t product, std::uint32_t revision, std::string_view name) {
+  static const std::array<SiiSyncManager, 4> sms{{
+      {0x1000, 128, 0x26, 0, 1, sii_sm_type::kMailboxOut},
+      {0x1080, 128, 0x22, 0, 1, sii_sm_type::kMailboxIn},
+      {0x1100, 0, 0x64, 0, 1, sii_sm_type::kOutputs},
+      {0x1180, 0, 0x20, 0, 1, sii_sm_type::kInputs},
+  }};
+  SiiProfile p;
+  p.identity = SiiIdentity{kVendor, product, revision, 1234};
+  p.standard_mailbox = SiiMailbox{0x1000, 128, 0x1080, 128};
+  p.mailbox_protocols = mailbox_protocol::kCoE;
+  p.name = name;
+  p.group = "Drive";
+  p.sync_managers = sms;
+  std::vector<std::uint8_t> out(2048);
+  const auto r = build_sii(p, out);
+  EXPECT_TRUE(r.ok()) << to_string(r.error);
+  return out;
+}
+
+FakeLine line_of(std::size_t n) {
+  FakeLine line;
+  for (std::size_t i = 0; i < n; ++i) {
+    FakeEsc esc;
+    esc.sii = image(kProduct, 0x00010000, "ESR TrioDrive");
+    line.slaves.push_back(std::move(esc));
+  }
+  return line;
+}
+
+const std::vector<ExpectedSlave> kThree{
+    {kVendor, kProduct, 0x00010000, "ESR TrioDrive"},
+    {kVendor, kProduct, 0x00010000, "ESR TrioDrive"},
+    {kVendor, kProduct, 0, "ESR TrioDrive"},
+};
+
+struct Harness {
+  FakeLine line;
+  Transactions tx;
+  std::unique_ptr<LineBoot> boot;
+  core::TimePoint now{};
+  std::function<bool(std::size_t)> drop;  // frame number -> lose it
+  std::size_t frames = 0;
+
+  Harness(FakeLine l, std::span<const ExpectedSlave> expected, LineBootConfig cfg = {})
+      : line(std::move(l)), boot(std::make_unique<LineBoot>(expected, cfg)) {}
+
+  void cycle() {
+    boot->poll(now, tx);
+    std::vector<std::vector<std::uint8_t>> out;
+    for (const auto& f : tx.take_frames(now + 1ms)) out.emplace_back(f.begin(), f.end());
+    for (auto& f : out) {
+      line.process(f);
+      if (!(drop && drop(frames++))) tx.on_frame(f);
+    }
+    now += 1ms;
+    tx.expire(now);
+  }
+  // Runs until the boot is no longer running (or the slave transition finished).
+  void run(int max_cycles = 20000) {
+    for (int i = 0; i < max_cycles && boot->status() != LineStatus::Done && boot->status() != LineStatus::Failed;
+         ++i) {
+      cycle();
+    }
+  }
+};
+
+TEST(EthercatLineBoot, ThreeSlavesReachPreOp) {
+  FakeLine line = line_of(3);
+  line.slaves[1].sii_eight_bytes = true;  // 8-byte EEPROM reads
+  line.slaves[2].sii_busy_reads = 2;      // busy twice after every read command
+  line.slaves[0].al_delay_reads = 3;      // PRE-OP reached after a few status reads
+  Harness h(std::move(line), kThree);
+  h.boot->start(h.now);
+  h.run();
+  ASSERT_EQ(h.boot->status(), LineStatus::Done) << h.boot->line_text();
+  EXPECT_TRUE(h.boot->ok());
+  EXPECT_EQ(h.boot->slave_count(), 3U);
+  EXPECT_TRUE(h.boot->line_text().empty()) << h.boot->line_text();
+  for (std::size_t i = 0; i < 3; ++i) {
+    const SlaveReport& r = h.boot->slave(i);
+    EXPECT_EQ(r.status, SlaveStatus::Ready) << r.text.view();
+    EXPECT_EQ(r.state, AlState::PreOp);
+    EXPECT_EQ(r.station, 0x1001 + i);
+    EXPECT_EQ(h.line.slaves[i].station(), 0x1001 + i);       // APWR 0010h = 1001h + position
+    EXPECT_EQ(h.line.slaves[i].al_state(), 2);               // the ESC is in PRE-OP
+    EXPECT_EQ(h.boot->sii(i).identity, (SiiIdentity{kVendor, kProduct, 0x00010000, 1234}));
+    EXPECT_EQ(h.boot->sii(i).string(h.boot->sii(i).general.name_index), "ESR TrioDrive");
+    // SM0/SM1 as the SII standard mailbox says, with the SyncM category's control bytes
+    // [ETG.1000.4 Table 59: start, length, control, status, activate, PDI control].
+    const std::vector<std::uint8_t> sms(h.line.slaves[i].mem.begin() + 0x0800, h.line.slaves[i].mem.begin() + 0x0810);
+    EXPECT_EQ(sms, (std::vector<std::uint8_t>{0x00, 0x10, 0x80, 0x00, 0x26, 0x00, 0x01, 0x00,  //
+                                              0x80, 0x10, 0x80, 0x00, 0x22, 0x00, 0x01, 0x00}));
+    // The reset acknowledged INIT first, then PRE-OP was requested.
+    ASSERT_GE(h.line.slaves[i].al_control_writes.size(), 2U);
+    EXPECT_EQ(h.line.slaves[i].al_control_writes.front(), 0x0011);
+    EXPECT_EQ(h.line.slaves[i].al_control_writes.back(), 0x0002);
+  }
+  // The reset also put the DC filter registers at their reset values.
+  EXPECT_EQ(get_u16(h.line.slaves[0].mem, reg::kDcSpeedCounterStart), 0x1000);
+  EXPECT_EQ(h.tx.counters().datagrams_lost, 0U);
+}
+
+TEST(EthercatLineBoot, RefusedSafeOpReportsTheAlStatusCodeAndAcknowledges) {
+  FakeLine line = line_of(3);
+  line.slaves[1].refuse[4] = 0x001D;
+  Harness h(std::move(line), kThree);
+  h.boot->start(h.now);
+  h.run();
+  ASSERT_TRUE(h.boot->ok());
+  ASSERT_TRUE(h.boot->request_state(1, AlState::SafeOp, h.now));
+  ASSERT_TRUE(h.boot->request_state(2, AlState::SafeOp, h.now));
+  EXPECT_FALSE(h.boot->request_state(1, AlState::SafeOp, h.now));  // already busy
+  h.run();
+  const SlaveReport& r = h.boot->slave(1);
+  EXPECT_EQ(r.status, SlaveStatus::Failed);
+  EXPECT_EQ(r.step, BootStep::Transition);
+  EXPECT_EQ(r.al_code, 0x001D);
+  EXPECT_EQ(r.text.view(), "slave 2 (0x1002, ESR TrioDrive): PRE-OP -> SAFE-OP refused: 0x001D invalid output configuration");
+  // Error acknowledged in the state the slave stayed in: AL control = PRE-OP | ack (0012h).
+  EXPECT_EQ(h.line.slaves[1].al_control_writes.back(), 0x0012);
+  EXPECT_EQ(h.line.slaves[1].mem[reg::kAlStatus], 0x02);
+  EXPECT_EQ(h.boot->slave(2).status, SlaveStatus::Ready);
+  EXPECT_EQ(h.boot->slave(2).state, AlState::SafeOp);
+  EXPECT_EQ(h.line.slaves[2].al_state(), 4);
+}
+
+TEST(EthercatLineBoot, IdentityMismatchIsReportedWithBothIdentities) {
+  FakeLine line = line_of(3);
+  line.slaves[1].sii = image(6745, 0x00020000, "ESR MidiDrive");
+  Harness h(std::move(line), kThree);
+  h.boot->start(h.now);
+  h.run();
+  ASSERT_EQ(h.boot->status(), LineStatus::Done);
+  EXPECT_FALSE(h.boot->ok());
+  const SlaveReport& r = h.boot->slave(1);
+  EXPECT_EQ(r.status, SlaveStatus::Failed);
+  EXPECT_EQ(r.step, BootStep::Identity);
+  EXPECT_TRUE(r.identity_mismatch);
+  EXPECT_EQ(r.found.product_code, 6745U);
+  EXPECT_EQ(r.text.view(),
+            "slave 2 (0x1002, ESR TrioDrive): identity mismatch: expected vendor 0x0000000F product 0x00001A63 "
+            "revision 0x00010000, found vendor 0x0000000F product 0x00001A59 revision 0x00020000");
+  EXPECT_EQ(h.line.slaves[1].al_state(), 1);  // left in INIT
+  EXPECT_EQ(h.boot->slave(0).state, AlState::PreOp);
+  EXPECT_EQ(h.boot->slave(2).state, AlState::PreOp);
+}
+
+TEST(EthercatLineBoot, ExtraSlaveIsReportedAndLeftInInit) {
+  FakeLine line = line_of(4);
+  line.slaves[3].sii = image(0x44, 1, "EK1100");
+  Harness h(std::move(line), kThree);
+  h.boot->start(h.now);
+  h.run();
+  ASSERT_EQ(h.boot->status(), LineStatus::Done);
+  EXPECT_FALSE(h.boot->ok());
+  EXPECT_EQ(h.boot->slave_count(), 4U);
+  const SlaveReport& r = h.boot->slave(3);
+  EXPECT_EQ(r.status, SlaveStatus::Extra);
+  EXPECT_EQ(r.text.view(),
+            "slave 4 (0x1004, EK1100): not configured (vendor 0x0000000F product 0x00000044 revision 0x00000001), "
+            "left in INIT");
+  EXPECT_EQ(h.line.slaves[3].al_state(), 1);
+  EXPECT_EQ(h.line.slaves[3].al_control_writes, (std::vector<std::uint16_t>{0x0011}));  // only the reset
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_EQ(h.boot->slave(i).state, AlState::PreOp);
+}
+
+TEST(EthercatLineBoot, MissingSlaveIsReported) {
+  Harness h(line_of(2), kThree);
+  h.boot->start(h.now);
+  h.run();
+  ASSERT_EQ(h.boot->status(), LineStatus::Done);
+  EXPECT_FALSE(h.boot->ok());
+  EXPECT_EQ(h.boot->missing(), 1U);
+  EXPECT_EQ(h.boot->line_text(), "3 slave(s) configured, 2 found: position 2 and after missing");
+}
+
+TEST(EthercatLineBoot, TransitionTimeoutNamesTheStateTheSlaveStayedIn) {
+  FakeLine line = line_of(1);
+  line.slaves[0].never_reach = true;
+  LineBootConfig cfg;
+  cfg.init_to_preop = 50ms;
+  Harness h(std::move(line), std::span<const ExpectedSlave>(kThree).first(1), cfg);
+  h.boot->start(h.now);
+  const auto t0 = h.now;
+  h.run();
+  const SlaveReport& r = h.boot->slave(0);
+  EXPECT_EQ(r.status, SlaveStatus::Failed);
+  EXPECT_EQ(r.text.view(), "slave 1 (0x1001, ESR TrioDrive): INIT -> PRE-OP timed out (AL status 0x0001 INIT)");
+  EXPECT_LT(h.now - t0, 1s);
+}
+
+TEST(EthercatLineBoot, LostFramesAreRetried) {
+  Harness h(line_of(3), kThree);
+  h.drop = [](std::size_t n) { return n % 7 == 3; };
+  h.boot->start(h.now);
+  h.run();
+  ASSERT_EQ(h.boot->status(), LineStatus::Done) << h.boot->line_text();
+  EXPECT_TRUE(h.boot->ok()) << h.boot->slave(0).text.view() << h.boot->slave(1).text.view();
+  EXPECT_GT(h.tx.counters().frames_lost, 0U);
+}
+
+TEST(EthercatLineBoot, EmptyLineFailsTheCount) {
+  Harness h(line_of(0), kThree);
+  h.boot->start(h.now);
+  h.run();
+  EXPECT_EQ(h.boot->status(), LineStatus::Failed);
+  EXPECT_EQ(h.boot->line_text(), "count: no slave answered BRD 0x0000 (WKC 0)");
+}
+
+TEST(EthercatLineBoot, DisconnectedLineFailsAfterRetries) {
+  Harness h(line_of(1), kThree);
+  h.drop = [](std::size_t) { return true; };
+  h.boot->start(h.now);
+  h.run();
+  EXPECT_EQ(h.boot->status(), LineStatus::Failed);
+  EXPECT_EQ(h.boot->line_text(), "count: no answer to BRD 0x0000 (frame lost 4 times): is the line connected?");
+}
+
+}  // namespace
+}  // namespace drivegate::ethercat
