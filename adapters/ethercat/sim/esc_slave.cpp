@@ -1,0 +1,697 @@
+#include "adapters/ethercat/sim/esc_slave.hpp"
+
+#include <algorithm>
+#include <cstring>
+
+#include "adapters/ethercat/wire/bytes.hpp"
+
+namespace drivegate::ethercat::sim {
+namespace {
+
+constexpr std::uint32_t kMemorySize = 0x10000;
+// AL status codes [ETG.1000.6 §5.3.2 Table 11].
+constexpr std::uint16_t kAlInvalidStateChange = 0x0011;
+constexpr std::uint16_t kAlUnknownState = 0x0012;
+constexpr std::uint16_t kAlBootstrapNotSupported = 0x0013;
+constexpr std::uint16_t kAlInvalidMailboxConfig = 0x0016;
+constexpr std::uint16_t kAlSmWatchdog = 0x001B;
+constexpr std::uint16_t kAlInvalidOutputConfig = 0x001D;
+constexpr std::uint16_t kAlInvalidInputConfig = 0x001E;
+// DL control bit 24: station alias enabled for FPxx addressing [ETG.1000.4 Table 31, 0100h].
+constexpr std::uint32_t kDlControlAlias = 0x01000000;
+// SM PDI control (byte 7): bit 0 deactivate, bit 1 repeat acknowledge [ETG.1000.4 Table 59].
+constexpr std::uint8_t kPdiDeactivate = 0x01;
+constexpr std::uint8_t kPdiRepeatAck = 0x02;
+// Watchdog tick: (divider + 2) × 40 ns [ETG.1000.4 watchdog divider 0400h; digest §8.2].
+constexpr std::uint64_t kWatchdogBaseNs = 40;
+
+bool overlaps(std::uint32_t a, std::uint32_t alen, std::uint32_t b, std::uint32_t blen) noexcept {
+  return alen != 0 && blen != 0 && a < b + blen && b < a + alen;
+}
+
+}  // namespace
+
+EscSlave::EscSlave(const EscConfig& config, std::span<const std::uint8_t> sii, SlaveApplication* app)
+    : cfg_(config),
+      app_(app),
+      mem_(kMemorySize, 0),
+      sii_(sii.begin(), sii.end()),
+      sii_info_storage_(1),
+      outbox_(config.mailbox_queue, 0),
+      coe_(app != nullptr ? app->object_dictionary() : nullptr, config.max_object_bytes) {
+  sii_info_ = sii_info_storage_.data();
+  parse_sii(sii_, *sii_info_);
+  has_mailbox_ = sii_info_->standard_mailbox.present();
+  if (has_mailbox_) {
+    outbox_ = MailboxOutbox(config.mailbox_queue, sii_info_->standard_mailbox.tx_size);
+    last_sent_.assign(sii_info_->standard_mailbox.tx_size, 0);
+  }
+  const std::size_t ram = static_cast<std::size_t>(cfg_.ram_kib) * 1024;
+  outputs_.assign(ram, 0);
+  inputs_.assign(ram, 0);
+  zeros_.assign(ram, 0);
+
+  // Register bytes the master may write [ETG.1000.4 Table 31: ECAT access r/w]; the rest of
+  // 0000h-0FFFh is read-only for ECAT.
+  auto allow = [this](std::uint32_t from, std::uint32_t count) {
+    for (std::uint32_t a = from; a < from + count && a < 0x1000; ++a) writable_.set(a);
+  };
+  allow(reg::kStationAddress, 2);
+  allow(reg::kWriteEnable, 2);
+  allow(reg::kEscWriteEnable, 2);
+  allow(reg::kEscResetEcat, 1);
+  allow(reg::kDlControl, 4);
+  allow(reg::kPhysicalRwOffset, 2);
+  allow(reg::kAlControl, 2);
+  allow(reg::kRunLedOverride, 2);
+  allow(reg::kEcatEventMask, 2);
+  allow(reg::kWatchdogDivider, 2);
+  allow(reg::kWatchdogTimePdi, 2);
+  allow(reg::kWatchdogTimeProcessData, 2);
+  allow(reg::kSiiConfig, 1);
+  allow(reg::kSiiAddress, 8);  // address and write data
+  for (unsigned n = 0; n < cfg_.fmmu_count; ++n) allow(reg::fmmu(n), 13);  // 13-15 reserved
+  for (unsigned n = 0; n < cfg_.sm_count; ++n) {
+    allow(reg::sm(n), 5);      // start, length, control; 5 status is read-only
+    allow(reg::sm(n) + 6U, 1); // activate; 7 PDI control is read-only
+  }
+  if (cfg_.dc_supported) {
+    allow(reg::kDcSystemTimeOffset, 8);
+    allow(reg::kDcSystemTimeDelay, 4);
+    allow(reg::kDcSpeedCounterStart, 2);
+    allow(reg::kDcTimeDifferenceFilterDepth, 2);
+    allow(reg::kDcCyclicUnitControl, 2);
+    allow(reg::kDcSync0StartTime, 8);
+    allow(reg::kDcSync0CycleTime, 8);
+    allow(reg::kDcLatch0Control, 2);
+  }
+  power_on();
+}
+
+std::uint16_t EscSlave::u16(std::uint16_t at) const noexcept { return get_u16(mem_, at); }
+std::uint32_t EscSlave::u32(std::uint16_t at) const noexcept { return get_u32(mem_, at); }
+std::uint64_t EscSlave::u64(std::uint16_t at) const noexcept { return get_u64(mem_, at); }
+void EscSlave::set16(std::uint16_t at, std::uint16_t v) noexcept { put_u16(mem_, at, v); }
+void EscSlave::set32(std::uint16_t at, std::uint32_t v) noexcept { put_u32(mem_, at, v); }
+void EscSlave::set64(std::uint16_t at, std::uint64_t v) noexcept { put_u64(mem_, at, v); }
+
+std::uint16_t EscSlave::al_status_code() const noexcept { return u16(reg::kAlStatusCode); }
+std::uint16_t EscSlave::station_address() const noexcept { return u16(reg::kStationAddress); }
+
+void EscSlave::power_on() noexcept {
+  std::fill(mem_.begin(), mem_.end(), std::uint8_t{0});
+  mem_[reg::kType] = cfg_.type;
+  mem_[reg::kRevision] = cfg_.revision;
+  set16(reg::kBuild, cfg_.build);
+  mem_[reg::kFmmusSupported] = cfg_.fmmu_count;
+  mem_[reg::kSmsSupported] = cfg_.sm_count;
+  mem_[reg::kRamSize] = cfg_.ram_kib;
+  mem_[reg::kPortDescriptor] = cfg_.port_descriptor;
+  // ESC features 0008h: bit 2 distributed clocks, bit 3 DC 64-bit [ETG.1000.4 Table 31].
+  std::uint16_t features = static_cast<std::uint16_t>(cfg_.features & ~0x000CU);
+  if (cfg_.dc_supported) features = static_cast<std::uint16_t>(features | 0x0004U | (cfg_.dc_64bit ? 0x0008U : 0U));
+  set16(reg::kEscFeatures, features);
+  // What the ESC loads from the EEPROM at power-on [ETG.1000.6 §5.4: words 0-4].
+  set16(reg::kStationAlias, sii_info_->station_alias);
+  mem_[reg::kPdiControl] = static_cast<std::uint8_t>(sii_info_->pdi_control & 0xFF);
+  mem_[reg::kEscConfiguration] = static_cast<std::uint8_t>(sii_info_->pdi_control >> 8);
+  set16(reg::kPdiConfiguration, sii_info_->pdi_configuration);
+  set32(reg::kDlControl, 0x00000001);  // forwarding rule; loops on auto
+  set16(reg::kAlStatus, static_cast<std::uint16_t>(AlState::Init));
+  // Watchdog defaults: divider 2498 (100 µs), times 1000 ticks = 100 ms [digest §8.2].
+  set16(reg::kWatchdogDivider, 2498);
+  set16(reg::kWatchdogTimePdi, 1000);
+  set16(reg::kWatchdogTimeProcessData, 1000);
+  std::uint16_t sii_ctl = cfg_.sii_read_8_bytes ? sii_control::kRead8Bytes : 0;
+  if (sii_.size() > 2048) sii_ctl = static_cast<std::uint16_t>(sii_ctl | sii_control::kTwoAddressBytes);
+  set16(reg::kSiiControl, sii_ctl);
+  for (unsigned n = 0; n < cfg_.sm_count; ++n) mem_[reg::sm(n) + 7U] = kPdiDeactivate;
+  sms_ = {};
+  state_ = AlState::Init;
+  sii_busy_ = 0;
+  outbox_.clear();
+  coe_.reset();
+  last_sent_size_ = 0;
+  last_rx_counter_ = 0;
+  mailbox_pending_ = false;
+  outputs_valid_ = false;
+  wd_triggered_ = false;
+  set_port1_link(port1_link_);
+}
+
+void EscSlave::set_port1_link(bool up) noexcept {
+  if (port1_link_ && !up && mem_[reg::kLostLinkCounter + 1] < 0xFF) ++mem_[reg::kLostLinkCounter + 1];
+  port1_link_ = up;
+  // DL status 0110h [ETG.1000.4 Table 34]: PDI operational (EEPROM loaded), port 0 link and
+  // communication; port 1 open with a link, closed without; ports 2 and 3 are not implemented
+  // (closed).
+  std::uint16_t s = static_cast<std::uint16_t>(dl_status::kPdiOperational | dl_status::link_on_port(0) |
+                                               dl_status::communication_on_port(0) | dl_status::loop_closed_port(2) |
+                                               dl_status::loop_closed_port(3));
+  if (up) {
+    s = static_cast<std::uint16_t>(s | dl_status::link_on_port(1) | dl_status::communication_on_port(1));
+  } else {
+    s = static_cast<std::uint16_t>(s | dl_status::loop_closed_port(1));
+  }
+  set16(reg::kDlStatus, s);
+}
+
+void EscSlave::count_rx_error() noexcept {
+  if (mem_[reg::kRxErrorCounter] < 0xFF) ++mem_[reg::kRxErrorCounter];  // port 0 invalid frame counter
+}
+
+void EscSlave::begin_frame(std::uint64_t port0_ns, std::uint64_t port1_ns, bool downstream) noexcept {
+  port0_ns_ = port0_ns;
+  port1_ns_ = port1_ns;
+  downstream_ = downstream;
+  now_ns_ = port0_ns;
+}
+
+// ---- SyncManagers -----------------------------------------------------------------------------
+
+SmEntry EscSlave::sm(unsigned n) const noexcept {
+  const auto e = decode_sm(std::span<const std::uint8_t>(mem_).subspan(reg::sm(n), kSmEntrySize));
+  return e.value_or(SmEntry{});
+}
+
+bool EscSlave::sm_active(unsigned n) const noexcept {
+  const SmEntry e = sm(n);
+  return e.enabled() && (e.pdi_control & kPdiDeactivate) == 0 && e.length != 0;
+}
+
+bool EscSlave::sm_allows(std::uint32_t start, std::uint32_t len, Rw rw) const noexcept {
+  for (unsigned n = 0; n < cfg_.sm_count; ++n) {
+    const SmEntry e = sm(n);
+    if (!e.enabled() || !overlaps(start, len, e.physical_start, e.length)) continue;
+    // Enabled by the master but deactivated by the PDI (INIT, or the slave has not reached the
+    // state that uses it): the area is locked [ETG.1000.4 Table 59, PDI control bit 0].
+    if ((e.pdi_control & kPdiDeactivate) != 0) return false;
+    const bool mailbox = (e.control & sm_control::kModeMask) == sm_control::kModeMailbox;
+    const bool ecat_writes = (e.control & sm_control::kDirectionMask) == sm_control::kDirectionWrite;
+    if (mailbox) {
+      // 1-buffer: the master writes an empty write mailbox and reads a full read mailbox
+      // [ETG.1000.4 SyncManager mailbox mode].
+      if (ecat_writes && (rw != Rw::Write || sms_[n].mailbox_full)) return false;
+      if (!ecat_writes && (rw != Rw::Read || !sms_[n].mailbox_full)) return false;
+    } else if (!ecat_writes && rw == Rw::Write) {
+      return false;  // inputs: the PDI writes, ECAT only reads
+    }
+  }
+  return true;
+}
+
+void EscSlave::sm_after(std::uint32_t start, std::uint32_t len, Rw rw) noexcept {
+  for (unsigned n = 0; n < cfg_.sm_count; ++n) {
+    if (!sm_active(n)) continue;
+    const SmEntry e = sm(n);
+    const std::uint32_t last = static_cast<std::uint32_t>(e.physical_start) + e.length - 1U;
+    if (!overlaps(start, len, last, 1)) continue;  // buffer state changes with the last byte
+    const bool mailbox = (e.control & sm_control::kModeMask) == sm_control::kModeMailbox;
+    const bool ecat_writes = (e.control & sm_control::kDirectionMask) == sm_control::kDirectionWrite;
+    const std::uint16_t status_at = static_cast<std::uint16_t>(reg::sm(n) + 5U);
+    if (mailbox && ecat_writes && rw == Rw::Write) {
+      sms_[n].mailbox_full = true;
+      mem_[status_at] = static_cast<std::uint8_t>(mem_[status_at] | sm_status::kMailboxFull | sm_status::kInterruptWrite);
+      if (n == 0) mailbox_pending_ = true;
+    } else if (mailbox && !ecat_writes && rw == Rw::Read) {
+      sms_[n].mailbox_full = false;
+      mem_[status_at] = static_cast<std::uint8_t>(mem_[status_at] & ~(sm_status::kMailboxFull | sm_status::kInterruptRead));
+    } else if (!mailbox && ecat_writes && rw == Rw::Write) {
+      // A complete output buffer: triggers the SM watchdog when the SM asks for it [ETG.1000.4
+      // Table 59 control bit 6; digest §8.2].
+      mem_[status_at] = static_cast<std::uint8_t>(mem_[status_at] | sm_status::kInterruptWrite);
+      outputs_valid_ = true;
+      if ((e.control & sm_control::kWatchdogTrigger) != 0) {
+        wd_triggered_ = true;
+        wd_last_ns_ = now_ns_;
+      }
+    }
+  }
+}
+
+void EscSlave::set_pdi_deactivate(unsigned n, bool deactivate) noexcept {
+  if (n >= cfg_.sm_count) return;
+  const auto at = static_cast<std::uint16_t>(reg::sm(n) + 7U);
+  mem_[at] = static_cast<std::uint8_t>(deactivate ? (mem_[at] | kPdiDeactivate) : (mem_[at] & ~kPdiDeactivate));
+  if (deactivate) {
+    sms_[n].mailbox_full = false;
+    mem_[reg::sm(n) + 5U] = 0;
+  }
+}
+
+// ---- Physical memory access -------------------------------------------------------------------
+
+void EscSlave::refresh_dynamic_registers() noexcept {
+  if (cfg_.dc_supported) {
+    // System time 0910h = local time + system time offset 0920h [ETG.1000.4 §6 DC].
+    const std::uint64_t sys = local_time(now_ns_) + u64(reg::kDcSystemTimeOffset);
+    set64(reg::kDcSystemTime, cfg_.dc_64bit ? sys : (sys & 0xFFFFFFFFU));
+  }
+}
+
+bool EscSlave::phys_read(std::uint32_t ado, std::span<std::uint8_t> data, bool or_in) noexcept {
+  const auto len = static_cast<std::uint32_t>(data.size());
+  if (ado + len > kMemorySize) return false;
+  if (!sm_allows(ado, len, Rw::Read)) return false;
+  for (std::uint32_t i = 0; i < len; ++i) {
+    const std::uint8_t v = mem_[ado + i];
+    data[i] = or_in ? static_cast<std::uint8_t>(data[i] | v) : v;
+  }
+  sm_after(ado, len, Rw::Read);
+  return true;
+}
+
+bool EscSlave::phys_write(std::uint32_t ado, std::span<const std::uint8_t> data) noexcept {
+  const auto len = static_cast<std::uint32_t>(data.size());
+  if (ado + len > kMemorySize) return false;
+  if (!sm_allows(ado, len, Rw::Write)) return false;
+  const std::uint32_t ram_end = reg::kProcessRam + static_cast<std::uint32_t>(cfg_.ram_kib) * 1024U;
+  const std::uint16_t sii_before = u16(reg::kSiiControl);
+  for (std::uint32_t i = 0; i < len; ++i) {
+    const std::uint32_t a = ado + i;
+    if (a < reg::kProcessRam ? writable_.test(a) : a < ram_end) mem_[a] = data[i];
+  }
+  if (ado < reg::kProcessRam) {
+    // SII control: only write enable (bit 0) and the command (bits 8-10) are written; a command
+    // while busy is ignored [ETG.1000.4 Table 48].
+    if (overlaps(ado, len, reg::kSiiControl, 2)) {
+      std::uint16_t written = sii_before;
+      for (std::uint32_t b = 0; b < 2; ++b) {
+        const std::uint32_t a = reg::kSiiControl + b;
+        if (a >= ado && a < ado + len) {
+          written = static_cast<std::uint16_t>((written & ~(0xFFU << (8 * b))) | (data[a - ado] << (8 * b)));
+        }
+      }
+      const std::uint16_t keep_mask = static_cast<std::uint16_t>(~(sii_control::kCommandMask | sii_control::kWriteEnable));
+      if ((sii_before & sii_control::kBusy) == 0) {
+        set16(reg::kSiiControl, static_cast<std::uint16_t>((sii_before & keep_mask) |
+                                                           (written & (sii_control::kCommandMask | sii_control::kWriteEnable))));
+        if ((written & sii_control::kCommandMask) != 0) sii_command();
+      }
+    }
+    // System time written (ARMW/FRMW of the other slaves, or FPWR): the DC control loop compares
+    // it with the local copy; the difference goes to 092Ch [ETG.1000.4 §6 DC].
+    if (cfg_.dc_supported && ado <= reg::kDcSystemTime && ado + len >= reg::kDcSystemTime + 4U) {
+      const std::uint32_t received = get_u32(data, reg::kDcSystemTime - ado);
+      const auto local = static_cast<std::uint32_t>(local_time(now_ns_) + u64(reg::kDcSystemTimeOffset));
+      const auto diff = static_cast<std::int32_t>(local - received);
+      const std::uint32_t mag = diff < 0 ? static_cast<std::uint32_t>(-static_cast<std::int64_t>(diff)) : static_cast<std::uint32_t>(diff);
+      set32(reg::kDcSystemTimeDifference, (mag & 0x7FFFFFFFU) | (diff < 0 ? 0x80000000U : 0U));
+    }
+    register_written(ado, len);
+  }
+  sm_after(ado, len, Rw::Write);
+  return true;
+}
+
+void EscSlave::register_written(std::uint32_t start, std::uint32_t len) noexcept {
+  if (overlaps(start, len, reg::kAlControl, 2)) al_control_written();
+  // A write to the error counters clears them [ETG.1000.4 Table 31, 0300h-0313h].
+  if (overlaps(start, len, reg::kRxErrorCounter, 0x14)) {
+    std::fill(mem_.begin() + reg::kRxErrorCounter, mem_.begin() + reg::kRxErrorCounter + 0x14, std::uint8_t{0});
+  }
+  if (cfg_.dc_supported && overlaps(start, len, reg::kDcReceiveTimePort0, 4)) {
+    // Receive time latch: each port stores the local time the write passed it; the processing
+    // unit's time goes to 0918h [ETG.1000.4 §6 DC, receive times].
+    set32(reg::kDcReceiveTimePort0, static_cast<std::uint32_t>(local_time(port0_ns_)));
+    if (downstream_) set32(reg::kDcReceiveTimePort1, static_cast<std::uint32_t>(local_time(port1_ns_)));
+    set64(reg::kDcReceiveTimeProcessingUnit, local_time(port0_ns_));
+  }
+}
+
+// ---- Datagrams --------------------------------------------------------------------------------
+
+bool EscSlave::logical(Command c, std::uint32_t address, std::span<std::uint8_t> data, std::uint16_t& wkc) noexcept {
+  bool read_hit = false;
+  bool write_hit = false;
+  const bool reads = c == Command::LRD || c == Command::LRW;
+  const bool writes = c == Command::LWR || c == Command::LRW;
+  const std::uint64_t lo = address;
+  const std::uint64_t hi = lo + data.size();
+  // Writes first, from the data as the frame brought it; then reads into the frame, so an input
+  // FMMU overlapping an output FMMU's logical range returns inputs [ETG.1000.4 §5.4 LRW].
+  for (int pass = 0; pass < 2; ++pass) {
+    const bool write_pass = pass == 0;
+    if (write_pass ? !writes : !reads) continue;
+    for (unsigned n = 0; n < cfg_.fmmu_count; ++n) {
+      const auto f = decode_fmmu(std::span<const std::uint8_t>(mem_).subspan(reg::fmmu(n), kFmmuEntrySize));
+      if (!f || !f->active || f->length == 0) continue;
+      if ((f->type & (write_pass ? fmmu_type::kWrite : fmmu_type::kRead)) == 0) continue;
+      if (f->logical_start_bit != 0 || f->logical_stop_bit != 7) continue;  // byte granularity only
+      const std::uint64_t flo = f->logical_start;
+      const std::uint64_t fhi = flo + f->length;
+      const std::uint64_t a = std::max(lo, flo);
+      const std::uint64_t b = std::min(hi, fhi);
+      if (a >= b) continue;
+      const auto phys = static_cast<std::uint32_t>(f->physical_start + (a - flo));
+      const auto off = static_cast<std::size_t>(a - lo);
+      const auto n_bytes = static_cast<std::size_t>(b - a);
+      if (write_pass) {
+        if (phys_write(phys, data.subspan(off, n_bytes))) write_hit = true;
+      } else if (phys_read(phys, data.subspan(off, n_bytes), false)) {
+        read_hit = true;
+      }
+    }
+  }
+  // WKC: +1 for a read, +1 (LWR) or +2 (LRW) for a write [ETG.1000.4 §5.4 logical commands].
+  if (read_hit) wkc = static_cast<std::uint16_t>(wkc + 1);
+  if (write_hit) wkc = static_cast<std::uint16_t>(wkc + (c == Command::LRW ? 2 : 1));
+  return read_hit || write_hit;
+}
+
+void EscSlave::process(std::span<std::uint8_t> header, std::span<std::uint8_t> data, std::span<std::uint8_t> wkc_bytes) noexcept {
+  DatagramHeader h;
+  if (!decode_datagram_header(header, h) || wkc_bytes.size() < 2) return;
+  std::uint16_t wkc = get_u16(wkc_bytes, 0);
+  refresh_dynamic_registers();
+  const std::uint16_t adp = h.adp();
+  const std::uint16_t ado = h.ado();
+  const Addressing addressing = addressing_of(h.command);
+  bool addressed = false;
+  if (addressing == Addressing::AutoIncrement || addressing == Addressing::Broadcast) {
+    // Every slave increments ADP; an auto-increment datagram is for the one that sees 0
+    // [ETG.1000.4 §5.4].
+    addressed = addressing == Addressing::Broadcast || adp == 0;
+    put_u16(header, 2, static_cast<std::uint16_t>(adp + 1));
+  } else if (addressing == Addressing::Configured) {
+    addressed = adp == station_address() ||
+                ((u32(reg::kDlControl) & kDlControlAlias) != 0 && adp == u16(reg::kStationAlias));
+  }
+  switch (h.command) {
+    case Command::APRD:
+    case Command::FPRD:
+    case Command::BRD:
+      if (addressed && phys_read(ado, data, h.command == Command::BRD)) ++wkc;
+      break;
+    case Command::APWR:
+    case Command::FPWR:
+    case Command::BWR:
+      if (addressed && phys_write(ado, data)) ++wkc;
+      break;
+    case Command::APRW:
+    case Command::FPRW:
+    case Command::BRW: {
+      if (!addressed) break;
+      // Read-write: the memory's content goes into the frame (ORed for BRW) and the frame's
+      // data into memory; WKC +1 read, +2 write [ETG.1000.4 §5.4].
+      std::copy(data.begin(), data.end(), scratch_.begin());
+      const std::span<const std::uint8_t> incoming(scratch_.data(), data.size());
+      if (phys_read(ado, data, h.command == Command::BRW)) wkc = static_cast<std::uint16_t>(wkc + 1);
+      if (phys_write(ado, incoming)) wkc = static_cast<std::uint16_t>(wkc + 2);
+      break;
+    }
+    case Command::ARMW:
+    case Command::FRMW:
+      // The addressed slave reads, every other slave writes; each counts once [ETG.1000.4 §5.4].
+      if (addressed) {
+        if (phys_read(ado, data, false)) ++wkc;
+      } else if (phys_write(ado, data)) {
+        ++wkc;
+      }
+      break;
+    case Command::LRD:
+    case Command::LWR:
+    case Command::LRW:
+      logical(h.command, h.address, data, wkc);
+      break;
+    default:
+      break;  // NOP: nothing
+  }
+  put_u16(wkc_bytes, 0, wkc);
+}
+
+// ---- AL state machine [ETG.1000.6 §5.3] -------------------------------------------------------
+
+void EscSlave::set_al(AlState s, std::uint16_t code, bool error) noexcept {
+  state_ = s;
+  set16(reg::kAlStatus, static_cast<std::uint16_t>(static_cast<std::uint16_t>(s) | (error ? kAlErrorBit : 0U)));
+  set16(reg::kAlStatusCode, code);
+}
+
+void EscSlave::al_control_written() noexcept {
+  const std::uint16_t control = u16(reg::kAlControl);
+  const auto raw = static_cast<std::uint8_t>(control & kAlStateMask);
+  const bool ack = (control & kAlErrorBit) != 0;
+  const bool error = (u16(reg::kAlStatus) & kAlErrorBit) != 0;
+  // With the error indication set, only an acknowledge or a request for a lower state is
+  // processed [ETG.1000.6 §5.3.2: the master acknowledges the error with AL control bit 4].
+  if (error && !ack && (!is_valid_state(raw) || raw >= static_cast<std::uint8_t>(state_))) return;
+  if (ack) set_al(state_, 0, false);
+  const bool keep_error = error && !ack;
+  const std::uint16_t keep_code = keep_error ? u16(reg::kAlStatusCode) : 0;
+  if (!is_valid_state(raw) || raw == 0) {
+    set_al(state_, kAlUnknownState, true);
+    return;
+  }
+  const auto to = static_cast<AlState>(raw);
+  if (to == state_) return;
+  const std::uint16_t code = check_transition(state_, to);
+  if (code != 0) {
+    set_al(state_, code, true);
+    return;
+  }
+  const AlState from = state_;
+  enter_state(from, to);
+  set_al(to, keep_code, keep_error);
+}
+
+std::uint16_t EscSlave::check_transition(AlState from, AlState to) noexcept {
+  if (to == AlState::Boot || from == AlState::Boot) return kAlBootstrapNotSupported;
+  const auto f = static_cast<std::uint8_t>(from);
+  const auto t = static_cast<std::uint8_t>(to);
+  if (t > f) {
+    // Upward only one step: INIT -> PRE-OP -> SAFE-OP -> OP [ETG.1000.6 §5.3.1 ESM].
+    const bool step = (from == AlState::Init && to == AlState::PreOp) ||
+                      (from == AlState::PreOp && to == AlState::SafeOp) ||
+                      (from == AlState::SafeOp && to == AlState::Op);
+    if (!step) return kAlInvalidStateChange;
+  }
+  if (from == AlState::Init && to == AlState::PreOp && has_mailbox_) {
+    // Mailbox SMs as the SII says: SM0 master -> slave, SM1 slave -> master, both 1-buffer and
+    // enabled [ETG.1000.6 §5.3.2 transition IP, code 0016h].
+    const SiiMailbox& mb = sii_info_->standard_mailbox;
+    const SmEntry s0 = sm(0);
+    const SmEntry s1 = sm(1);
+    const bool ok0 = s0.enabled() && s0.physical_start == mb.rx_offset && s0.length == mb.rx_size &&
+                     (s0.control & sm_control::kModeMask) == sm_control::kModeMailbox &&
+                     (s0.control & sm_control::kDirectionMask) == sm_control::kDirectionWrite;
+    const bool ok1 = s1.enabled() && s1.physical_start == mb.tx_offset && s1.length == mb.tx_size &&
+                     (s1.control & sm_control::kModeMask) == sm_control::kModeMailbox &&
+                     (s1.control & sm_control::kDirectionMask) == sm_control::kDirectionRead;
+    if (!ok0 || !ok1) return kAlInvalidMailboxConfig;
+  }
+  if (from == AlState::PreOp && to == AlState::SafeOp && app_ != nullptr) {
+    // Process data SMs: SM2 outputs, SM3 inputs, buffered, lengths equal to the mapped PDOs
+    // [ETG.1000.6 §5.3.2 transition PS, codes 001Dh/001Eh; digest §5].
+    const std::uint32_t ram_end = reg::kProcessRam + static_cast<std::uint32_t>(cfg_.ram_kib) * 1024U;
+    auto valid = [&](unsigned n, std::size_t size, std::uint8_t direction) {
+      const SmEntry s = sm(n);
+      if (size == 0) return !s.enabled() || s.length == 0;
+      return s.enabled() && s.length == size && (s.control & sm_control::kModeMask) == sm_control::kModeBuffered &&
+             (s.control & sm_control::kDirectionMask) == direction && s.physical_start >= reg::kProcessRam &&
+             static_cast<std::uint32_t>(s.physical_start) + s.length <= ram_end;
+    };
+    if (!valid(2, app_->output_size(), sm_control::kDirectionWrite)) return kAlInvalidOutputConfig;
+    if (!valid(3, app_->input_size(), sm_control::kDirectionRead)) return kAlInvalidInputConfig;
+  }
+  if (app_ != nullptr) return app_->on_state_change(from, to);
+  return 0;
+}
+
+void EscSlave::enter_state(AlState /*from*/, AlState to) noexcept {
+  switch (to) {
+    case AlState::Init:
+      // Back in INIT the PDI deactivates every SM and drops the mailbox [ETG.1000.6 §5.3.1].
+      for (unsigned n = 0; n < cfg_.sm_count; ++n) set_pdi_deactivate(n, true);
+      outbox_.clear();
+      coe_.reset();
+      last_sent_size_ = 0;
+      last_rx_counter_ = 0;
+      mailbox_pending_ = false;
+      outputs_valid_ = false;
+      break;
+    case AlState::PreOp:
+      set_pdi_deactivate(0, false);
+      set_pdi_deactivate(1, false);
+      set_pdi_deactivate(2, true);
+      set_pdi_deactivate(3, true);
+      outputs_valid_ = false;
+      break;
+    case AlState::SafeOp:
+      set_pdi_deactivate(2, false);
+      set_pdi_deactivate(3, false);
+      outputs_valid_ = false;  // SAFE-OP: outputs are not applied [digest §5]
+      break;
+    case AlState::Op:
+      wd_last_ns_ = now_ns_;  // the SM watchdog runs from here
+      set16(reg::kWatchdogStatusProcessData, 1);
+      break;
+    default:
+      break;
+  }
+}
+
+// ---- SII EEPROM interface [ETG.1000.4 Table 48] -----------------------------------------------
+
+void EscSlave::sii_command() noexcept {
+  std::uint16_t ctl = u16(reg::kSiiControl);
+  const std::uint16_t cmd = ctl & sii_control::kCommandMask;
+  ctl = static_cast<std::uint16_t>(ctl & ~(sii_control::kCommandError | sii_control::kWriteError |
+                                           sii_control::kChecksumError | sii_control::kDeviceInfoError));
+  if (cmd == sii_control::kCommandRead) {
+    const std::uint32_t word = u32(reg::kSiiAddress);
+    const std::size_t n = cfg_.sii_read_8_bytes ? 8 : 4;
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::uint64_t at = static_cast<std::uint64_t>(word) * 2 + i;
+      mem_[reg::kSiiData + i] = at < sii_.size() ? sii_[at] : 0xFF;  // unprogrammed beyond the image
+    }
+  } else if (cmd == sii_control::kCommandReload) {
+    set16(reg::kStationAlias, sii_info_->station_alias);
+  } else {
+    ctl = static_cast<std::uint16_t>(ctl | sii_control::kCommandError);  // write or invalid: not offered
+  }
+  set16(reg::kSiiControl, static_cast<std::uint16_t>(ctl | sii_control::kBusy));
+  sii_busy_ = static_cast<std::uint8_t>(cfg_.sii_busy_frames + 1);
+}
+
+// ---- Mailbox [ETG.1000.4 SM mailbox mode; ETG.1000.6 mailbox] ----------------------------------
+
+void EscSlave::mailbox_received() noexcept {
+  mailbox_pending_ = false;
+  const SmEntry s0 = sm(0);
+  const std::span<const std::uint8_t> box(mem_.data() + s0.physical_start, s0.length);
+  const MailboxView v = decode_mailbox(box);
+  // The PDI has read the mailbox: SM0 is empty again.
+  sms_[0].mailbox_full = false;
+  mem_[reg::sm(0) + 5U] = static_cast<std::uint8_t>(mem_[reg::sm(0) + 5U] & ~(sm_status::kMailboxFull | sm_status::kInterruptWrite));
+  if (v.error != MailboxError::None) {
+    const auto buf = outbox_.reserve();
+    if (!buf.empty()) outbox_.commit(encode_mailbox_error(buf, 0, mailbox_error_code::kInvalidSize));
+    return;
+  }
+  // A counter equal to the previous one is a repeated request (the master did not see the WKC)
+  // and is discarded; 0 means "no counter" [ETG.1000.6 mailbox header, Cnt].
+  if (v.header.counter != 0 && v.header.counter == last_rx_counter_) {
+    ++duplicates_;
+    return;
+  }
+  last_rx_counter_ = v.header.counter;
+  if (v.header.type == static_cast<std::uint8_t>(MailboxType::CoE) &&
+      (sii_info_->mailbox_protocols & mailbox_protocol::kCoE) != 0) {
+    coe_.on_request(box, state_, outbox_);
+    return;
+  }
+  const auto buf = outbox_.reserve();
+  if (!buf.empty()) outbox_.commit(encode_mailbox_error(buf, 0, mailbox_error_code::kUnsupportedProtocol));
+}
+
+void EscSlave::load_sm1() noexcept {
+  if (!has_mailbox_ || !sm_active(1) || sms_[1].mailbox_full || outbox_.empty()) return;
+  const SmEntry s1 = sm(1);
+  const auto msg = outbox_.front();
+  if (msg.size() > s1.length) {  // cannot happen with the SII's SM1 size; drop rather than cut
+    outbox_.pop();
+    outbox_.count_drop();
+    return;
+  }
+  std::fill(mem_.begin() + s1.physical_start, mem_.begin() + s1.physical_start + s1.length, std::uint8_t{0});
+  std::copy(msg.begin(), msg.end(), mem_.begin() + s1.physical_start);
+  std::copy(msg.begin(), msg.end(), last_sent_.begin());
+  last_sent_size_ = msg.size();
+  outbox_.pop();
+  sms_[1].mailbox_full = true;
+  mem_[reg::sm(1) + 5U] = static_cast<std::uint8_t>(mem_[reg::sm(1) + 5U] | sm_status::kMailboxFull);
+}
+
+void EscSlave::sm1_repeat() noexcept {
+  // Repeat request: the master toggled SM1 activate bit 1; the slave puts the last mailbox back
+  // into SM1 and answers with PDI control bit 1 = the request [ETG.1000.4 Table 59; ETG.1000.6
+  // mailbox repeat].
+  const auto pdi_at = static_cast<std::uint16_t>(reg::sm(1) + 7U);
+  const bool request = (mem_[reg::sm(1) + 6U] & sm_activate::kRepeat) != 0;
+  ++repeats_;
+  const SmEntry s1 = sm(1);
+  if (sms_[1].mailbox_full) {
+    // A newer mailbox waiting in SM1 goes back to the front of the queue (its counter kept).
+    const MailboxView v = decode_mailbox(std::span<const std::uint8_t>(mem_.data() + s1.physical_start, s1.length));
+    if (v.error == MailboxError::None && v.header.counter != (last_sent_.size() > 5 ? (last_sent_[5] >> 4) & 7 : 0)) {
+      outbox_.push_front(std::span<const std::uint8_t>(mem_.data() + s1.physical_start,
+                                                       kMailboxHeaderSize + v.header.length));
+    }
+    sms_[1].mailbox_full = false;
+  }
+  if (last_sent_size_ > 0 && last_sent_size_ <= s1.length) {
+    std::fill(mem_.begin() + s1.physical_start, mem_.begin() + s1.physical_start + s1.length, std::uint8_t{0});
+    std::copy(last_sent_.begin(), last_sent_.begin() + static_cast<std::ptrdiff_t>(last_sent_size_),
+              mem_.begin() + s1.physical_start);
+    sms_[1].mailbox_full = true;
+    mem_[reg::sm(1) + 5U] = static_cast<std::uint8_t>(mem_[reg::sm(1) + 5U] | sm_status::kMailboxFull);
+  }
+  mem_[pdi_at] = static_cast<std::uint8_t>(request ? (mem_[pdi_at] | kPdiRepeatAck) : (mem_[pdi_at] & ~kPdiRepeatAck));
+}
+
+bool EscSlave::post_emergency(const CoeEmergency& e) noexcept {
+  if (!has_mailbox_) return false;
+  const auto buf = outbox_.reserve();
+  if (buf.empty()) {
+    outbox_.count_drop();
+    return false;
+  }
+  const std::size_t n = encode_emergency(buf, 0, e);
+  if (n == 0) return false;
+  outbox_.commit(n);
+  return true;
+}
+
+// ---- PDI cycle --------------------------------------------------------------------------------
+
+void EscSlave::watchdog_check(std::uint64_t now_ns) noexcept {
+  if (state_ != AlState::Op || app_ == nullptr || app_->output_size() == 0) return;
+  const SmEntry s2 = sm(2);
+  if ((s2.control & sm_control::kWatchdogTrigger) == 0) return;
+  const std::uint64_t ticks = u16(reg::kWatchdogTimeProcessData);
+  if (ticks == 0) return;  // 0 disables the watchdog
+  const std::uint64_t timeout = (static_cast<std::uint64_t>(u16(reg::kWatchdogDivider)) + 2) * kWatchdogBaseNs * ticks;
+  if (now_ns < wd_last_ns_ || now_ns - wd_last_ns_ <= timeout) return;
+  // Expired: status 0440h bit 0 = 0, counter 0442h + 1, OP -> SAFE-OP with 001Bh, outputs off
+  // [ETG.1000.4 Table 31; ETG.1000.6 §5.3.2; digest §8.2].
+  set16(reg::kWatchdogStatusProcessData, 0);
+  if (mem_[reg::kWatchdogCounterProcessData] < 0xFF) ++mem_[reg::kWatchdogCounterProcessData];
+  enter_state(AlState::Op, AlState::SafeOp);
+  set_al(AlState::SafeOp, kAlSmWatchdog, true);
+}
+
+void EscSlave::pdi_cycle(std::uint64_t now_ns) noexcept {
+  now_ns_ = now_ns;
+  if (sii_busy_ > 0 && --sii_busy_ == 0) {
+    set16(reg::kSiiControl, static_cast<std::uint16_t>(u16(reg::kSiiControl) & ~(sii_control::kBusy | sii_control::kCommandMask)));
+  }
+  if (has_mailbox_ && state_ != AlState::Init) {
+    if (mailbox_pending_) mailbox_received();
+    const bool request = (mem_[reg::sm(1) + 6U] & sm_activate::kRepeat) != 0;
+    const bool acked = (mem_[reg::sm(1) + 7U] & kPdiRepeatAck) != 0;
+    if (request != acked && sm_active(1)) sm1_repeat();
+    load_sm1();
+  }
+  if (wd_triggered_) {
+    wd_triggered_ = false;
+    set16(reg::kWatchdogStatusProcessData, 1);
+  }
+  watchdog_check(now_ns);
+  if (app_ == nullptr) return;
+  const std::size_t out_n = std::min(app_->output_size(), outputs_.size());
+  const std::size_t in_n = std::min(app_->input_size(), inputs_.size());
+  std::span<const std::uint8_t> outputs(zeros_.data(), out_n);
+  if (state_ == AlState::Op && outputs_valid_ && out_n > 0) {
+    const SmEntry s2 = sm(2);
+    if (s2.length >= out_n) outputs = std::span<const std::uint8_t>(mem_.data() + s2.physical_start, out_n);
+  }
+  app_->exchange(outputs, std::span<std::uint8_t>(inputs_.data(), in_n), state_, now_ns);
+  if ((state_ == AlState::SafeOp || state_ == AlState::Op) && in_n > 0 && sm_active(3)) {
+    const SmEntry s3 = sm(3);
+    std::copy(inputs_.begin(), inputs_.begin() + static_cast<std::ptrdiff_t>(std::min<std::size_t>(in_n, s3.length)),
+              mem_.begin() + s3.physical_start);
+  }
+}
+
+}  // namespace drivegate::ethercat::sim
