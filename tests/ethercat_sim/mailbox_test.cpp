@@ -1,0 +1,345 @@
+// Mailbox and CoE of a simulated slave: SM0/SM1 in mailbox mode, SDO expedited/normal/segmented,
+// aborts, SDO information, emergencies, the repeat request and the mailbox counter. Frames and
+// mailboxes are built with the wire codecs; expected bytes follow ETG.1000.4 (SM mailbox mode) and
+// ETG.1000.6 §5.6 (CoE) as cited per test.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "adapters/ethercat/sim/object_dictionary.hpp"
+#include "tests/ethercat_sim/harness.hpp"
+
+namespace drivegate::ethercat::sim {
+namespace {
+
+using test::Bus;
+using test::Reply;
+
+constexpr std::uint16_t kMbxOut = 0x1000;  // SM0, master -> slave
+constexpr std::uint16_t kMbxIn = 0x1080;   // SM1, slave -> master
+constexpr std::uint16_t kMbxSize = 128;
+constexpr std::uint16_t kOut = 0x1100;
+constexpr std::uint16_t kIn = 0x1180;
+
+class CoeApp final : public SlaveApplication {
+ public:
+  CoeApp() {
+    const std::array<std::uint8_t, 4> device_type{0x92, 0x01, 0x02, 0x00};  // 00020192h (CiA 402 drive)
+    od.add_variable(0x1000, data_type::kUnsigned32, object_access::kReadPreOp | object_access::kReadSafeOp | object_access::kReadOp,
+                    "Device type", device_type);
+    const std::array<std::uint8_t, 2> u16v{0x34, 0x12};
+    od.add_variable(0x2000, data_type::kUnsigned16, 0x003F, "Parameter", u16v);
+    long_value.assign(300, 0);
+    for (std::size_t i = 0; i < long_value.size(); ++i) long_value[i] = static_cast<std::uint8_t>('A' + i % 26);
+    od.add_variable(0x2001, data_type::kOctetString, 0x003F, "Long", long_value);
+    od.add_object(0x6040, object_code::kRecord, "Record");
+    const std::array<std::uint8_t, 1> one{2};
+    od.add_entry(OdEntrySpec{0x6040, 0, data_type::kUnsigned8, object_access::kReadPreOp, "Count", one});
+    const std::array<std::uint8_t, 2> w{0, 0};
+    od.add_entry(OdEntrySpec{0x6040, 1, data_type::kUnsigned16, 0x003F | object_access::kRxPdoMappable, "Word", w});
+  }
+  std::size_t output_size() const noexcept override { return 2; }
+  std::size_t input_size() const noexcept override { return 2; }
+  void exchange(std::span<const std::uint8_t>, std::span<std::uint8_t>, AlState, std::uint64_t) noexcept override {}
+  ObjectDictionary* object_dictionary() noexcept override { return &od; }
+
+  SimpleObjectDictionary od;
+  std::vector<std::uint8_t> long_value;
+};
+
+std::vector<std::uint8_t> coe_sii() {
+  const std::array<SiiSyncManager, 4> sms{
+      SiiSyncManager{kMbxOut, kMbxSize, sm_control::kMailboxOut, 0, 1, sii_sm_type::kMailboxOut},
+      SiiSyncManager{kMbxIn, kMbxSize, sm_control::kMailboxIn, 0, 1, sii_sm_type::kMailboxIn},
+      SiiSyncManager{kOut, 2, sm_control::kOutputs, 0, 1, sii_sm_type::kOutputs},
+      SiiSyncManager{kIn, 2, sm_control::kInputs, 0, 1, sii_sm_type::kInputs},
+  };
+  SiiProfile p;
+  p.identity = SiiIdentity{0x0000066F, 0x1234, 1, 7};
+  p.standard_mailbox = SiiMailbox{kMbxOut, kMbxSize, kMbxIn, kMbxSize};
+  p.mailbox_protocols = mailbox_protocol::kCoE;
+  p.name = "CoE test slave";
+  p.general.coe_details = coe_details::kSdo | coe_details::kSdoInfo;
+  p.sync_managers = sms;
+  std::vector<std::uint8_t> image(2048, 0);
+  const auto r = build_sii(p, image);
+  EXPECT_TRUE(r.ok());
+  image.resize(r.size);
+  return image;
+}
+
+struct CoeLine {
+  CoeLine() : sii(coe_sii()), esc(EscConfig{}, sii, &app) {
+    bus.line().add(esc);
+    bus.assign_addresses(1);
+  }
+  void mailbox_sms() {
+    bus.write_sm(st, 0, SmEntry{kMbxOut, kMbxSize, sm_control::kMailboxOut, 0, 1, 0});
+    bus.write_sm(st, 1, SmEntry{kMbxIn, kMbxSize, sm_control::kMailboxIn, 0, 1, 0});
+  }
+  void preop() {
+    mailbox_sms();
+    ASSERT_EQ(bus.request(st, AlState::PreOp), 0x0002);
+  }
+  // Writes a whole mailbox into SM0 (the full SM length, so the last byte is written).
+  std::uint16_t put(std::span<const std::uint8_t> msg) {
+    std::array<std::uint8_t, kMbxSize> box{};
+    std::copy(msg.begin(), msg.end(), box.begin());
+    return bus.fpwr(st, kMbxOut, box).wkc;
+  }
+  // Polls SM1 status for "mailbox full", then reads SM1. Empty optional reply when nothing came.
+  Reply get(int polls = 4) {
+    for (int i = 0; i < polls; ++i) {
+      const Reply s = bus.fprd(st, static_cast<std::uint16_t>(reg::sm(1) + 5U), 1);
+      if ((s.data[0] & sm_status::kMailboxFull) != 0) return bus.fprd(st, kMbxIn, kMbxSize);
+    }
+    return Reply{};
+  }
+  SdoView sdo(std::span<const std::uint8_t> request) {
+    EXPECT_EQ(put(request), 1);
+    reply = get();
+    EXPECT_TRUE(reply.returned);
+    return decode_sdo_response(reply.bytes());
+  }
+  std::uint8_t next() { return counter = next_mailbox_counter(counter); }
+
+  Bus bus;
+  CoeApp app;
+  std::vector<std::uint8_t> sii;
+  EscSlave esc;
+  std::uint16_t st = Bus::station(0);
+  std::array<std::uint8_t, kMbxSize> req{};
+  Reply reply;
+  std::uint8_t counter = 0;
+};
+
+TEST(EthercatSimMailbox, InitToPreOpChecksMailboxSms) {
+  CoeLine l;
+  // No SM0/SM1 configured: invalid mailbox configuration 0016h [ETG.1000.6 §5.3.2].
+  EXPECT_EQ(l.bus.request(l.st, AlState::PreOp), 0x0011);
+  EXPECT_EQ(l.bus.fprd(l.st, reg::kAlStatusCode, 2).u16(), 0x0016);
+  // SM1 with the wrong length: still refused.
+  l.bus.write_sm(l.st, 0, SmEntry{kMbxOut, kMbxSize, sm_control::kMailboxOut, 0, 1, 0});
+  l.bus.write_sm(l.st, 1, SmEntry{kMbxIn, 64, sm_control::kMailboxIn, 0, 1, 0});
+  EXPECT_EQ(l.bus.request(l.st, AlState::PreOp, true), 0x0011);
+  l.mailbox_sms();
+  EXPECT_EQ(l.bus.request(l.st, AlState::PreOp, true), 0x0002);
+  // In PRE-OP with an empty SM1: reading it is refused (WKC 0), SM0 takes one mailbox and a
+  // second write to the full SM0 is refused until the slave has taken it.
+  EXPECT_EQ(l.bus.fprd(l.st, kMbxIn, kMbxSize).wkc, 0);
+}
+
+TEST(EthercatSimMailbox, ExpeditedUploadAndDownload) {
+  CoeLine l;
+  l.preop();
+  // Upload 1000h: expedited response 43h, 00020192h [ETG.1000.6 §5.6.2.4; CiA 301 SDO].
+  std::size_t n = encode_sdo_upload_request(l.req, l.next(), 0x1000, 0);
+  SdoView v = l.sdo(std::span(l.req.data(), n));
+  ASSERT_EQ(v.error, MailboxError::None);
+  EXPECT_EQ(v.sdo.command, SdoCommand::UploadInitiateResponse);
+  EXPECT_TRUE(v.sdo.expedited);
+  ASSERT_EQ(v.sdo.data.size(), 4U);
+  EXPECT_EQ(get_u32(v.sdo.data, 0), 0x00020192U);
+  // Raw bytes: mailbox header length 10, type CoE, counter 1; CoE 3000h (SDO response); 43 00 10 00.
+  const std::array<std::uint8_t, 16> expect{0x0A, 0x00, 0x00, 0x00, 0x00, 0x13, 0x00, 0x30,
+                                            0x43, 0x00, 0x10, 0x00, 0x92, 0x01, 0x02, 0x00};
+  EXPECT_TRUE(std::equal(expect.begin(), expect.end(), l.reply.data.begin()));
+  // Download 2000h := 5678h, read back.
+  n = encode_sdo_download_value(l.req, l.next(), 0x2000, 0, 0x5678, 2);
+  v = l.sdo(std::span(l.req.data(), n));
+  EXPECT_EQ(v.sdo.command, SdoCommand::DownloadInitiateResponse);
+  EXPECT_EQ(get_u16(l.app.od.value(0x2000, 0), 0), 0x5678);
+  n = encode_sdo_upload_request(l.req, l.next(), 0x2000, 0);
+  v = l.sdo(std::span(l.req.data(), n));
+  EXPECT_EQ(get_u16(v.sdo.data, 0), 0x5678);
+}
+
+TEST(EthercatSimMailbox, Aborts) {
+  CoeLine l;
+  l.preop();
+  struct Case {
+    std::uint16_t index;
+    std::uint8_t sub;
+    bool write;
+    std::size_t size;
+    std::uint32_t code;  // CiA 301 §7.2.4.3.17
+  };
+  const std::array<Case, 5> cases{
+      Case{0x3000, 0, false, 0, 0x06020000},  // object does not exist
+      Case{0x6040, 7, false, 0, 0x06090011},  // subindex does not exist
+      Case{0x1000, 0, true, 4, 0x06010002},   // read only
+      Case{0x2000, 0, true, 4, 0x06070012},   // length too high
+      Case{0x2000, 0, true, 1, 0x06070013},   // length too low
+  };
+  for (const Case& c : cases) {
+    const std::size_t n = c.write ? encode_sdo_download_value(l.req, l.next(), c.index, c.sub, 1, c.size)
+                                  : encode_sdo_upload_request(l.req, l.next(), c.index, c.sub);
+    const SdoView v = l.sdo(std::span(l.req.data(), n));
+    EXPECT_EQ(v.sdo.command, SdoCommand::Abort) << std::hex << c.index;
+    EXPECT_EQ(v.sdo.abort_code, c.code) << std::hex << c.index;
+    EXPECT_EQ(v.sdo.index, c.index);
+  }
+  // A segment with no transfer open: 05040001h.
+  const std::size_t n = encode_sdo_upload_segment_request(l.req, l.next(), false);
+  EXPECT_EQ(l.sdo(std::span(l.req.data(), n)).sdo.abort_code, 0x05040001U);
+}
+
+TEST(EthercatSimMailbox, SegmentedUploadAndDownload) {
+  CoeLine l;
+  l.preop();
+  // Upload 300 bytes through a 128-byte mailbox: the normal response carries 128 - 16 = 112, the
+  // segments 128 - 9 = 119, then 69 [ETG.1000.6 §5.6.2.4-§5.6.2.6].
+  std::size_t n = encode_sdo_upload_request(l.req, l.next(), 0x2001, 0);
+  SdoView v = l.sdo(std::span(l.req.data(), n));
+  ASSERT_EQ(v.sdo.command, SdoCommand::UploadInitiateResponse);
+  EXPECT_FALSE(v.sdo.expedited);
+  EXPECT_EQ(v.sdo.size, 300U);
+  std::vector<std::uint8_t> got(v.sdo.data.begin(), v.sdo.data.end());
+  EXPECT_EQ(got.size(), 112U);
+  bool toggle = false;
+  bool last = false;
+  std::vector<std::size_t> sizes;
+  while (!last) {
+    n = encode_sdo_upload_segment_request(l.req, l.next(), toggle);
+    v = l.sdo(std::span(l.req.data(), n));
+    ASSERT_EQ(v.sdo.command, SdoCommand::UploadSegmentResponse);
+    EXPECT_EQ(v.sdo.toggle, toggle);
+    got.insert(got.end(), v.sdo.data.begin(), v.sdo.data.end());
+    sizes.push_back(v.sdo.data.size());
+    last = v.sdo.last;
+    toggle = !toggle;
+  }
+  EXPECT_EQ(sizes, (std::vector<std::size_t>{119, 69}));
+  EXPECT_EQ(got, l.app.long_value);
+
+  // Download 300 bytes: initiate with 128 - 16 = 112, then segments.
+  std::vector<std::uint8_t> data(300);
+  for (std::size_t i = 0; i < data.size(); ++i) data[i] = static_cast<std::uint8_t>(i);
+  n = encode_sdo_download_normal(l.req, l.next(), 0x2001, 0, 300, std::span(data.data(), 112));
+  v = l.sdo(std::span(l.req.data(), n));
+  EXPECT_EQ(v.sdo.command, SdoCommand::DownloadInitiateResponse);
+  std::size_t at = 112;
+  toggle = false;
+  while (at < data.size()) {
+    const std::size_t chunk = std::min<std::size_t>(119, data.size() - at);
+    n = encode_sdo_download_segment(l.req, l.next(), toggle, at + chunk == data.size(), std::span(data.data() + at, chunk));
+    v = l.sdo(std::span(l.req.data(), n));
+    EXPECT_EQ(v.sdo.command, SdoCommand::DownloadSegmentResponse);
+    EXPECT_EQ(v.sdo.toggle, toggle);
+    at += chunk;
+    toggle = !toggle;
+  }
+  const auto stored = l.app.od.value(0x2001, 0);
+  EXPECT_TRUE(std::equal(stored.begin(), stored.end(), data.begin(), data.end()));
+  // A wrong toggle aborts with 05030000h.
+  n = encode_sdo_upload_request(l.req, l.next(), 0x2001, 0);
+  l.sdo(std::span(l.req.data(), n));
+  n = encode_sdo_upload_segment_request(l.req, l.next(), true);
+  EXPECT_EQ(l.sdo(std::span(l.req.data(), n)).sdo.abort_code, 0x05030000U);
+}
+
+TEST(EthercatSimMailbox, SdoInformation) {
+  CoeLine l;
+  l.preop();
+  std::size_t n = encode_get_od_list_request(l.req, l.next(), OdListType::All);
+  ASSERT_EQ(l.put(std::span(l.req.data(), n)), 1);
+  Reply r = l.get();
+  SdoInfoView v = decode_sdo_info(r.bytes());
+  ASSERT_EQ(v.error, MailboxError::None);
+  EXPECT_EQ(v.opcode, SdoInfoOpcode::GetOdListResponse);
+  ASSERT_EQ(v.index_count(), 4U);
+  EXPECT_EQ(v.index_at(0), 0x1000);
+  EXPECT_EQ(v.index_at(3), 0x6040);
+  n = encode_get_od_list_request(l.req, l.next(), OdListType::RxPdoMappable);
+  l.put(std::span(l.req.data(), n));
+  v = decode_sdo_info(l.get().bytes());
+  ASSERT_EQ(v.index_count(), 1U);
+  EXPECT_EQ(v.index_at(0), 0x6040);
+
+  n = encode_get_object_description_request(l.req, l.next(), 0x6040);
+  l.put(std::span(l.req.data(), n));
+  r = l.get();
+  v = decode_sdo_info(r.bytes());
+  EXPECT_EQ(v.opcode, SdoInfoOpcode::GetObjectDescriptionResponse);
+  EXPECT_EQ(v.object.max_subindex, 1);
+  EXPECT_EQ(v.object.object_code, object_code::kRecord);
+  EXPECT_EQ(v.object.name, "Record");
+
+  n = encode_get_entry_description_request(l.req, l.next(), 0x6040, 1, 0);
+  l.put(std::span(l.req.data(), n));
+  r = l.get();
+  v = decode_sdo_info(r.bytes());
+  EXPECT_EQ(v.opcode, SdoInfoOpcode::GetEntryDescriptionResponse);
+  EXPECT_EQ(v.entry.data_type, data_type::kUnsigned16);
+  EXPECT_EQ(v.entry.bit_length, 16);
+  EXPECT_EQ(v.entry.name, "Word");
+
+  n = encode_get_object_description_request(l.req, l.next(), 0x5555);
+  l.put(std::span(l.req.data(), n));
+  r = l.get();
+  v = decode_sdo_info(r.bytes());
+  EXPECT_EQ(v.opcode, SdoInfoOpcode::Error);
+  EXPECT_EQ(v.abort_code, 0x06020000U);
+}
+
+TEST(EthercatSimMailbox, EmergencyRepeatAndCounter) {
+  CoeLine l;
+  l.preop();
+  // Emergency queued, delivered when SM1 is read [ETG.1000.6 §5.6.4].
+  ASSERT_TRUE(l.esc.post_emergency(CoeEmergency{0x8100, 0x11, {1, 2, 3, 4, 5}}));
+  Reply r = l.get();
+  ASSERT_TRUE(r.returned);
+  const EmergencyView e = decode_emergency(r.bytes());
+  ASSERT_EQ(e.error, MailboxError::None);
+  EXPECT_EQ(e.emergency.error_code, 0x8100);
+  const std::uint8_t emcy_counter = e.mailbox.counter;
+  EXPECT_EQ(emcy_counter, 1);
+  // SM1 is empty again after its last byte was read.
+  EXPECT_EQ(l.bus.fprd(l.st, kMbxIn, kMbxSize).wkc, 0);
+
+  // Repeat request: toggle SM1 activate bit 1; the slave puts the same mailbox back and
+  // acknowledges in PDI control bit 1 [ETG.1000.4 Table 59].
+  const std::array<std::uint8_t, 1> act{static_cast<std::uint8_t>(sm_activate::kEnable | sm_activate::kRepeat)};
+  EXPECT_EQ(l.bus.fpwr(l.st, static_cast<std::uint16_t>(reg::sm(1) + 6U), act).wkc, 1);
+  r = l.get();
+  ASSERT_TRUE(r.returned);
+  EXPECT_EQ(decode_emergency(r.bytes()).mailbox.counter, emcy_counter);
+  EXPECT_EQ(l.bus.fprd(l.st, static_cast<std::uint16_t>(reg::sm(1) + 7U), 1).data[0] & 0x02, 0x02);
+  EXPECT_EQ(l.esc.mailbox_repeats(), 1U);
+
+  // The same request counter twice: the second is a repeat and gets no second answer.
+  const std::size_t n = encode_sdo_upload_request(l.req, 3, 0x1000, 0);
+  ASSERT_EQ(l.put(std::span(l.req.data(), n)), 1);
+  EXPECT_TRUE(l.get().returned);
+  ASSERT_EQ(l.put(std::span(l.req.data(), n)), 1);
+  EXPECT_FALSE(l.get().returned);
+  EXPECT_EQ(l.esc.mailbox_duplicates(), 1U);
+  // A non-CoE mailbox (type FoE): mailbox error "unsupported protocol" 0002h.
+  std::array<std::uint8_t, 8> foe{};
+  encode_mailbox_header(MailboxHeader{2, 0, 0, 0, static_cast<std::uint8_t>(MailboxType::FoE), 4}, foe);
+  ASSERT_EQ(l.put(foe), 1);
+  r = l.get();
+  const MailboxErrorReply me = decode_mailbox_error(r.bytes());
+  EXPECT_EQ(me.detail, mailbox_error_code::kUnsupportedProtocol);
+}
+
+TEST(EthercatSimMailbox, FullMailboxRefusesWrite) {
+  CoeLine l;
+  l.preop();
+  // Block the PDI: two SM0 writes in one frame; the second finds the mailbox full (WKC 0 for it).
+  std::array<std::uint8_t, kMaxFrameSize> tx{};
+  std::array<std::uint8_t, kMbxSize> box{};
+  encode_sdo_upload_request(box, 1, 0x1000, 0);
+  FrameBuilder b(tx, test::kMasterMac, test::kMasterMac);
+  const auto s1 = b.add(Command::FPWR, 0, physical_address(l.st, kMbxOut), kMbxSize, box);
+  const auto s2 = b.add(Command::FPWR, 1, physical_address(l.st, kMbxOut), kMbxSize, box);
+  const auto frame = b.finish();
+  l.bus.link().send(FrameView(frame.data(), frame.size()));
+  std::array<FrameBuffer, 1> rx;
+  ASSERT_EQ(l.bus.link().receive(rx), 1U);
+  EXPECT_EQ(get_u16(rx[0].view(), s1.slot.wkc_offset), 1);
+  EXPECT_EQ(get_u16(rx[0].view(), s2.slot.wkc_offset), 0);
+}
+
+}  // namespace
+}  // namespace drivegate::ethercat::sim
