@@ -252,7 +252,8 @@ TEST(EthercatSimMailbox, SdoInformation) {
   EXPECT_EQ(v.index_at(3), 0x6040);
   n = encode_get_od_list_request(l.req, l.next(), OdListType::RxPdoMappable);
   l.put(std::span(l.req.data(), n));
-  v = decode_sdo_info(l.get().bytes());
+  r = l.get();
+  v = decode_sdo_info(r.bytes());
   ASSERT_EQ(v.index_count(), 1U);
   EXPECT_EQ(v.index_at(0), 0x6040);
 

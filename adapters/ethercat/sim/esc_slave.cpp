@@ -279,7 +279,7 @@ bool EscSlave::phys_write(std::uint32_t ado, std::span<const std::uint8_t> data)
       for (std::uint32_t b = 0; b < 2; ++b) {
         const std::uint32_t a = reg::kSiiControl + b;
         if (a >= ado && a < ado + len) {
-          written = static_cast<std::uint16_t>((written & ~(0xFFU << (8 * b))) | (data[a - ado] << (8 * b)));
+          written = static_cast<std::uint16_t>((written & ~(0xFFU << (8 * b))) | (static_cast<std::uint32_t>(data[a - ado]) << (8 * b)));
         }
       }
       const std::uint16_t keep_mask = static_cast<std::uint16_t>(~(sii_control::kCommandMask | sii_control::kWriteEnable));
@@ -306,6 +306,14 @@ bool EscSlave::phys_write(std::uint32_t ado, std::span<const std::uint8_t> data)
 
 void EscSlave::register_written(std::uint32_t start, std::uint32_t len) noexcept {
   if (overlaps(start, len, reg::kAlControl, 2)) al_control_written();
+  // An SM the master disables is reset: its mailbox is empty again [ETG.1000.4 Table 59,
+  // activate bit 0].
+  for (unsigned n = 0; n < cfg_.sm_count; ++n) {
+    if (overlaps(start, len, reg::sm(n), kSmEntrySize) && (mem_[reg::sm(n) + 6U] & sm_activate::kEnable) == 0) {
+      sms_[n].mailbox_full = false;
+      mem_[reg::sm(n) + 5U] = 0;
+    }
+  }
   // A write to the error counters clears them [ETG.1000.4 Table 31, 0300h-0313h].
   if (overlaps(start, len, reg::kRxErrorCounter, 0x14)) {
     std::fill(mem_.begin() + reg::kRxErrorCounter, mem_.begin() + reg::kRxErrorCounter + 0x14, std::uint8_t{0});
