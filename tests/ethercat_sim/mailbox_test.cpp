@@ -283,6 +283,42 @@ TEST(EthercatSimMailbox, SdoInformation) {
   EXPECT_EQ(v.abort_code, 0x06020000U);
 }
 
+TEST(EthercatSimMailbox, OdListInFragments) {
+  CoeLine l;
+  const std::array<std::uint8_t, 1> v{0};
+  for (std::uint16_t i = 0; i < 100; ++i) {
+    l.app.od.add_variable(static_cast<std::uint16_t>(0x3000 + i), data_type::kUnsigned8, object_access::kReadPreOp, "x", v);
+  }
+  l.preop();
+  // 104 indexes; a 128-byte mailbox holds (128 - 12) / 2 = 58 u16: the first fragment the list
+  // type and 57 indexes, the second 47 [ETG.1000.6 §5.6.3.2 fragments, "fragments left"].
+  const std::size_t n = encode_get_od_list_request(l.req, l.next(), OdListType::All);
+  ASSERT_EQ(l.put(std::span(l.req.data(), n)), 1);
+  Reply r = l.get();
+  SdoInfoView f = decode_sdo_info(r.bytes(), true);
+  ASSERT_EQ(f.error, MailboxError::None);
+  EXPECT_TRUE(f.incomplete);
+  EXPECT_EQ(f.fragments_left, 1);
+  EXPECT_EQ(f.index_count(), 57U);
+  EXPECT_EQ(f.index_at(1), 0x2000);
+  r = l.get();
+  f = decode_sdo_info(r.bytes(), false);
+  ASSERT_EQ(f.error, MailboxError::None);
+  EXPECT_FALSE(f.incomplete);
+  EXPECT_EQ(f.fragments_left, 0);
+  EXPECT_EQ(f.index_count(), 47U);
+  EXPECT_EQ(f.index_at(46), 0x6040);
+  // List type 0: the five lengths (all, RxPDO, TxPDO, backup, startup).
+  const std::size_t m = encode_get_od_list_request(l.req, l.next(), OdListType::Lengths);
+  ASSERT_EQ(l.put(std::span(l.req.data(), m)), 1);
+  r = l.get();
+  f = decode_sdo_info(r.bytes(), true);
+  ASSERT_EQ(f.index_count(), 5U);
+  EXPECT_EQ(f.index_at(0), 104);
+  EXPECT_EQ(f.index_at(1), 1);
+  EXPECT_EQ(f.index_at(2), 0);
+}
+
 TEST(EthercatSimMailbox, EmergencyRepeatAndCounter) {
   CoeLine l;
   l.preop();

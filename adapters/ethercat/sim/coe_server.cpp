@@ -182,9 +182,7 @@ void CoeServer::sdo(std::span<const std::uint8_t> mailbox, AlState state, Mailbo
       if (transfer_ != Transfer::Download) return abort(out, 0, 0, abort_code::kUnknownCommand);
       if (s.toggle != toggle_) return abort(out, index_, subindex_, abort_code::kToggleNotAlternated);
       const std::size_t n = std::min(s.data.size(), size_ - done_);
-      if (s.data.size() > size_ - done_ && s.last) {
-        // More data than announced: the segment padding (at least 7 bytes) is not data.
-      }
+      // Bytes beyond the announced size are the segment padding (at least 7 bytes), not data.
       std::memcpy(buffer_.data() + done_, s.data.data(), n);
       done_ += n;
       const bool toggle = s.toggle;

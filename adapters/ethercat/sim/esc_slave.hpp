@@ -171,7 +171,6 @@ class EscSlave {
   std::size_t last_sent_size_ = 0;
   std::uint8_t last_rx_counter_ = 0;
   bool mailbox_pending_ = false;             // SM0 full, not yet handled by the PDI
-  bool sm1_read_done_ = false;
   std::uint64_t repeats_ = 0;
   std::uint64_t duplicates_ = 0;
 

@@ -28,13 +28,12 @@ std::size_t SimLine::reachable() const noexcept {
 }
 
 void SimLine::update_links() noexcept {
-  const std::size_t n = reachable();
+  // Port 1 has a link when the next slave is powered and the cable to it is whole.
   for (std::size_t k = 0; k < slaves_.size(); ++k) {
     if (!slaves_[k].powered) continue;
     const bool next_up = k + 1 < slaves_.size() && slaves_[k + 1].powered && k != break_after_;
     slaves_[k].esc->set_port1_link(next_up);
   }
-  (void)n;
 }
 
 void SimLine::power_off(std::size_t k) noexcept {
