@@ -199,6 +199,25 @@ TEST(EthercatSimLine, SmWatchdogDropsToSafeOp) {
   EXPECT_EQ(l.apps[0]->outputs()[0], 0x00);  // outputs treated as zero
 }
 
+TEST(EthercatSimLine, SlaveStuckInSafeOp) {
+  IoLine l(1);
+  l.bus.assign_addresses(1);
+  const std::uint16_t st = Bus::station(0);
+  configure_pd(l.bus, st, 1, 2, 0x10000, 0x10004);
+  l.bus.request(st, AlState::PreOp);
+  l.bus.request(st, AlState::SafeOp);
+  EXPECT_EQ(l.bus.request(st, AlState::Op), 0x0008);
+  // Stuck at SAFE-OP with 001Ah (synchronization error): drops from OP on its own...
+  l.bus.line().stick(0, AlState::SafeOp, 0x001A);
+  EXPECT_EQ(l.bus.fprd(st, reg::kAlStatus, 2).u16(), 0x0014);
+  EXPECT_EQ(l.bus.fprd(st, reg::kAlStatusCode, 2).u16(), 0x001A);
+  // ...and refuses OP again after the acknowledge.
+  EXPECT_EQ(l.bus.request(st, AlState::Op, true), 0x0014);
+  EXPECT_EQ(l.bus.fprd(st, reg::kAlStatusCode, 2).u16(), 0x001A);
+  l.bus.line().stick(0, AlState::Op, 0);
+  EXPECT_EQ(l.bus.request(st, AlState::Op, true), 0x0008);
+}
+
 TEST(EthercatSimLine, PowerLossAndCableBreak) {
   IoLine l(3);
   l.bus.assign_addresses(3);

@@ -463,8 +463,18 @@ void EscSlave::al_control_written() noexcept {
   set_al(to, keep_code, keep_error);
 }
 
+void EscSlave::limit_state(AlState highest, std::uint16_t code) noexcept {
+  highest_ = highest;
+  limit_code_ = code;
+  if (static_cast<std::uint8_t>(state_) > static_cast<std::uint8_t>(highest)) {
+    enter_state(state_, highest);
+    set_al(highest, code, true);
+  }
+}
+
 std::uint16_t EscSlave::check_transition(AlState from, AlState to) noexcept {
   if (to == AlState::Boot || from == AlState::Boot) return kAlBootstrapNotSupported;
+  if (static_cast<std::uint8_t>(to) > static_cast<std::uint8_t>(highest_)) return limit_code_;
   const auto f = static_cast<std::uint8_t>(from);
   const auto t = static_cast<std::uint8_t>(to);
   if (t > f) {

@@ -112,6 +112,10 @@ class EscSlave {
   void set_port1_link(bool up) noexcept;
   // A frame with a bad FCS arrived on port 0 (corruption injected by the line).
   void count_rx_error() noexcept;
+  // Fault: the slave refuses every state above `highest` with `code` (e.g. SAFE-OP and 001Ah, a
+  // slave "stuck in SAFE-OP"); when it is above it now, it drops there on its own with the error
+  // set, as after a local error [ETG.1000.6 §5.3.2]. AlState::Op lifts the fault.
+  void limit_state(AlState highest, std::uint16_t code) noexcept;
   const SiiInfo& sii_info() const noexcept { return *sii_info_; }
   std::uint64_t mailbox_repeats() const noexcept { return repeats_; }
   std::uint64_t mailbox_duplicates() const noexcept { return duplicates_; }
@@ -161,6 +165,8 @@ class EscSlave {
   SiiInfo* sii_info_ = nullptr;
   std::array<SmState, 16> sms_{};
   AlState state_ = AlState::Init;
+  AlState highest_ = AlState::Op;   // limit_state()
+  std::uint16_t limit_code_ = 0;
   std::uint8_t sii_busy_ = 0;
 
   // mailbox

@@ -69,6 +69,10 @@ class SimLine final : public FrameSink {
   void repair_cable() noexcept;
   void drop_next(std::size_t frames) noexcept { drop_ = frames; }
   void corrupt_next() noexcept { corrupt_ = true; }
+  // Slave k stuck at `highest` (refuses higher states with `code`); AlState::Op lifts it.
+  void stick(std::size_t k, AlState highest, std::uint16_t code) noexcept {
+    if (k < slaves_.size()) slaves_[k].esc->limit_state(highest, code);
+  }
   // Slaves a frame reaches now.
   std::size_t reachable() const noexcept;
 
