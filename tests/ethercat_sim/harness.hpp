@@ -46,10 +46,12 @@ class Bus {
     const AddResult r = b.add(c, 0x42, address, length, data);
     EXPECT_TRUE(r.ok());
     const auto frame = b.finish();
+    if (capture != nullptr) capture->emplace_back(frame.begin(), frame.end());
     link_.send(FrameView(frame.data(), frame.size()));
     Reply reply;
     std::array<FrameBuffer, 1> rx;
     if (link_.receive(rx) != 1) return reply;
+    if (capture != nullptr) capture->emplace_back(rx[0].view().begin(), rx[0].view().end());
     FrameParser p(rx[0].view());
     Datagram d;
     if (!p.next(d)) return reply;
@@ -88,6 +90,9 @@ class Bus {
       EXPECT_EQ(r.wkc, 1);
     }
   }
+  // When set, every frame sent and received is appended (for a capture file).
+  std::vector<std::vector<std::uint8_t>>* capture = nullptr;
+
   static std::uint16_t station(std::size_t k) { return static_cast<std::uint16_t>(0x1001 + k); }
 
   // Writes an SM entry.
