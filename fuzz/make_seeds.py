@@ -15,6 +15,9 @@ ethercat_frame:   EtherCAT frames (ETG.1000.4 §5 layout): one APRD, a multi-dat
 ethercat_mailbox: SM1 mailboxes: the digest's TV-6 SDO download, TV-4 emergencies, SDO responses
                   (expedited, normal, segments, abort), SDO information replies, a mailbox error.
 ethercat_sii:     SII images: a minimal one and one with every category the parser reads.
+ethercat_sim:     operation scripts (format in fuzz_ethercat_sim.cpp): addressing and identity
+                  reads, a bring-up to PRE-OP with an SDO upload through the mailbox, process data
+                  to OP with LRW, a DC latch, faults.
 """
 import struct
 import pathlib
@@ -209,7 +212,41 @@ def ethercat_sii_seeds():
     write("ethercat_sii", "header_only", sii_image([])[:128])
 
 
+def sim_dg(cmd, adp, ado, data):
+    """One datagram operation of fuzz_ethercat_sim.cpp: command, address (ADP | ADO << 16), length u8, data."""
+    return bytes([cmd]) + struct.pack("<HHB", adp, ado, len(data)) + data
+
+
+def ethercat_sim_seeds():
+    st0, st1 = 0x1001, 0x1002
+    addr = sim_dg(2, 0, 0x10, struct.pack("<H", st0)) + sim_dg(2, 0xFFFF, 0x10, struct.pack("<H", st1))
+    ident = sim_dg(7, 0, 0, bytes(1)) + sim_dg(4, st0, 0, bytes(10)) + sim_dg(4, st1, 0, bytes(10))
+    # SM0/SM1 of the CoE slave (ETG.1000.4 Table 59 entries), PRE-OP, an SDO upload of 1000h.
+    sm0 = struct.pack("<HHBBBB", 0x1000, 128, 0x26, 0, 1, 0)
+    sm1 = struct.pack("<HHBBBB", 0x1080, 128, 0x22, 0, 1, 0)
+    upload = struct.pack("<HHBB", 10, 0, 0, 0x13) + struct.pack("<H", 0x2000) + bytes([0x40, 0x00, 0x10, 0]) + bytes(4)
+    mbx_seq = (sim_dg(5, st0, 0x800, sm0) + sim_dg(5, st0, 0x808, sm1) + sim_dg(5, st0, 0x120, bytes([2, 0]))
+               + sim_dg(5, st0, 0x1000, upload + bytes(128 - len(upload))) + b"\xf1"
+               + sim_dg(4, st0, 0x80D, bytes(1)) + sim_dg(4, st0, 0x1080, bytes(128)))
+    # Generic slave to OP: SM2/SM3, FMMUs, LRW.
+    sm2 = struct.pack("<HHBBBB", 0x1000, 2, 0x64, 0, 1, 0)
+    sm3 = struct.pack("<HHBBBB", 0x1100, 2, 0x20, 0, 1, 0)
+    f0 = struct.pack("<IHBBHBBBxxx", 0x10000, 2, 0, 7, 0x1000, 0, 2, 1)
+    f1 = struct.pack("<IHBBHBBBxxx", 0x10002, 2, 0, 7, 0x1100, 0, 1, 1)
+    pd = (sim_dg(5, st1, 0x810, sm2) + sim_dg(5, st1, 0x818, sm3) + sim_dg(5, st1, 0x600, f0)
+          + sim_dg(5, st1, 0x610, f1) + sim_dg(5, st1, 0x120, bytes([2, 0])) + sim_dg(5, st1, 0x120, bytes([4, 0]))
+          + sim_dg(5, st1, 0x120, bytes([8, 0])) + sim_dg(12, 0, 1, bytes([0x11, 0x22, 0, 0])) + b"\xff\xff")
+    dc = sim_dg(8, 0, 0x900, bytes(4)) + sim_dg(4, st1, 0x900, bytes(16)) + sim_dg(13, 0, 0x910, bytes(8))
+    faults = addr + b"\xe0" + sim_dg(7, 0, 0, bytes(1)) + b"\xe1\xe2\xe3\xe4" + sim_dg(7, 0, 0, bytes(1)) + b"\xe5"
+    write("ethercat_sim", "identity", addr + ident)
+    write("ethercat_sim", "mailbox", addr + mbx_seq)
+    write("ethercat_sim", "process_data", addr + pd)
+    write("ethercat_sim", "dc", addr + dc)
+    write("ethercat_sim", "faults", faults)
+
+
 if __name__ == "__main__":
+    ethercat_sim_seeds()
     ethercat_frame_seeds()
     ethercat_mailbox_seeds()
     ethercat_sii_seeds()
