@@ -3,7 +3,7 @@
 # on a scratch copy of its seed corpus (fuzz/README.md).
 #
 #   scripts/fuzz.sh [SECONDS] [TARGET...]      TARGET: msgpack_frame sdo can_engines eds config
-#                                              ethercat_frame ethercat_mailbox ethercat_sii
+#                                              ethercat_frame ethercat_mailbox ethercat_sii ethercat_sim
 #
 # Environment: BUILD_DIR (default build-fuzz next to the source tree), WORK_DIR (scratch, default
 # a new mktemp -d), JOBS (ninja -j, default 2).
@@ -15,7 +15,7 @@ set -euo pipefail
 seconds=${1:-60}
 shift || true
 targets=("$@")
-[ ${#targets[@]} -eq 0 ] && targets=(msgpack_frame sdo can_engines eds config ethercat_frame ethercat_mailbox ethercat_sii)
+[ ${#targets[@]} -eq 0 ] && targets=(msgpack_frame sdo can_engines eds config ethercat_frame ethercat_mailbox ethercat_sii ethercat_sim)
 
 src=$(cd "$(dirname "$0")/.." && pwd)
 build=${BUILD_DIR:-$src/../build-fuzz}

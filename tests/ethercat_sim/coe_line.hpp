@@ -37,8 +37,16 @@ class CoeApp final : public SlaveApplication {
   std::size_t input_size() const noexcept override { return 2; }
   void exchange(std::span<const std::uint8_t>, std::span<std::uint8_t>, AlState, std::uint64_t) noexcept override {}
   ObjectDictionary* object_dictionary() noexcept override { return &od; }
+  void attach(EscSlave& e) noexcept override { esc = &e; }
+  void on_state_entered(AlState from, AlState to) noexcept override {
+    last_from = from;
+    last_to = to;
+  }
 
   SimpleObjectDictionary od;
+  EscSlave* esc = nullptr;
+  AlState last_from = AlState::None;
+  AlState last_to = AlState::None;
   std::vector<std::uint8_t> long_value;
 };
 

@@ -228,8 +228,12 @@ TEST(EthercatSimMailbox, OdListInFragments) {
 TEST(EthercatSimMailbox, EmergencyRepeatAndCounter) {
   CoeLine l;
   l.preop();
-  // Emergency queued, delivered when SM1 is read [ETG.1000.6 §5.6.4].
-  ASSERT_TRUE(l.esc.post_emergency(CoeEmergency{0x8100, 0x11, {1, 2, 3, 4, 5}}));
+  // The application was attached and saw INIT -> PRE-OP.
+  ASSERT_EQ(l.app.esc, &l.esc);
+  EXPECT_EQ(l.app.last_from, AlState::Init);
+  EXPECT_EQ(l.app.last_to, AlState::PreOp);
+  // Emergency queued by the application, delivered when SM1 is read [ETG.1000.6 §5.6.4].
+  ASSERT_TRUE(l.app.esc->post_emergency(CoeEmergency{0x8100, 0x11, {1, 2, 3, 4, 5}}));
   Reply r = l.get();
   ASSERT_TRUE(r.returned);
   const EmergencyView e = decode_emergency(r.bytes());

@@ -86,6 +86,7 @@ EscSlave::EscSlave(const EscConfig& config, std::span<const std::uint8_t> sii, S
     allow(reg::kDcLatch0Control, 2);
   }
   power_on();
+  if (app_ != nullptr) app_->attach(*this);
 }
 
 std::uint16_t EscSlave::u16(std::uint16_t at) const noexcept { return get_u16(mem_, at); }
@@ -516,7 +517,8 @@ std::uint16_t EscSlave::check_transition(AlState from, AlState to) noexcept {
   return 0;
 }
 
-void EscSlave::enter_state(AlState /*from*/, AlState to) noexcept {
+void EscSlave::enter_state(AlState from, AlState to) noexcept {
+  if (app_ != nullptr && from != to) app_->on_state_entered(from, to);
   switch (to) {
     case AlState::Init:
       // Back in INIT the PDI deactivates every SM and drops the mailbox [ETG.1000.6 §5.3.1].

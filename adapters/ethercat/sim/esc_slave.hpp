@@ -45,8 +45,12 @@ class SlaveApplication {
   // §5.3.2: checked at PRE-OP -> SAFE-OP]. They may depend on the PDO assignment in the OD.
   virtual std::size_t output_size() const noexcept = 0;
   virtual std::size_t input_size() const noexcept = 0;
-  // A state transition the generic checks passed: 0 accepts, otherwise the AL status code.
+  // Called once by the EscSlave constructor: the application keeps `esc` to post emergencies.
+  virtual void attach(EscSlave& /*esc*/) noexcept {}
+  // A requested transition the generic checks passed: 0 accepts, otherwise the AL status code.
   virtual std::uint16_t on_state_change(AlState /*from*/, AlState /*to*/) noexcept { return 0; }
+  // Every state change, requested or not (SM watchdog, limit_state()), as it happens.
+  virtual void on_state_entered(AlState /*from*/, AlState /*to*/) noexcept {}
   // After each frame: `outputs` as the master last wrote them (all zero outside OP or after the
   // SM watchdog expired), `inputs` to fill (copied into SM3 in SAFE-OP and OP).
   virtual void exchange(std::span<const std::uint8_t> outputs, std::span<std::uint8_t> inputs, AlState state,
