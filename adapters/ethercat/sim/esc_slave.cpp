@@ -175,6 +175,12 @@ SmEntry EscSlave::sm(unsigned n) const noexcept {
   return e.value_or(SmEntry{});
 }
 
+std::span<std::uint8_t> EscSlave::sm_buffer(unsigned n) noexcept {
+  const SmEntry e = sm(n);
+  if (static_cast<std::uint32_t>(e.physical_start) + e.length > kMemorySize) return {};
+  return {mem_.data() + e.physical_start, e.length};
+}
+
 bool EscSlave::sm_active(unsigned n) const noexcept {
   const SmEntry e = sm(n);
   return e.enabled() && (e.pdi_control & kPdiDeactivate) == 0 && e.length != 0;
@@ -578,8 +584,7 @@ void EscSlave::sii_command() noexcept {
 
 void EscSlave::mailbox_received() noexcept {
   mailbox_pending_ = false;
-  const SmEntry s0 = sm(0);
-  const std::span<const std::uint8_t> box(mem_.data() + s0.physical_start, s0.length);
+  const std::span<const std::uint8_t> box = sm_buffer(0);
   const MailboxView v = decode_mailbox(box);
   // The PDI has read the mailbox: SM0 is empty again.
   sms_[0].mailbox_full = false;
@@ -607,15 +612,15 @@ void EscSlave::mailbox_received() noexcept {
 
 void EscSlave::load_sm1() noexcept {
   if (!has_mailbox_ || !sm_active(1) || sms_[1].mailbox_full || outbox_.empty()) return;
-  const SmEntry s1 = sm(1);
+  const std::span<std::uint8_t> buf = sm_buffer(1);
   const auto msg = outbox_.front();
-  if (msg.size() > s1.length) {  // cannot happen with the SII's SM1 size; drop rather than cut
+  if (msg.size() > buf.size()) {  // SM1 shorter than the SII's (or outside memory): drop, never cut
     outbox_.pop();
     outbox_.count_drop();
     return;
   }
-  std::fill(mem_.begin() + s1.physical_start, mem_.begin() + s1.physical_start + s1.length, std::uint8_t{0});
-  std::copy(msg.begin(), msg.end(), mem_.begin() + s1.physical_start);
+  std::fill(buf.begin(), buf.end(), std::uint8_t{0});
+  std::copy(msg.begin(), msg.end(), buf.begin());
   std::copy(msg.begin(), msg.end(), last_sent_.begin());
   last_sent_size_ = msg.size();
   outbox_.pop();
@@ -630,20 +635,18 @@ void EscSlave::sm1_repeat() noexcept {
   const auto pdi_at = static_cast<std::uint16_t>(reg::sm(1) + 7U);
   const bool request = (mem_[reg::sm(1) + 6U] & sm_activate::kRepeat) != 0;
   ++repeats_;
-  const SmEntry s1 = sm(1);
+  const std::span<std::uint8_t> buf = sm_buffer(1);
   if (sms_[1].mailbox_full) {
     // A newer mailbox waiting in SM1 goes back to the front of the queue (its counter kept).
-    const MailboxView v = decode_mailbox(std::span<const std::uint8_t>(mem_.data() + s1.physical_start, s1.length));
+    const MailboxView v = decode_mailbox(buf);
     if (v.error == MailboxError::None && v.header.counter != (last_sent_.size() > 5 ? (last_sent_[5] >> 4) & 7 : 0)) {
-      outbox_.push_front(std::span<const std::uint8_t>(mem_.data() + s1.physical_start,
-                                                       kMailboxHeaderSize + v.header.length));
+      outbox_.push_front(buf.first(kMailboxHeaderSize + v.header.length));
     }
     sms_[1].mailbox_full = false;
   }
-  if (last_sent_size_ > 0 && last_sent_size_ <= s1.length) {
-    std::fill(mem_.begin() + s1.physical_start, mem_.begin() + s1.physical_start + s1.length, std::uint8_t{0});
-    std::copy(last_sent_.begin(), last_sent_.begin() + static_cast<std::ptrdiff_t>(last_sent_size_),
-              mem_.begin() + s1.physical_start);
+  if (last_sent_size_ > 0 && last_sent_size_ <= buf.size()) {
+    std::fill(buf.begin(), buf.end(), std::uint8_t{0});
+    std::copy(last_sent_.begin(), last_sent_.begin() + static_cast<std::ptrdiff_t>(last_sent_size_), buf.begin());
     sms_[1].mailbox_full = true;
     mem_[reg::sm(1) + 5U] = static_cast<std::uint8_t>(mem_[reg::sm(1) + 5U] | sm_status::kMailboxFull);
   }
@@ -703,14 +706,13 @@ void EscSlave::pdi_cycle(std::uint64_t now_ns) noexcept {
   const std::size_t in_n = std::min(app_->input_size(), inputs_.size());
   std::span<const std::uint8_t> outputs(zeros_.data(), out_n);
   if (state_ == AlState::Op && outputs_valid_ && out_n > 0) {
-    const SmEntry s2 = sm(2);
-    if (s2.length >= out_n) outputs = std::span<const std::uint8_t>(mem_.data() + s2.physical_start, out_n);
+    const std::span<const std::uint8_t> s2 = sm_buffer(2);
+    if (s2.size() >= out_n) outputs = s2.first(out_n);
   }
   app_->exchange(outputs, std::span<std::uint8_t>(inputs_.data(), in_n), state_, now_ns);
   if ((state_ == AlState::SafeOp || state_ == AlState::Op) && in_n > 0 && sm_active(3)) {
-    const SmEntry s3 = sm(3);
-    std::copy(inputs_.begin(), inputs_.begin() + static_cast<std::ptrdiff_t>(std::min<std::size_t>(in_n, s3.length)),
-              mem_.begin() + s3.physical_start);
+    const std::span<std::uint8_t> s3 = sm_buffer(3);
+    std::copy_n(inputs_.begin(), std::min(in_n, s3.size()), s3.begin());
   }
 }
 

@@ -138,6 +138,9 @@ class EscSlave {
   void set64(std::uint16_t at, std::uint64_t v) noexcept;
 
   SmEntry sm(unsigned n) const noexcept;
+  // The SM's buffer in memory; empty when it would reach past 64 KiB (the master may configure
+  // anything after the state checks passed).
+  std::span<std::uint8_t> sm_buffer(unsigned n) noexcept;
   bool sm_active(unsigned n) const noexcept;
   // Checks an ECAT access to [start, start+len): false when an SM refuses it.
   bool sm_allows(std::uint32_t start, std::uint32_t len, Rw rw) const noexcept;
