@@ -87,6 +87,26 @@ TEST(EthercatSimLine, SiiReadThroughEepromInterface) {
   EXPECT_EQ(get_u32(got, 16), 0x00000099U);
 }
 
+TEST(EthercatSimLine, SiiFourByteReadsAndWriteCommandRefused) {
+  EscConfig cfg;
+  cfg.sii_read_8_bytes = false;
+  cfg.sii_busy_frames = 0;  // done by the next frame
+  IoLine l(1, cfg);
+  l.bus.assign_addresses(1);
+  const std::uint16_t st = Bus::station(0);
+  EXPECT_EQ(l.bus.fprd(st, reg::kSiiControl, 2).u16() & sii_control::kRead8Bytes, 0);
+  l.bus.fpwr32(st, reg::kSiiAddress, 0x0008);  // vendor ID, word 8 [ETG.1000.6 §5.4]
+  l.bus.fpwr16(st, reg::kSiiControl, sii_control::kCommandRead);
+  const Reply s = l.bus.fprd(st, reg::kSiiControl, 2);
+  EXPECT_EQ(s.u16() & sii_control::kBusy, 0);
+  const Reply d = l.bus.fprd(st, reg::kSiiData, 8);
+  EXPECT_EQ(d.u32(0), 0x00000099U);
+  EXPECT_EQ(d.u32(4), 0U);  // only 4 bytes read
+  // A write command is not offered: command error bit 13 [ETG.1000.4 Table 48].
+  l.bus.fpwr16(st, reg::kSiiControl, sii_control::kCommandWrite | sii_control::kWriteEnable);
+  EXPECT_NE(l.bus.fprd(st, reg::kSiiControl, 2).u16() & sii_control::kCommandError, 0);
+}
+
 // Configures generic slave k for process data: SM2/SM3 and FMMU0 outputs, FMMU1 inputs at
 // logical addresses out_log / in_log.
 void configure_pd(Bus& bus, std::uint16_t st, std::size_t outputs, std::size_t inputs, std::uint32_t out_log,

@@ -253,6 +253,18 @@ TEST(EthercatSimMailbox, EmergencyRepeatAndCounter) {
   EXPECT_EQ(decode_emergency(r.bytes()).mailbox.counter, emcy_counter);
   EXPECT_EQ(l.bus.fprd(l.st, static_cast<std::uint16_t>(reg::sm(1) + 7U), 1).data[0] & 0x02, 0x02);
   EXPECT_EQ(l.esc.mailbox_repeats(), 1U);
+  // Repeat while a newer mailbox already waits in SM1: the one read last comes first, the newer
+  // one after it (counters 1 and 2).
+  ASSERT_TRUE(l.esc.post_emergency(CoeEmergency{0x8200, 0x11, {}}));
+  l.bus.brd(reg::kType, 1);  // a frame passes: the PDI loads the new emergency into SM1
+  const std::array<std::uint8_t, 1> act2{sm_activate::kEnable};
+  EXPECT_EQ(l.bus.fpwr(l.st, static_cast<std::uint16_t>(reg::sm(1) + 6U), act2).wkc, 1);
+  r = l.get();
+  EXPECT_EQ(decode_emergency(r.bytes()).emergency.error_code, 0x8100);
+  r = l.get();
+  EXPECT_EQ(decode_emergency(r.bytes()).emergency.error_code, 0x8200);
+  EXPECT_EQ(decode_emergency(r.bytes()).mailbox.counter, 2);
+  EXPECT_EQ(l.bus.fprd(l.st, static_cast<std::uint16_t>(reg::sm(1) + 7U), 1).data[0] & 0x02, 0x00);
 
   // The same request counter twice: the second is a repeat and gets no second answer.
   const std::size_t n = encode_sdo_upload_request(l.req, 3, 0x1000, 0);

@@ -221,6 +221,12 @@ void EscSlave::sm_after(std::uint32_t start, std::uint32_t len, Rw rw) noexcept 
       mem_[status_at] = static_cast<std::uint8_t>(mem_[status_at] | sm_status::kMailboxFull | sm_status::kInterruptWrite);
       if (n == 0) mailbox_pending_ = true;
     } else if (mailbox && !ecat_writes && rw == Rw::Read) {
+      if (n == 1 && has_mailbox_) {
+        // Keep what the master just read: a repeat request asks for exactly this mailbox again.
+        const std::span<const std::uint8_t> buf = sm_buffer(1);
+        last_sent_size_ = std::min(buf.size(), last_sent_.size());
+        std::copy_n(buf.begin(), last_sent_size_, last_sent_.begin());
+      }
       sms_[n].mailbox_full = false;
       mem_[status_at] = static_cast<std::uint8_t>(mem_[status_at] & ~(sm_status::kMailboxFull | sm_status::kInterruptRead));
     } else if (!mailbox && ecat_writes && rw == Rw::Write) {
@@ -621,8 +627,6 @@ void EscSlave::load_sm1() noexcept {
   }
   std::fill(buf.begin(), buf.end(), std::uint8_t{0});
   std::copy(msg.begin(), msg.end(), buf.begin());
-  std::copy(msg.begin(), msg.end(), last_sent_.begin());
-  last_sent_size_ = msg.size();
   outbox_.pop();
   sms_[1].mailbox_full = true;
   mem_[reg::sm(1) + 5U] = static_cast<std::uint8_t>(mem_[reg::sm(1) + 5U] | sm_status::kMailboxFull);
@@ -639,9 +643,7 @@ void EscSlave::sm1_repeat() noexcept {
   if (sms_[1].mailbox_full) {
     // A newer mailbox waiting in SM1 goes back to the front of the queue (its counter kept).
     const MailboxView v = decode_mailbox(buf);
-    if (v.error == MailboxError::None && v.header.counter != (last_sent_.size() > 5 ? (last_sent_[5] >> 4) & 7 : 0)) {
-      outbox_.push_front(buf.first(kMailboxHeaderSize + v.header.length));
-    }
+    if (v.error == MailboxError::None) outbox_.push_front(buf.first(kMailboxHeaderSize + v.header.length));
     sms_[1].mailbox_full = false;
   }
   if (last_sent_size_ > 0 && last_sent_size_ <= buf.size()) {

@@ -180,7 +180,7 @@ class EscSlave {
   bool has_mailbox_ = false;
   MailboxOutbox outbox_;
   CoeServer coe_;
-  std::vector<std::uint8_t> last_sent_;      // last mailbox handed to the master (repeat)
+  std::vector<std::uint8_t> last_sent_;      // last mailbox the master read from SM1 (repeat)
   std::size_t last_sent_size_ = 0;
   std::uint8_t last_rx_counter_ = 0;
   bool mailbox_pending_ = false;             // SM0 full, not yet handled by the PDI
