@@ -198,7 +198,6 @@ TEST(DdsBridge, CommandOnlyClientSubscribesToStatesOnFirstRead) {
   bridge.start();
   msg::DdsNode probe(raw_options());
   dds::DataWriter& state_w = probe.writer(msg::TopicId::AxisState);
-  dds::DataReader& command_r = probe.reader(msg::TopicId::AxisCommand);
   const auto matched_state_readers = [&] {
     dds::PublicationMatchedStatus m{};
     state_w.get_publication_matched_status(m);
@@ -211,6 +210,9 @@ TEST(DdsBridge, CommandOnlyClientSubscribesToStatesOnFirstRead) {
   req.kind = "enable";
   ASSERT_EQ(c.send(req, true, kTimeout).outcome, Outcome::Completed);
   EXPECT_EQ(c.stream_setpoint("x", "gw1", 0, 1, 0), "");
+  // Made only now: a command reader of the probe's, matched before the gateway's, would let the
+  // client send before the gateway can hear it (the client counts matched readers, not whose).
+  dds::DataReader& command_r = probe.reader(msg::TopicId::AxisCommand);
   // The probe has discovered the client's endpoints (the command writer, made after the readers the
   // client made at construction) ...
   ASSERT_TRUE(c.wait_until(
