@@ -16,6 +16,7 @@
 #include "adapters/ethercat/wire/frame.hpp"
 #include "adapters/ethercat/wire/mailbox.hpp"
 #include "adapters/ethercat/wire/registers.hpp"
+#include "tests/support/pcap.hpp"
 
 namespace drivegate::ethercat {
 namespace {
@@ -24,47 +25,6 @@ using Bytes = std::vector<std::uint8_t>;
 constexpr MacAddress kSrc{0x02, 0x00, 0x00, 0x00, 0x00, 0x01};
 constexpr std::uint16_t kSlave = 0x1001;
 constexpr std::uint16_t kMailboxSize = 128;
-
-void put32(std::ofstream& f, std::uint32_t v) {
-  const std::array<char, 4> b{static_cast<char>(v & 0xFF), static_cast<char>((v >> 8) & 0xFF),
-                              static_cast<char>((v >> 16) & 0xFF), static_cast<char>(v >> 24)};
-  f.write(b.data(), 4);
-}
-void put16(std::ofstream& f, std::uint16_t v) {
-  const std::array<char, 2> b{static_cast<char>(v & 0xFF), static_cast<char>(v >> 8)};
-  f.write(b.data(), 2);
-}
-
-// pcap: magic A1B2C3D4 (little-endian file), version 2.4, zone 0, sigfigs 0, snaplen, link type 1.
-void write_pcap(const std::filesystem::path& path, const std::vector<Bytes>& frames) {
-  std::ofstream f(path, std::ios::binary);
-  put32(f, 0xA1B2C3D4);
-  put16(f, 2);
-  put16(f, 4);
-  put32(f, 0);
-  put32(f, 0);
-  put32(f, 65535);
-  put32(f, 1);
-  std::uint32_t usec = 0;
-  for (const Bytes& fr : frames) {
-    put32(f, 1700000000);
-    put32(f, usec += 1000);
-    put32(f, static_cast<std::uint32_t>(fr.size()));
-    put32(f, static_cast<std::uint32_t>(fr.size()));
-    f.write(reinterpret_cast<const char*>(fr.data()), static_cast<std::streamsize>(fr.size()));
-  }
-}
-
-std::string run(const std::string& cmd) {
-  std::string out;
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return out;
-  std::array<char, 4096> buf{};
-  std::size_t n = 0;
-  while ((n = std::fread(buf.data(), 1, buf.size(), p)) > 0) out.append(buf.data(), n);
-  pclose(p);
-  return out;
-}
 
 // One datagram carrying a mailbox: FPWR into SM0 (1000h) or FPRD of SM1 (1080h), padded to the
 // mailbox size as a master writes and reads it.
@@ -158,8 +118,8 @@ TEST(EcatTshark, FramesDissectCleanly) {
   const auto path = std::filesystem::temp_directory_path() /
                     ("drivegate-ecat-wire-" + std::to_string(::getpid()) + ".pcap");
   const std::vector<Bytes> fs = frames();
-  write_pcap(path, fs);
-  const std::string out = run("tshark -r '" + path.string() + "' -V 2>&1");
+  drivegate::test::write_pcap(path, fs);
+  const std::string out = drivegate::test::command_output("tshark -r '" + path.string() + "' -V 2>&1");
   std::filesystem::remove(path);
   ASSERT_FALSE(out.empty());
   EXPECT_EQ(out.find("Malformed"), std::string::npos) << out;
