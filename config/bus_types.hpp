@@ -90,9 +90,12 @@ struct BusTypeInfo {
   std::function<void(const MapReader& axis, const BusPlan& bus, const DeviceProfile* device,
                      const std::filesystem::path& base_dir, AxisPlan& a)>
       read_axis;
-  // The `device_section` of the profile `root` (called when present) into profile.sections; it may
-  // fill profile.cyclic_objects when the profile does not list them (`cyclic_given` false).
-  std::function<void(const MapReader& root, DeviceProfile& profile, bool cyclic_given)> read_device;
+  // The `device_section` of the profile `root` (called when present) into profile.sections.
+  std::function<void(const MapReader& root, DeviceProfile& profile)> read_device;
+  // The objects the section maps cyclically (its PDOs, outputs first); empty: it maps none. A
+  // profile without cyclic_objects gets them from the first section that maps any, and every such
+  // section must map exactly the profile's cyclic objects (config/device_profile.cpp).
+  std::function<std::vector<cia402::ObjectId>(const DeviceProfile& profile)> mapped_objects;
   // Checks of a bus with all its axes, reported at its entry, in order.
   std::vector<std::function<void(const BusPlan& bus, const BusEntry& at)>> check_bus;
   // The printout: a bus' rows after its options, in order; an axis' rows after the common ones.

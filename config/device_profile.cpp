@@ -198,13 +198,29 @@ void read_profile(const MapReader& root, const fs::path& file, const BusTypeRegi
         p.cyclic_objects.push_back(*id);
     }
   }
+  for (const auto& type : types.types())
+    if (type->read_device && root.has(type->device_section)) type->read_device(root, p);
+  // The cyclic image is what the bus sections map: given in the file, or taken from the first
+  // section that maps objects; every section that maps any must map exactly those.
   const bool cyclic_given = root.has("cyclic_objects");
   std::string derived_from;  // the section that filled cyclic_objects
   for (const auto& type : types.types()) {
-    if (!type->read_device || !root.has(type->device_section)) continue;
-    const bool had_cyclic = !p.cyclic_objects.empty();
-    type->read_device(root, p, cyclic_given);
-    if (!cyclic_given && !had_cyclic && !p.cyclic_objects.empty()) derived_from = type->device_section;
+    if (!type->mapped_objects || !root.has(type->device_section)) continue;
+    const auto mapped = type->mapped_objects(p);
+    if (mapped.empty()) continue;
+    const std::string& section = type->device_section;
+    if (!cyclic_given && derived_from.empty()) {
+      p.cyclic_objects = mapped;
+      derived_from = section;
+    } else if (const auto d = cyclic_image_difference(mapped, p.cyclic_objects, cyclic_given ? "listed" : "cyclic");
+               !d.empty()) {
+      if (cyclic_given)
+        root.error("cyclic_objects",
+                   "must list exactly the objects of the " + section + " PDO maps (or be left out to derive them):" + d);
+      else
+        root.error(section, "the " + section + " PDO maps must carry the same objects as the " + derived_from +
+                                " PDO maps (the cyclic image):" + d);
+    }
   }
   check_cyclic_image(p, root, derived_from);
 }

@@ -61,6 +61,7 @@ BusTypeInfo canopen_bus_type() {
   t.read_bus = read_canopen_bus;
   t.read_axis = read_canopen_axis;
   t.read_device = read_canopen_device;
+  t.mapped_objects = canopen_mapped_objects;
   t.check_bus = {check_realtime};
   t.describe_bus = {describe_canopen_bus};
   t.describe_axis = describe_canopen_axis;

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "config/object_text.hpp"
+#include "config/pdo_checks.hpp"
 #include "config/canopen/parameter_names.hpp"
 #include "config/text_util.hpp"
 #include "profiles/cia402/standard_types.hpp"
@@ -50,14 +51,6 @@ std::optional<cia402::ObjectId> read_object(const YAML::Node& n, const std::stri
   return std::nullopt;
 }
 
-void check_known_type(const YAML::Node& n, const std::string& path, const Source& src, cia402::ObjectId id,
-                      cia402::DataType type) {
-  const auto known = cia402::profile_object_type(id);  // a profile that gives 6060h another size is caught
-  if (known && size_of(*known) != size_of(type))
-    src.error(n.Mark(), path,
-              object_hex(id) + " is " + std::string{to_string(*known)} + " in CiA 402, got " + std::string{to_string(type)});
-}
-
 // One map entry "INDEX[:SUB] TYPE", its type checked against CiA 402.
 std::optional<PdoEntrySpec> read_entry(const YAML::Node& n, const std::string& path, const Source& src) {
   const auto entry = read_pdo_entry(n, path, src);
@@ -95,14 +88,8 @@ std::optional<PdoEntrySpec> read_pdo_entry(const YAML::Node& n, const std::strin
 
 namespace {
 
-struct Mapped {
-  cia402::ObjectId id;
-  std::string path;  // where it was mapped
-  YAML::Mark mark;
-};
-
 void read_pdos(const MapReader& c, const std::string& key, bool receive, const DeviceProfile& p,
-               std::vector<PdoSpec>& out, std::vector<Mapped>& mapped) {
+               std::vector<PdoSpec>& out, std::vector<MappedEntry>& mapped) {
   const auto list = c.list(key, Need::Optional);
   if (!list) return;
   const Source& src = c.source();
@@ -143,13 +130,7 @@ void read_pdos(const MapReader& c, const std::string& key, bool receive, const D
         const std::string path = indexed(m.field("map"), e);
         const auto entry = read_entry((*entries)[e], path, src);
         if (!entry) continue;
-        const auto dup = std::find_if(mapped.begin(), mapped.end(), [&](const Mapped& x) { return x.id == entry->object; });
-        if (dup != mapped.end()) {
-          src.error((*entries)[e].Mark(), path, object_hex(entry->object) + " is already mapped in " + dup->path);
-          continue;
-        }
-        mapped.push_back({entry->object, path, (*entries)[e].Mark()});
-        pdo.entries.push_back(*entry);
+        if (record_mapping((*entries)[e], path, src, entry->object, mapped)) pdo.entries.push_back(*entry);
       }
       if (entries->size() > static_cast<std::size_t>(max_entries))
         m.error("map", std::to_string(entries->size()) + " entries mapped, a PDO " +
@@ -172,34 +153,13 @@ void read_pdos(const MapReader& c, const std::string& key, bool receive, const D
   }
 }
 
-bool maps(const std::vector<PdoSpec>& pdos, cia402::ObjectId id) {
-  return std::any_of(pdos.begin(), pdos.end(), [id](const PdoSpec& p) {
-    return std::any_of(p.entries.begin(), p.entries.end(), [id](const PdoEntrySpec& e) { return e.object == id; });
-  });
-}
-
-void check_directions(const MapReader& c, const DeviceProfile& p) {
-  const auto& co = p.section<CanopenDeviceSpec>();
-  if (co.rpdos.empty() && co.tpdos.empty()) return;
-  const auto need = [&](const std::vector<PdoSpec>& pdos, const char* key, cia402::ObjectId id, const std::string& why) {
-    if (!maps(pdos, id)) c.error(key, "must map " + object_hex(id) + " " + why);
-  };
-  need(co.rpdos, "rpdos", cia402::obj::kControlword.id, "(controlword): the gateway drives every axis through it");
-  need(co.tpdos, "tpdos", cia402::obj::kStatusword.id, "(statusword): the gateway follows every axis through it");
-  if (p.quirk("mode_object_always_valid"))
-    need(co.rpdos, "rpdos", cia402::obj::kModesOfOperation.id,
-         "(modes of operation): quirk mode_object_always_valid needs 6060h in every RPDO cycle "
-         "(nord-sk500p-ds402.md §13 step 6)");
-}
-
-// Every object mapped into an RPDO and a TPDO at once is refused at the TPDO entry: data goes one way.
-void check_one_way(const MapReader& c, const std::vector<Mapped>& rx, const std::vector<Mapped>& tx) {
-  for (const auto& t : tx) {
-    const auto r = std::find_if(rx.begin(), rx.end(), [&](const Mapped& x) { return x.id == t.id; });
-    if (r != rx.end())
-      c.source().error(t.mark, t.path, object_hex(t.id) + " is also mapped in " + r->path +
-                                           "; an object is either sent or received");
-  }
+// 6040h/6041h, and 6060h in the RPDOs where the device needs it in every cycle.
+void check_directions(const MapReader& c, const DeviceProfile& p, const std::vector<MappedEntry>& rx,
+                      const std::vector<MappedEntry>& tx) {
+  check_control_and_status(c, rx, "rpdos", tx, "tpdos");
+  if (p.quirk("mode_object_always_valid") && !rx.empty() && !is_mapped(rx, cia402::obj::kModesOfOperation.id))
+    c.error("rpdos", "must map 0x6060 (modes of operation): quirk mode_object_always_valid needs 6060h in every RPDO "
+                     "cycle (nord-sk500p-ds402.md §13 step 6)");
 }
 
 void read_emcy(const MapReader& e, CanopenDeviceSpec& co) {
@@ -257,24 +217,6 @@ void read_sync_periods(const MapReader& c, CanopenDeviceSpec& co) {
       co.sync_periods.push_back(*d);
 }
 
-// The cyclic image is the set of mapped objects: a profile that lists cyclic_objects too must
-// list exactly those, so the two cannot drift apart.
-void reconcile_cyclic_objects(const MapReader& root, DeviceProfile& p, bool cyclic_given) {
-  std::vector<cia402::ObjectId> mapped;
-  const auto& co = p.section<CanopenDeviceSpec>();
-  for (const auto* pdos : {&co.rpdos, &co.tpdos})
-    for (const auto& pdo : *pdos)
-      for (const auto& e : pdo.entries) mapped.push_back(e.object);
-  if (mapped.empty()) return;
-  if (!cyclic_given) {
-    p.cyclic_objects = mapped;
-    return;
-  }
-  if (const auto d = cyclic_image_difference(mapped, p.cyclic_objects, "listed"); !d.empty())
-    root.error("cyclic_objects",
-               "must list exactly the objects of the canopen PDO maps (or be left out to derive them):" + d);
-}
-
 }  // namespace
 
 void read_startup_writes(const MapReader& parent, std::string_view key, const std::optional<ParameterNaming>& naming,
@@ -282,7 +224,7 @@ void read_startup_writes(const MapReader& parent, std::string_view key, const st
   const auto list = parent.list(key, Need::Optional);
   if (!list) return;
   const Source& src = parent.source();
-  std::vector<Mapped> written;
+  std::vector<MappedEntry> written;
   for (std::size_t i = 0; i < list->size(); ++i) {
     const MapReader w{(*list)[i], indexed(parent.field(key), i), src};
     if (!w.present()) continue;
@@ -310,7 +252,7 @@ void read_startup_writes(const MapReader& parent, std::string_view key, const st
       continue;
     }
     if (has_type) check_known_type(object_node, w.field("object"), src, *id, type);
-    const auto dup = std::find_if(written.begin(), written.end(), [&](const Mapped& x) { return x.id == *id; });
+    const auto dup = std::find_if(written.begin(), written.end(), [&](const MappedEntry& x) { return x.id == *id; });
     if (dup != written.end()) {
       w.error("object", object_hex(*id) + " is already written by " + dup->path);
       continue;
@@ -330,7 +272,7 @@ std::optional<GatewayWatch> read_gateway_watch(const MapReader& parent) {
   return GatewayWatch::Optional;
 }
 
-void read_canopen_device(const MapReader& root, DeviceProfile& p, bool cyclic_given) {
+void read_canopen_device(const MapReader& root, DeviceProfile& p) {
   if (!root.has("canopen")) return;
   const MapReader c = root.map("canopen", Need::Optional);
   if (!c.present()) return;
@@ -388,17 +330,25 @@ void read_canopen_device(const MapReader& root, DeviceProfile& p, bool cyclic_gi
   }
   read_sync_periods(c, co);
 
-  std::vector<Mapped> rx;
-  std::vector<Mapped> tx;
+  std::vector<MappedEntry> rx;
+  std::vector<MappedEntry> tx;
   read_pdos(c, "rpdos", true, p, co.rpdos, rx);
   read_pdos(c, "tpdos", false, p, co.tpdos, tx);
-  check_one_way(c, rx, tx);
-  check_directions(c, p);
+  check_one_way(c.source(), rx, tx);
+  check_directions(c, p, rx, tx);
 
   if (c.has("parameter_names")) read_naming(c.map("parameter_names", Need::Optional), co);
   read_startup_writes(c, "startup_writes", co.parameter_naming, co.startup_writes);
   read_emcy(c.map("emcy", Need::Optional), co);
-  reconcile_cyclic_objects(root, p, cyclic_given);
+}
+
+std::vector<cia402::ObjectId> canopen_mapped_objects(const DeviceProfile& p) {
+  std::vector<cia402::ObjectId> mapped;
+  const auto& co = p.section<CanopenDeviceSpec>();
+  for (const auto* pdos : {&co.rpdos, &co.tpdos})
+    for (const auto& pdo : *pdos)
+      for (const auto& e : pdo.entries) mapped.push_back(e.object);
+  return mapped;
 }
 
 }  // namespace drivegate::config

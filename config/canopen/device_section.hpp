@@ -11,10 +11,11 @@
 
 namespace drivegate::config {
 
-// Reads the `canopen:` map of the profile `root` (if any) into `p.canopen`. Needs p.quirks already
-// read. When the section maps PDOs, p.cyclic_objects must list the same objects (if the profile
-// gave them: `cyclic_given`) or is derived from the maps.
-void read_canopen_device(const MapReader& root, DeviceProfile& p, bool cyclic_given);
+// Reads the `canopen:` map of the profile `root` (if any) into p.sections. Needs p.quirks already
+// read.
+void read_canopen_device(const MapReader& root, DeviceProfile& p);
+// The objects of its PDO maps, RPDOs first (BusTypeInfo::mapped_objects).
+std::vector<cia402::ObjectId> canopen_mapped_objects(const DeviceProfile& p);
 
 // A `startup_writes:` list under `parent` (absent: nothing). Objects are "0x6046:1" or, with
 // `naming`, manufacturer parameter names ("A83").

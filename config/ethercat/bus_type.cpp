@@ -13,6 +13,7 @@ BusTypeInfo ethercat_bus_type() {
   t.max_address = 65535;
   t.device_section = "ethercat";
   t.read_device = read_ethercat_device;
+  t.mapped_objects = ethercat_mapped_objects;
   return t;
 }
 

@@ -1,22 +1,17 @@
 #include "config/ethercat/device_section.hpp"
 
 #include <algorithm>
-#include <cstdio>
 
 #include "config/canopen/device_section.hpp"
 #include "config/object_text.hpp"
+#include "config/pdo_checks.hpp"
 #include "config/text_util.hpp"
-#include "profiles/cia402/standard_types.hpp"
 
 namespace drivegate::config {
 
 namespace {
 
-std::string hex16(std::uint16_t v) {
-  char buf[8];
-  std::snprintf(buf, sizeof buf, "0x%04X", v);
-  return buf;
-}
+std::string hex16(std::uint16_t v) { return object_hex({v, 0}); }
 
 bool is_mode_object(cia402::ObjectId id) {
   return id == cia402::obj::kModesOfOperation.id || id == cia402::obj::kModesOfOperationDisplay.id;
@@ -32,12 +27,8 @@ void check_entry_type(const YAML::Node& n, const std::string& path, const Source
                                     std::string{to_string(e.type)});
     return;
   }
-  const auto known = cia402::profile_object_type(e.object);
-  if (known && size_of(*known) != size_of(e.type))
-    src.error(n.Mark(), path,
-              object_hex(e.object) + " is " + std::string{to_string(*known)} + " in CiA 402, got " +
-                  std::string{to_string(e.type)} +
-                  (is_mode_object(e.object) ? " (a device with 16-bit mode objects needs quirk mode_objects_16bit)" : ""));
+  check_known_type(n, path, src, e.object, e.type,
+                   is_mode_object(e.object) ? " (a device with 16-bit mode objects needs quirk mode_objects_16bit)" : "");
 }
 
 std::vector<std::uint16_t> read_indexes(const MapReader& m, const std::string& key, std::uint16_t lo, std::uint16_t hi) {
@@ -93,14 +84,9 @@ void read_identities(const MapReader& e, EthercatDeviceSpec& spec) {
   }
 }
 
-struct Mapped {
-  cia402::ObjectId id;
-  std::string path;
-};
-
 // rxpdos / txpdos: [{ index: 0x1600, map: ["0x6040 u16", ...] }]
 void read_pdos(const MapReader& e, bool receive, const DeviceProfile& p, EthercatDeviceSpec& spec,
-               std::vector<Mapped>& mapped) {
+               std::vector<MappedEntry>& mapped) {
   const std::string key = receive ? "rxpdos" : "txpdos";
   const auto list = e.list(key, Need::Optional);
   if (!list) return;
@@ -142,23 +128,11 @@ void read_pdos(const MapReader& e, bool receive, const DeviceProfile& p, Etherca
                         " of this device (its " + (receive ? "rx_mappable" : "tx_mappable") + " list)");
           continue;
         }
-        const auto dup = std::find_if(mapped.begin(), mapped.end(), [&](const Mapped& x) { return x.id == entry->object; });
-        if (dup != mapped.end()) {
-          src.error((*entries)[k].Mark(), path, object_hex(entry->object) + " is already mapped in " + dup->path);
-          continue;
-        }
-        mapped.push_back({entry->object, path});
-        pdo.entries.push_back(*entry);
+        if (record_mapping((*entries)[k], path, src, entry->object, mapped)) pdo.entries.push_back(*entry);
       }
     }
     out.push_back(std::move(pdo));
   }
-}
-
-bool maps(const std::vector<EthercatPdoSpec>& pdos, cia402::ObjectId id) {
-  return std::any_of(pdos.begin(), pdos.end(), [id](const EthercatPdoSpec& p) {
-    return std::any_of(p.entries.begin(), p.entries.end(), [id](const PdoEntrySpec& e) { return e.object == id; });
-  });
 }
 
 // PDO objects belong to the gateway: a start-up write may not touch them.
@@ -171,28 +145,9 @@ void check_startup_writes(const MapReader& e, const EthercatDeviceSpec& spec) {
   }
 }
 
-void reconcile_cyclic_objects(const MapReader& root, DeviceProfile& p, bool cyclic_given) {
-  const auto& spec = p.section<EthercatDeviceSpec>();
-  std::vector<cia402::ObjectId> mapped;
-  for (const auto* pdos : {&spec.rxpdos, &spec.txpdos})
-    for (const auto& pdo : *pdos)
-      for (const auto& e : pdo.entries) mapped.push_back(e.object);
-  if (mapped.empty()) return;
-  if (!cyclic_given) {
-    // A profile with a canopen section too derived its image from the canopen maps already: both
-    // buses must then carry the same objects.
-    if (p.cyclic_objects.empty()) {
-      p.cyclic_objects = mapped;
-      return;
-    }
-  }
-  if (const auto d = cyclic_image_difference(mapped, p.cyclic_objects, "cyclic"); !d.empty())
-    root.error("ethercat", "the ethercat PDOs must carry exactly the cyclic objects:" + d);
-}
-
 }  // namespace
 
-void read_ethercat_device(const MapReader& root, DeviceProfile& p, bool cyclic_given) {
+void read_ethercat_device(const MapReader& root, DeviceProfile& p) {
   const MapReader e = root.map("ethercat", Need::Optional);
   if (!e.present()) return;
   auto& spec = p.sections.edit<EthercatDeviceSpec>();
@@ -214,23 +169,24 @@ void read_ethercat_device(const MapReader& root, DeviceProfile& p, bool cyclic_g
   mappable.check_keys({"rx", "tx"});
   spec.rx_mappable = read_objects(mappable, "rx");
   spec.tx_mappable = read_objects(mappable, "tx");
-  std::vector<Mapped> rx;
-  std::vector<Mapped> tx;
+  std::vector<MappedEntry> rx;
+  std::vector<MappedEntry> tx;
   read_pdos(e, true, p, spec, rx);
   read_pdos(e, false, p, spec, tx);
-  for (const auto& t : tx)
-    if (const auto r = std::find_if(rx.begin(), rx.end(), [&](const Mapped& x) { return x.id == t.id; }); r != rx.end())
-      e.error("txpdos", object_hex(t.id) + " is also mapped in " + r->path + "; an object is either sent or received");
-  if (!spec.rxpdos.empty() || !spec.txpdos.empty()) {
-    if (!maps(spec.rxpdos, cia402::obj::kControlword.id))
-      e.error("rxpdos", "must map 0x6040 (controlword): the gateway drives every axis through it");
-    if (!maps(spec.txpdos, cia402::obj::kStatusword.id))
-      e.error("txpdos", "must map 0x6041 (statusword): the gateway follows every axis through it");
-  }
+  check_one_way(e.source(), rx, tx);
+  check_control_and_status(e, rx, "rxpdos", tx, "txpdos");
   read_startup_writes(e, "startup_writes", std::nullopt, spec.startup_writes);
   check_startup_writes(e, spec);
   spec.ignored_writes = read_objects(e, "ignored_writes");
-  reconcile_cyclic_objects(root, p, cyclic_given);
+}
+
+std::vector<cia402::ObjectId> ethercat_mapped_objects(const DeviceProfile& p) {
+  std::vector<cia402::ObjectId> mapped;
+  const auto& spec = p.section<EthercatDeviceSpec>();
+  for (const auto* pdos : {&spec.rxpdos, &spec.txpdos})
+    for (const auto& pdo : *pdos)
+      for (const auto& e : pdo.entries) mapped.push_back(e.object);
+  return mapped;
 }
 
 }  // namespace drivegate::config

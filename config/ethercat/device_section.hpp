@@ -7,8 +7,9 @@
 namespace drivegate::config {
 
 // Reads the `ethercat:` map of the profile `root` into p.sections (EthercatDeviceSpec). Needs
-// p.quirks already read. When the profile does not list cyclic_objects they are derived from the
-// PDOs; when it does, the PDOs must carry exactly them.
-void read_ethercat_device(const MapReader& root, DeviceProfile& p, bool cyclic_given);
+// p.quirks already read.
+void read_ethercat_device(const MapReader& root, DeviceProfile& p);
+// The objects of its PDOs, RxPDOs first (BusTypeInfo::mapped_objects).
+std::vector<cia402::ObjectId> ethercat_mapped_objects(const DeviceProfile& p);
 
 }  // namespace drivegate::config

@@ -42,7 +42,7 @@ BusTypeInfo ring_bus_type(int& buses_made) {
     if (device && device->section<ModuleSection>().module.empty())
       axis.error("device", "device \"" + device->name + "\" has no ringbus section");
   };
-  t.read_device = [](const MapReader& root, DeviceProfile& p, bool) {
+  t.read_device = [](const MapReader& root, DeviceProfile& p) {
     const MapReader m = root.map("ringbus", Need::Optional);
     m.check_keys({"module"});
     p.sections.edit<ModuleSection>().module = m.string("module", Need::Required).value_or("");

@@ -130,13 +130,36 @@ ethercat:
     - { object: "0x1C12:1", type: u16, value: 0x1601, why: "another PDO" }
     - { object: "0x6040", type: u16, value: 15, why: "enable at once" }
 )");
-  EXPECT_REPORTED(e, "ethercat.txpdos: 0x607A is also mapped in ethercat.rxpdos[0].map[0]; an object is either sent or received");
+  EXPECT_REPORTED(e, "ethercat.txpdos[0].map[1]: 0x607A is also mapped in ethercat.rxpdos[0].map[0]; an object is either "
+                     "sent or received");
   EXPECT_REPORTED(e, "ethercat.rxpdos: must map 0x6040 (controlword)");
   EXPECT_REPORTED(e, "ethercat.txpdos: must map 0x6041 (statusword)");
   EXPECT_REPORTED(e, "ethercat.startup_writes: 0x1C12:1 is a PDO mapping or assignment object");
   EXPECT_REPORTED(e, "ethercat.startup_writes[1].object: 0x6040 is the controlword");
-  EXPECT_REPORTED(e, "ethercat: the ethercat PDOs must carry exactly the cyclic objects: not mapped: 0x6040 0x6041; "
-                     "mapped but not cyclic: 0x6064");
+  EXPECT_REPORTED(e, "cyclic_objects: must list exactly the objects of the ethercat PDO maps (or be left out to derive "
+                     "them): not mapped: 0x6040 0x6041; mapped but not listed: 0x6064");
+}
+
+// Without cyclic_objects the first bus section that maps objects gives the cyclic image (canopen,
+// registered first); every other one must map the same objects, whatever the registration order.
+TEST_F(EthercatProfileErrors, EveryBusSectionMapsTheSameCyclicImage) {
+  const std::string e = errors_of_profile(R"(canopen:
+  rpdos: [{ number: 1, map: ["0x6040 u16", "0x607A i32"] }]
+  tpdos: [{ number: 1, map: ["0x6041 u16"] }]
+ethercat:
+  rxpdos: [{ index: 0x1600, map: ["0x6040 u16", "0x607A i32"] }]
+  txpdos: [{ index: 0x1A00, map: ["0x6041 u16", "0x6064 i32"] }]
+)");
+  EXPECT_REPORTED(e, "ethercat: the ethercat PDO maps must carry the same objects as the canopen PDO maps (the cyclic "
+                     "image): mapped but not cyclic: 0x6064");
+  const std::string same = errors_of_profile(R"(canopen:
+  rpdos: [{ number: 1, map: ["0x6040 u16", "0x607A i32"] }]
+  tpdos: [{ number: 1, map: ["0x6041 u16"] }]
+ethercat:
+  rxpdos: [{ index: 0x1600, map: ["0x6040 u16", "0x607A i32"] }]
+  txpdos: [{ index: 0x1A00, map: ["0x6041 u16"] }]
+)");
+  EXPECT_EQ(same, "(parsed)");
 }
 
 }  // namespace
