@@ -124,6 +124,11 @@ struct DeviceProfile {
   [[nodiscard]] const T& section() const {
     return sections.get<T>();
   }
+  // The profile has the bus type's section (`canopen:`) whose part is T.
+  template <typename T>
+  [[nodiscard]] bool has_section() const noexcept {
+    return sections.find<T>() != nullptr;
+  }
   [[nodiscard]] bool quirk(const std::string& flag) const {
     const auto it = quirks.find(flag);
     return it != quirks.end() && it->second;

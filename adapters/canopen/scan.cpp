@@ -496,7 +496,7 @@ std::vector<config::DeviceProfile> scan_profiles(const std::vector<std::filesyst
   std::vector<config::DeviceProfile> out;
   config::Problems problems;
   for (const auto& name : catalog.available())
-    if (const auto* p = catalog.get(name, problems); p != nullptr && p->section<config::CanopenDeviceSpec>().present) out.push_back(*p);
+    if (const auto* p = catalog.get(name, problems); p != nullptr && p->has_section<config::CanopenDeviceSpec>()) out.push_back(*p);
   for (const auto& e : problems.errors()) notes.push_back("device profile not used: " + e.to_string());
   return out;
 }

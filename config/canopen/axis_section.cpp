@@ -137,7 +137,7 @@ void check_sync(const MapReader& axis, const BusPlan& bus, const DeviceProfile& 
 
 void read_canopen_axis(const MapReader& axis, const BusPlan& bus, const DeviceProfile* device,
                        const fs::path& base_dir, AxisPlan& a) {
-  if (device && !device->section<CanopenDeviceSpec>().present) {
+  if (device && !device->has_section<CanopenDeviceSpec>()) {
     axis.error("device", "device profile \"" + device->name + "\" has no canopen section, which an axis on a "
                          "canopen bus needs (profiles/devices/README.md)");
     device = nullptr;

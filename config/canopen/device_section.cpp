@@ -277,7 +277,6 @@ void read_canopen_device(const MapReader& root, DeviceProfile& p) {
   const MapReader c = root.map("canopen", Need::Optional);
   if (!c.present()) return;
   auto& co = p.sections.edit<CanopenDeviceSpec>();
-  co.present = true;
   c.check_keys({"device_type", "device_type_mask", "persona", "sdo_channels", "error_control", "consumer_heartbeat",
                 "gateway_watch",
                 "pdo_policy", "disable_unused_pdos", "fixed_mapping_count", "sync_periods", "rpdos", "tpdos",

@@ -84,7 +84,6 @@ struct ParameterNaming {
 };
 
 struct CanopenDeviceSpec {
-  bool present = false;                 // the profile has a canopen section
   std::optional<std::uint32_t> device_type;  // 1000h expected value, compared under the mask
   std::uint32_t device_type_mask = 0x00FFFFFF;  // AKD: upper "mode bits" may change (quirk 13)
   std::vector<PdoSpec> rpdos;

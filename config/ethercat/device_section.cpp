@@ -151,7 +151,6 @@ void read_ethercat_device(const MapReader& root, DeviceProfile& p) {
   const MapReader e = root.map("ethercat", Need::Optional);
   if (!e.present()) return;
   auto& spec = p.sections.edit<EthercatDeviceSpec>();
-  spec.present = true;
   e.check_keys({"identities", "persona", "distributed_clocks", "coe_store", "axes", "axis_offset", "pdo_indexes",
                 "max_entries", "mappable", "rxpdos", "txpdos", "startup_writes", "ignored_writes"});
   read_identities(e, spec);

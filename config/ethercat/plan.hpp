@@ -34,7 +34,6 @@ struct EthercatPdoSpec {
 };
 
 struct EthercatDeviceSpec {
-  bool present = false;
   // The identities it may show; empty: any slave whose 1000h names CiA 402 (generic profiles).
   std::vector<EthercatIdentity> identities;
   std::vector<EthercatPdoSpec> rxpdos;       // master -> slave, in 1C12h order

@@ -142,7 +142,7 @@ TEST(CanopenPlans, AxesCarryTheirCanopenSection) {
   const AxisPlan& x = axis(plan, "x");
   EXPECT_EQ(x.address, 5);
   EXPECT_EQ(x.spec.default_mode, core::Mode::CyclicPosition);
-  EXPECT_TRUE(x.device.section<CanopenDeviceSpec>().present);
+  EXPECT_TRUE(x.device.has_section<CanopenDeviceSpec>());
   EXPECT_EQ(x.device.section<CanopenDeviceSpec>().rpdos.size(), 3U);
   // 2^20 units per motor rev over a 5 mm feed.
   EXPECT_DOUBLE_EQ(x.spec.units.position_factor(), 1048576.0 / 5.0);

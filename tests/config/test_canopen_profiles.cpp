@@ -46,8 +46,8 @@ const StartupWrite& write_of(const DeviceProfile& p, ObjectId id) {
 
 TEST(CanopenProfiles, KollmorgenAkd) {
   const DeviceProfile p = load("kollmorgen-akd");
+  ASSERT_TRUE(p.has_section<CanopenDeviceSpec>());
   const auto& co = p.section<CanopenDeviceSpec>();
-  ASSERT_TRUE(co.present);
   EXPECT_EQ(p.identity.vendor_id, 0x6AU);
   EXPECT_EQ(co.device_type, 0x00020192U);
   EXPECT_EQ(co.device_type_mask, 0x00FFFFFFU);
@@ -165,7 +165,7 @@ TEST(CanopenProfiles, StoeberSd6) {
 
 TEST(CanopenProfiles, GenericMapsEqualItsCyclicObjects) {
   const DeviceProfile p = load("generic-cia402");
-  ASSERT_TRUE(p.section<CanopenDeviceSpec>().present);
+  ASSERT_TRUE(p.has_section<CanopenDeviceSpec>());
   EXPECT_EQ(p.section<CanopenDeviceSpec>().persona, "generic");
   EXPECT_EQ(p.section<CanopenDeviceSpec>().device_type_mask, 0x0000FFFFU);
   std::size_t mapped = 0;
@@ -196,7 +196,7 @@ TEST(CanopenProfiles, TypeLimits) {
   EXPECT_EQ(data_type_names(), (Strings{"i8", "u8", "i16", "u16", "i32", "u32"}));
 }
 
-TEST(CanopenProfiles, SimServoHasNoCanopenSection) { EXPECT_FALSE(load("sim-servo").section<CanopenDeviceSpec>().present); }
+TEST(CanopenProfiles, SimServoHasNoCanopenSection) { EXPECT_FALSE(load("sim-servo").has_section<CanopenDeviceSpec>()); }
 
 class CanopenProfileErrors : public test::TempDir {
  protected:

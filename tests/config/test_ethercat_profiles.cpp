@@ -15,8 +15,8 @@ namespace fs = std::filesystem;
 
 TEST(EthercatProfiles, EsrTriodriveIsTheDigestsDrive) {
   const DeviceProfile p = load_device_profile(fs::path{DRIVEGATE_DEVICE_DIR_SOURCE} / "esr-triodrive.yaml");
+  ASSERT_TRUE(p.has_section<EthercatDeviceSpec>());
   const auto& e = p.section<EthercatDeviceSpec>();
-  ASSERT_TRUE(e.present);
   // Vendor 15, product 6755/6745 read both as hex-coded and as decimal (dunker-ethercat-coe.md §10).
   ASSERT_EQ(e.identities.size(), 4U);
   for (const auto& id : e.identities) EXPECT_EQ(id.vendor_id, 0x0FU);
@@ -49,8 +49,8 @@ TEST(EthercatProfiles, EsrTriodriveIsTheDigestsDrive) {
 
 TEST(EthercatProfiles, GenericDriveRunsOnDistributedClocksWithItsCyclicObjects) {
   const DeviceProfile p = load_device_profile(fs::path{DRIVEGATE_DEVICE_DIR_SOURCE} / "generic-cia402.yaml");
+  ASSERT_TRUE(p.has_section<EthercatDeviceSpec>());
   const auto& e = p.section<EthercatDeviceSpec>();
-  ASSERT_TRUE(e.present);
   EXPECT_TRUE(e.identities.empty());  // any CiA 402 slave
   EXPECT_TRUE(e.distributed_clocks);
   EXPECT_EQ(e.max_entries, 254);
