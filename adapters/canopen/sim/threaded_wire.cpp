@@ -64,6 +64,13 @@ class GatewayEnd final : public Transport {
     if (r == SendResult::Sent) signal(shared_->wire_changed.get());
     return r;
   }
+  // One lock and one wake-up of the drive thread per batch, as a real transport's one sendmmsg.
+  SendBatchResult send_batch(std::span<const CanFrame> frames, core::TimePoint now) noexcept override {
+    const std::lock_guard lock(shared_->mutex);
+    const SendBatchResult r = shared_->gateway_end->send_batch(frames, now);
+    if (r.sent > 0) signal(shared_->wire_changed.get());
+    return r;
+  }
   [[nodiscard]] ControllerState controller_state() const noexcept override {
     const std::lock_guard lock(shared_->mutex);
     return shared_->gateway_end->controller_state();
