@@ -147,7 +147,6 @@ void CanopenScan::on_frame(const CanFrame& frame, core::TimePoint now) noexcept 
     case Function::ErrorControl:
       if (node == nullptr) break;
       if (frame.remote) {  // a node guarding request: someone guards this node
-        ++counters_.foreign_master;
         ++foreign_.guarding;
         break;
       }
@@ -164,19 +163,15 @@ void CanopenScan::on_frame(const CanFrame& frame, core::TimePoint now) noexcept 
       if (node != nullptr) node->seen.heard = true;
       break;
     case Function::Nmt:
-      ++counters_.foreign_master;
       ++foreign_.nmt;
       break;
     case Function::Sync:
-      ++counters_.foreign_master;
       ++foreign_.sync;
       break;
     case Function::Rpdo:
-      ++counters_.foreign_master;
       ++foreign_.rpdo;
       break;
     case Function::SdoRx:
-      ++counters_.foreign_master;
       ++foreign_.sdo_requests;
       if (node != nullptr) foreign_.sdo_request_on[s.node] = true;
       break;
@@ -281,7 +276,7 @@ void CanopenScan::collect(Node& n, core::TimePoint now) {
 }
 
 void CanopenScan::poll(core::TimePoint now, TxQueue& tx) {
-  if (phase_ == Phase::Listen && now >= listen_end_ && counters_.foreign_master > 0) {
+  if (phase_ == Phase::Listen && now >= listen_end_ && foreign_.total() > 0) {
     refusal_ = refusal_words(foreign_);
     phase_ = Phase::Done;
     return;
@@ -361,6 +356,7 @@ std::vector<ScannedNode> CanopenScan::nodes() const {
 
 CanopenScanCounters CanopenScan::counters() const noexcept {
   CanopenScanCounters c = counters_;
+  c.foreign_master = foreign_.total();
   c.sdo_unexpected = sdo_.counters().unexpected;
   c.sdo_malformed = sdo_.counters().malformed;
   return c;

@@ -62,6 +62,7 @@ struct ForeignMasterFrames {
   std::uint64_t sdo_requests = 0;
   std::uint64_t guarding = 0;                        // node guarding RTRs on 700h + N
   std::array<bool, kMaxNodeId + 1> sdo_request_on{};  // [N]: an SDO request on 600h + N
+  [[nodiscard]] std::uint64_t total() const noexcept { return sync + nmt + rpdo + sdo_requests + guarding; }
 };
 
 struct CanopenScanCounters {
