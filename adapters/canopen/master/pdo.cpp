@@ -128,7 +128,6 @@ void NodePdos::restart() noexcept {
   // Event-driven RPDOs go out at the first poll, and inputs are stale until the drive has sent
   // them again.
   for (std::size_t i = 0; i < rpdo_count_; ++i) rpdos_[i].ever_sent = false;
-  heard_ = false;
   for (std::size_t i = 0; i < tpdo_count_; ++i) {
     auto& t = tpdos_[i];
     t.seen = t.due = t.stale = false;
@@ -166,12 +165,15 @@ void NodePdos::send_event_driven(core::TimePoint now, TxQueue& tx) noexcept {
 
 void NodePdos::after_sync(core::TimePoint now, TxQueue& tx) noexcept {
   if (!enabled_) return;
+  // A TPDO since enable() shows the drive operational: from then on RPDOs with a refresh wait for a change.
+  const bool heard = std::any_of(tpdos_.begin(), tpdos_.begin() + static_cast<std::ptrdiff_t>(tpdo_count_),
+                                 [](const TpdoState& t) { return t.seen; });
   for (std::size_t i = 0; i < rpdo_count_; ++i) {
     auto& r = rpdos_[i];
     if (!synchronous(r.config.transmission_type)) continue;
     std::array<std::uint8_t, 8> bytes{};
     image_.pack(r.config.layout, bytes);
-    const bool every_sync = r.config.refresh <= core::Duration::zero() || !heard_ || !r.ever_sent;
+    const bool every_sync = r.config.refresh <= core::Duration::zero() || !heard || !r.ever_sent;
     if (every_sync || bytes != r.sent || now - r.sent_at >= r.config.refresh) send(r, bytes, now, tx);
   }
   send_event_driven(now, tx);
@@ -226,7 +228,6 @@ bool NodePdos::on_frame(const CanFrame& frame, core::TimePoint now) noexcept {
     ++counters_.tpdos_received;
     t.received_at = now;
     last_rx_ = now;
-    heard_ = true;
     t.seen = true;
     t.due = t.stale = false;
     // The drive's SYNC phase is the one its frames show (it counts SYNCs from its own start).

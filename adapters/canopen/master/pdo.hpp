@@ -164,7 +164,6 @@ class NodePdos {
 
   ProcessImage image_;
   bool enabled_ = false;
-  bool heard_ = false;  // a TPDO arrived since enable()
   core::TimePoint last_rx_{};
   PdoCounters counters_;
   std::array<RpdoState, kPdosPerDirection> rpdos_{};
