@@ -19,6 +19,7 @@
 
 #include "adapters/canopen/transport/udp_multicast_transport.hpp"
 #include "tests/canopen_sim/sim_test_support.hpp"
+#include "tests/support/pipe_lines.hpp"
 
 extern char** environ;
 
@@ -97,11 +98,11 @@ class SimProcess {
 
   // The next stdout line, waiting at most `timeout`.
   std::optional<std::string> line(std::chrono::milliseconds timeout = std::chrono::seconds(10)) {
-    return next_line(stdout_, out_buffer_, timeout);
+    return out_lines_.next(stdout_, timeout);
   }
   std::string error_text() {
     std::string all;
-    while (const auto l = next_line(stderr_, err_buffer_, std::chrono::milliseconds(2000))) all += *l + "\n";
+    while (const auto l = err_lines_.next(stderr_, std::chrono::milliseconds(2000))) all += *l + "\n";
     return all;
   }
   std::optional<std::string> command(const std::string& c) {
@@ -124,31 +125,12 @@ class SimProcess {
   }
 
  private:
-  static std::optional<std::string> next_line(int fd, std::string& buffer, std::chrono::milliseconds timeout) {
-    const auto end = Clock::now() + timeout;
-    for (;;) {
-      if (const auto nl = buffer.find('\n'); nl != std::string::npos) {
-        std::string l = buffer.substr(0, nl);
-        buffer.erase(0, nl + 1);
-        return l;
-      }
-      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(end - Clock::now()).count();
-      if (left <= 0) return std::nullopt;
-      pollfd p{fd, POLLIN, 0};
-      if (::poll(&p, 1, static_cast<int>(left)) <= 0) continue;
-      char chunk[256];
-      const ssize_t n = ::read(fd, chunk, sizeof chunk);
-      if (n <= 0) return std::nullopt;
-      buffer.append(chunk, static_cast<std::size_t>(n));
-    }
-  }
-
   pid_t pid_ = -1;
   int stdin_ = -1;
   int stdout_ = -1;
   int stderr_ = -1;
-  std::string out_buffer_;
-  std::string err_buffer_;
+  drivegate::test::PipeLines out_lines_;
+  drivegate::test::PipeLines err_lines_;
 };
 
 core::TimePoint now() { return core::SteadyClock{}.now(); }
