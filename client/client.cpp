@@ -20,6 +20,7 @@
 #include <fastdds/dds/subscriber/DataReaderListener.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 
+#include "client/settled.hpp"
 #include "drivegate.h"
 #include "idl/dds_node.hpp"
 
@@ -442,16 +443,8 @@ class Client::Impl : public dds::DataReaderListener {
   std::vector<AxisEvent> events_since(std::uint64_t& cursor) {
     // The gateways' event history (transient local) reaches the reader after it matched their
     // writers: wait until it stopped growing (called under mutex_, once the reader matched).
-    std::uint64_t last = 0;
-    std::optional<SteadyClock::time_point> since;
-    subscribe(event_r_, msg::TopicId::AxisEvent, [&] {
-      const auto now = SteadyClock::now();
-      if (!since || events_end_ != last) {
-        since = now;
-        last = events_end_;
-      }
-      return now - *since >= kHistoryQuiet;
-    });
+    Settled settled(kHistoryQuiet);
+    subscribe(event_r_, msg::TopicId::AxisEvent, [&] { return settled(events_end_); });
     std::lock_guard lock(mutex_);
     std::vector<AxisEvent> v;
     const std::uint64_t first = events_end_ - events_.size();

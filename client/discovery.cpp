@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 
+#include "client/settled.hpp"
+
 namespace drivegate::client {
 
 bool discover_gateways(const Client& client, std::string_view gateway, Millis timeout) {
@@ -23,19 +25,8 @@ bool discover_gateways(const Client& client, std::string_view gateway, Millis ti
 }
 
 void wait_settled(const Client& client, const std::function<std::size_t()>& count, Millis quiet, Millis timeout) {
-  auto last = count();
-  auto changed = std::chrono::steady_clock::now();
-  client.wait_until(
-      [&] {
-        const auto now = std::chrono::steady_clock::now();
-        const auto n = count();
-        if (n != last) {
-          last = n;
-          changed = now;
-        }
-        return now - changed >= quiet;
-      },
-      timeout);
+  Settled settled(quiet);
+  client.wait_until([&] { return settled(count()); }, timeout);
 }
 
 }  // namespace drivegate::client

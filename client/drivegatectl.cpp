@@ -585,8 +585,8 @@ int cmd_param(Context& ctx) {
 
 int cmd_buses(Context& ctx) {
   expect_words(ctx, 0);
+  // The first read waits for every known gateway's bus statuses (client.hpp).
   ctx.client.wait_until([&] { return !ctx.client.buses().empty(); }, std::min(ctx.timeout, Millis(1500)));
-  wait_settled(ctx.client, [&] { return ctx.client.buses().size(); }, Millis(300), Millis(1000));
   for (const auto& b : ctx.client.buses()) {
     if (!ctx.gateway.empty() && b.gateway != ctx.gateway) continue;
     if (ctx.json) {
