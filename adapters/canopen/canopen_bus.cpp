@@ -6,6 +6,7 @@
 #include <thread>
 
 #include "adapters/canopen/boot_plan.hpp"
+#include "adapters/canopen/flush_queue.hpp"
 #include "adapters/canopen/wire/bit_timing.hpp"
 #include "profiles/cia402/master_settings.hpp"
 #include "profiles/cia402/op_modes.hpp"
@@ -692,17 +693,10 @@ void CanopenBus::take_between_cycles(core::TimePoint now) noexcept {
 }
 
 std::size_t CanopenBus::flush(core::TimePoint now) noexcept {
-  // One batch per contiguous run of the queue (two when it wraps around).
-  std::size_t sent = 0;
-  while (!tx_.empty()) {
-    const SendBatchResult r = transport_->send_batch(tx_.front_run(), now);
-    sent_.fetch_add(r.sent, std::memory_order_relaxed);
-    sent += r.sent;
-    tx_dropped_ += r.taken - r.sent;
-    tx_.pop(r.taken);
-    if (r.busy || r.taken == 0) break;  // the rest goes next cycle; timeouts cover what is late
-  }
-  return sent;
+  const FlushResult f = flush_queue(tx_, *transport_, now);
+  sent_.fetch_add(f.sent, std::memory_order_relaxed);
+  tx_dropped_ += f.refused;
+  return f.sent;
 }
 
 void CanopenBus::publish_counters() noexcept {

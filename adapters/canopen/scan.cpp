@@ -9,6 +9,7 @@
 #include <thread>
 
 #include "adapters/canopen/canopen_bus.hpp"
+#include "adapters/canopen/flush_queue.hpp"
 #include "adapters/canopen/wire/bit_timing.hpp"
 #include "adapters/canopen/wire/cob_id.hpp"
 #include "config/canopen/bus_options.hpp"
@@ -746,12 +747,7 @@ core::ScanResult run_scan(const config::BusPlan& plan, const core::ScanRequest& 
     for (std::size_t got; (got = transport->receive(rx, now)) > 0;)
       for (std::size_t i = 0; i < got; ++i) scan.on_frame(rx[i], now);
     scan.poll(now, out);
-    while (!out.empty()) {
-      const SendResult s = transport->send(out.front(), now);
-      if (s == SendResult::Busy) break;  // the interface queue is full: the rest go next round
-      if (s != SendResult::Sent) ++not_sent;
-      out.pop();
-    }
+    not_sent += flush_queue(out, *transport, now).refused;  // a full interface queue: the rest go next round
     // Sleep until the engine has something to do, a frame arrives, or (frames waiting to be sent) 1 ms.
     now = clock.now();
     auto until = scan.next_deadline();
