@@ -13,6 +13,7 @@
 #include <span>
 #include <vector>
 
+#include "adapters/ethercat/wire/al_status.hpp"
 #include "adapters/ethercat/wire/bytes.hpp"
 #include "adapters/ethercat/wire/frame.hpp"
 #include "adapters/ethercat/wire/registers.hpp"
@@ -135,7 +136,7 @@ struct FakeEsc {
       const std::uint16_t rx_size = get_u16(sii, 0x32);
       if (rx_size != 0 && (sm(0).physical_start != rx || sm(0).length != rx_size || !sm(0).enabled() ||
                            !sm(1).enabled())) {
-        code = 0x0016;
+        code = al_status_code::kInvalidMailboxConfigPreOp;
       }
     }
     if (code != 0) {
