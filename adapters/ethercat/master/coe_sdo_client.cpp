@@ -4,15 +4,10 @@
 
 #include "adapters/ethercat/wire/bytes.hpp"
 #include "adapters/ethercat/wire/registers.hpp"
+#include "profiles/cia402/sdo_abort.hpp"
 
 namespace drivegate::ethercat {
 namespace {
-
-// CiA 301 §7.2.4.3.17 abort codes the client raises itself (CoE reuses them, ETG.1000.6 §5.6.2.7.2).
-constexpr std::uint32_t kAbortToggle = 0x05030000;
-constexpr std::uint32_t kAbortTimeout = 0x05040000;
-constexpr std::uint32_t kAbortOutOfMemory = 0x05040005;
-constexpr std::uint32_t kAbortGeneral = 0x08000000;
 
 // Bytes in front of the data: mailbox header 6 + CoE header 2 + SDO command, index, subindex, size
 // (8) for a normal initiate; + command byte (1) for a segment [ETG.1000.6 §5.6.2.2-§5.6.2.5].
@@ -216,7 +211,7 @@ void CoeSdoClient::poll(core::TimePoint now, Transactions& tx) noexcept {
   if (waiting_) return;
   if (active_ != nullptr && now >= deadline_) {
     ++counters_.timeouts;
-    finish(*active_, SlotState::Failed, kAbortTimeout);
+    finish(*active_, SlotState::Failed, cia402::sdo_abort_code::kTimeout);
   }
   if (active_ == nullptr) start_next(now);
   switch (phase_) {
@@ -232,7 +227,7 @@ void CoeSdoClient::poll(core::TimePoint now, Transactions& tx) noexcept {
         (void)queue(tx, Command::FPWR, mailbox_.rx_offset, static_cast<std::uint16_t>(out_size_),
                     std::span<const std::uint8_t>(out_.data(), out_size_));
       } else if (out_size_ == 0 && active_ != nullptr) {
-        finish(*active_, SlotState::Failed, kAbortGeneral);  // could not encode (cannot happen when valid())
+        finish(*active_, SlotState::Failed, cia402::sdo_abort_code::kGeneral);  // could not encode (cannot happen when valid())
       }
       return;
     case Phase::Wait:
@@ -321,7 +316,7 @@ void CoeSdoClient::on_mailbox(std::span<const std::uint8_t> mb) noexcept {
     const MailboxErrorReply e = decode_mailbox_error(mb);
     if (active_ != nullptr) {
       active_->result.mailbox_error = e.detail;
-      finish(*active_, SlotState::Failed, kAbortGeneral);
+      finish(*active_, SlotState::Failed, cia402::sdo_abort_code::kGeneral);
     } else {
       ++counters_.unexpected;
     }
@@ -375,7 +370,7 @@ void CoeSdoClient::on_sdo(Slot& s, const CoeSdo& sdo) noexcept {
     return;
   }
   if (!initiate && sdo.toggle != toggle_) {  // CiA 301 §7.2.4.3: toggle alternates per segment
-    finish(s, SlotState::Failed, kAbortToggle);
+    finish(s, SlotState::Failed, cia402::sdo_abort_code::kToggle);
     return;
   }
   if (!s.upload) {
@@ -389,7 +384,7 @@ void CoeSdoClient::on_sdo(Slot& s, const CoeSdo& sdo) noexcept {
   }
   // Upload: copy what came.
   if (s.done + sdo.data.size() > s.capacity) {
-    finish(s, SlotState::Failed, kAbortOutOfMemory);
+    finish(s, SlotState::Failed, cia402::sdo_abort_code::kOutOfMemory);
     return;
   }
   std::copy(sdo.data.begin(), sdo.data.end(), s.into + s.done);
@@ -401,7 +396,7 @@ void CoeSdoClient::on_sdo(Slot& s, const CoeSdo& sdo) noexcept {
     }
     s.total = sdo.size;
     if (s.total > s.capacity) {
-      finish(s, SlotState::Failed, kAbortOutOfMemory);
+      finish(s, SlotState::Failed, cia402::sdo_abort_code::kOutOfMemory);
       return;
     }
     if (s.done >= s.total) {

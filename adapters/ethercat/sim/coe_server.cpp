@@ -112,18 +112,18 @@ void CoeServer::sdo(std::span<const std::uint8_t> mailbox, AlState state, Mailbo
   if (v.error != MailboxError::None) {
     // An undecodable command specifier aborts [CiA 301 §7.2.4.3.17 05040001h]; a cut-off SDO
     // cannot name its object.
-    abort(out, 0, 0, abort_code::kUnknownCommand);
+    abort(out, 0, 0, cia402::sdo_abort_code::kUnknownCommand);
     return;
   }
   const CoeSdo& s = v.sdo;
   if (s.complete_access) {
-    abort(out, s.index, s.subindex, abort_code::kUnsupportedAccess);
+    abort(out, s.index, s.subindex, cia402::sdo_abort_code::kUnsupportedAccess);
     return;
   }
   switch (s.command) {
     case SdoCommand::UploadInitiateRequest: {
       reset();
-      if (od_ == nullptr) return abort(out, s.index, s.subindex, abort_code::kObjectDoesNotExist);
+      if (od_ == nullptr) return abort(out, s.index, s.subindex, cia402::sdo_abort_code::kNoObject);
       const OdReadResult r = od_->read(s.index, s.subindex, buffer_, state);
       if (r.abort_code != 0) return abort(out, s.index, s.subindex, r.abort_code);
       const auto buf = out.reserve();
@@ -149,13 +149,13 @@ void CoeServer::sdo(std::span<const std::uint8_t> mailbox, AlState state, Mailbo
       return;
     }
     case SdoCommand::UploadSegmentRequest:
-      if (transfer_ != Transfer::Upload) return abort(out, 0, 0, abort_code::kUnknownCommand);
-      if (s.toggle != toggle_) return abort(out, index_, subindex_, abort_code::kToggleNotAlternated);
+      if (transfer_ != Transfer::Upload) return abort(out, 0, 0, cia402::sdo_abort_code::kUnknownCommand);
+      if (s.toggle != toggle_) return abort(out, index_, subindex_, cia402::sdo_abort_code::kToggle);
       upload_segment(s.toggle, out);
       return;
     case SdoCommand::DownloadInitiateRequest: {
       reset();
-      if (od_ == nullptr) return abort(out, s.index, s.subindex, abort_code::kObjectDoesNotExist);
+      if (od_ == nullptr) return abort(out, s.index, s.subindex, cia402::sdo_abort_code::kNoObject);
       if (s.expedited || s.data.size() >= s.size) {
         const std::span<const std::uint8_t> value =
             s.expedited ? s.data : s.data.first(std::min<std::size_t>(s.data.size(), s.size));
@@ -166,7 +166,7 @@ void CoeServer::sdo(std::span<const std::uint8_t> mailbox, AlState state, Mailbo
         return;
       }
       // Segmented download: collect the segments, write at the last one [ETG.1000.6 §5.6.2.3].
-      if (s.size > buffer_.size()) return abort(out, s.index, s.subindex, abort_code::kOutOfMemory);
+      if (s.size > buffer_.size()) return abort(out, s.index, s.subindex, cia402::sdo_abort_code::kOutOfMemory);
       std::memcpy(buffer_.data(), s.data.data(), s.data.size());
       transfer_ = Transfer::Download;
       index_ = s.index;
@@ -179,8 +179,8 @@ void CoeServer::sdo(std::span<const std::uint8_t> mailbox, AlState state, Mailbo
       return;
     }
     case SdoCommand::DownloadSegmentRequest: {
-      if (transfer_ != Transfer::Download) return abort(out, 0, 0, abort_code::kUnknownCommand);
-      if (s.toggle != toggle_) return abort(out, index_, subindex_, abort_code::kToggleNotAlternated);
+      if (transfer_ != Transfer::Download) return abort(out, 0, 0, cia402::sdo_abort_code::kUnknownCommand);
+      if (s.toggle != toggle_) return abort(out, index_, subindex_, cia402::sdo_abort_code::kToggle);
       const std::size_t n = std::min(s.data.size(), size_ - done_);
       // Bytes beyond the announced size are the segment padding (at least 7 bytes), not data.
       std::memcpy(buffer_.data() + done_, s.data.data(), n);
@@ -193,13 +193,13 @@ void CoeServer::sdo(std::span<const std::uint8_t> mailbox, AlState state, Mailbo
         const std::size_t done = done_;
         const std::size_t size = size_;
         reset();
-        if (done < size) return abort(out, index, subindex, abort_code::kLengthTooLow);
-        const std::uint32_t code = od_ == nullptr ? abort_code::kObjectDoesNotExist
+        if (done < size) return abort(out, index, subindex, cia402::sdo_abort_code::kTooShort);
+        const std::uint32_t code = od_ == nullptr ? cia402::sdo_abort_code::kNoObject
                                                   : od_->write(index, subindex,
                                                                std::span<const std::uint8_t>(buffer_.data(), size), state);
         if (code != 0) return abort(out, index, subindex, code);
       } else if (done_ >= size_ && s.data.size() > n) {
-        return abort(out, index_, subindex_, abort_code::kLengthTooHigh);
+        return abort(out, index_, subindex_, cia402::sdo_abort_code::kTooLong);
       }
       const auto buf = out.reserve();
       if (!buf.empty()) out.commit(encode_sdo_download_segment_response(buf, 0, toggle));
@@ -209,7 +209,7 @@ void CoeServer::sdo(std::span<const std::uint8_t> mailbox, AlState state, Mailbo
       reset();  // a client abort ends the transfer; no answer [ETG.1000.6 §5.6.2.7]
       return;
     default:
-      return abort(out, s.index, s.subindex, abort_code::kUnknownCommand);
+      return abort(out, s.index, s.subindex, cia402::sdo_abort_code::kUnknownCommand);
   }
 }
 
@@ -219,11 +219,11 @@ void CoeServer::info(std::span<const std::uint8_t> mailbox, MailboxOutbox& out) 
     const auto buf = out.reserve();
     if (!buf.empty()) out.commit(encode_sdo_info_error(buf, 0, code));
   };
-  if (v.error != MailboxError::None || od_ == nullptr) return error(abort_code::kUnknownCommand);
+  if (v.error != MailboxError::None || od_ == nullptr) return error(cia402::sdo_abort_code::kUnknownCommand);
   switch (v.opcode) {
     case SdoInfoOpcode::GetOdListRequest: {
       const auto type = static_cast<OdListType>(v.list_type);
-      if (v.list_type > static_cast<std::uint16_t>(OdListType::Startup)) return error(abort_code::kUnsupportedAccess);
+      if (v.list_type > static_cast<std::uint16_t>(OdListType::Startup)) return error(cia402::sdo_abort_code::kUnsupportedAccess);
       std::size_t total = 0;
       if (type == OdListType::Lengths) {
         // List type 0: the five list lengths [ETG.1000.6 §5.6.3.3].
@@ -257,7 +257,7 @@ void CoeServer::info(std::span<const std::uint8_t> mailbox, MailboxOutbox& out) 
     }
     case SdoInfoOpcode::GetObjectDescriptionRequest: {
       SdoInfoObjectDescription d;
-      if (!od_->describe_object(v.object.index, d)) return error(abort_code::kObjectDoesNotExist);
+      if (!od_->describe_object(v.object.index, d)) return error(cia402::sdo_abort_code::kNoObject);
       const auto buf = out.reserve();
       if (!buf.empty()) out.commit(encode_get_object_description_response(buf, 0, d));
       return;
@@ -266,8 +266,8 @@ void CoeServer::info(std::span<const std::uint8_t> mailbox, MailboxOutbox& out) 
       SdoInfoEntryDescription d;
       if (!od_->describe_entry(v.entry.index, v.entry.subindex, d)) {
         SdoInfoObjectDescription o;
-        return error(od_->describe_object(v.entry.index, o) ? abort_code::kSubindexDoesNotExist
-                                                             : abort_code::kObjectDoesNotExist);
+        return error(od_->describe_object(v.entry.index, o) ? cia402::sdo_abort_code::kNoSubIndex
+                                                             : cia402::sdo_abort_code::kNoObject);
       }
       d.value_info = 0;  // no unit/default/min/max offered
       const auto buf = out.reserve();
@@ -275,7 +275,7 @@ void CoeServer::info(std::span<const std::uint8_t> mailbox, MailboxOutbox& out) 
       return;
     }
     default:
-      return error(abort_code::kUnknownCommand);
+      return error(cia402::sdo_abort_code::kUnknownCommand);
   }
 }
 

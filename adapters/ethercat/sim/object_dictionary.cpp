@@ -84,26 +84,26 @@ SimpleObjectDictionary::Entry* SimpleObjectDictionary::find_entry(std::uint16_t 
 
 OdReadResult SimpleObjectDictionary::read(std::uint16_t index, std::uint8_t subindex, std::span<std::uint8_t> out,
                                           AlState state) noexcept {
-  if (find_object(index) == nullptr) return {abort_code::kObjectDoesNotExist, 0};
+  if (find_object(index) == nullptr) return {cia402::sdo_abort_code::kNoObject, 0};
   const Entry* e = find_entry(index, subindex);
-  if (e == nullptr) return {abort_code::kSubindexDoesNotExist, 0};
+  if (e == nullptr) return {cia402::sdo_abort_code::kNoSubIndex, 0};
   if (!readable(e->access, state)) {
-    return {writable_any(e->access) ? abort_code::kWriteOnly : abort_code::kStateForbids, 0};
+    return {writable_any(e->access) ? cia402::sdo_abort_code::kWriteOnly : cia402::sdo_abort_code::kDeviceState, 0};
   }
-  if (e->size > out.size()) return {abort_code::kOutOfMemory, 0};
+  if (e->size > out.size()) return {cia402::sdo_abort_code::kOutOfMemory, 0};
   if (e->size > 0) std::memcpy(out.data(), values_.data() + e->offset, e->size);
   return {0, e->size};
 }
 
 std::uint32_t SimpleObjectDictionary::write(std::uint16_t index, std::uint8_t subindex,
                                             std::span<const std::uint8_t> data, AlState state) noexcept {
-  if (find_object(index) == nullptr) return abort_code::kObjectDoesNotExist;
+  if (find_object(index) == nullptr) return cia402::sdo_abort_code::kNoObject;
   Entry* e = find_entry(index, subindex);
-  if (e == nullptr) return abort_code::kSubindexDoesNotExist;
-  if (!writable_any(e->access)) return abort_code::kReadOnly;
-  if (!writable(e->access, state)) return abort_code::kStateForbids;
-  if (data.size() > e->size) return abort_code::kLengthTooHigh;
-  if (data.size() < e->size) return abort_code::kLengthTooLow;
+  if (e == nullptr) return cia402::sdo_abort_code::kNoSubIndex;
+  if (!writable_any(e->access)) return cia402::sdo_abort_code::kReadOnly;
+  if (!writable(e->access, state)) return cia402::sdo_abort_code::kDeviceState;
+  if (data.size() > e->size) return cia402::sdo_abort_code::kTooLong;
+  if (data.size() < e->size) return cia402::sdo_abort_code::kTooShort;
   if (e->size > 0) std::memcpy(values_.data() + e->offset, data.data(), e->size);
   return 0;
 }
