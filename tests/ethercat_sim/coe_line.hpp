@@ -93,7 +93,7 @@ struct CoeLine {
   // Polls SM1 status for "mailbox full", then reads SM1. Empty optional reply when nothing came.
   Reply get(int polls = 4) {
     for (int i = 0; i < polls; ++i) {
-      const Reply s = bus.fprd(st, static_cast<std::uint16_t>(reg::sm(1) + 5U), 1);
+      const Reply s = bus.fprd(st, reg::sm_status(1), 1);
       if ((s.data[0] & sm_status::kMailboxFull) != 0) return bus.fprd(st, kMbxIn, kMbxSize);
     }
     return Reply{};

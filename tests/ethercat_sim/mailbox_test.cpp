@@ -247,24 +247,24 @@ TEST(EthercatSimMailbox, EmergencyRepeatAndCounter) {
   // Repeat request: toggle SM1 activate bit 1; the slave puts the same mailbox back and
   // acknowledges in PDI control bit 1 [ETG.1000.4 Table 59].
   const std::array<std::uint8_t, 1> act{static_cast<std::uint8_t>(sm_activate::kEnable | sm_activate::kRepeat)};
-  EXPECT_EQ(l.bus.fpwr(l.st, static_cast<std::uint16_t>(reg::sm(1) + 6U), act).wkc, 1);
+  EXPECT_EQ(l.bus.fpwr(l.st, reg::sm_activation(1), act).wkc, 1);
   r = l.get();
   ASSERT_TRUE(r.returned);
   EXPECT_EQ(decode_emergency(r.bytes()).mailbox.counter, emcy_counter);
-  EXPECT_EQ(l.bus.fprd(l.st, static_cast<std::uint16_t>(reg::sm(1) + 7U), 1).data[0] & 0x02, 0x02);
+  EXPECT_EQ(l.bus.fprd(l.st, reg::sm_pdi_control(1), 1).data[0] & sm_pdi_control::kRepeatAck, sm_pdi_control::kRepeatAck);
   EXPECT_EQ(l.esc.mailbox_repeats(), 1U);
   // Repeat while a newer mailbox already waits in SM1: the one read last comes first, the newer
   // one after it (counters 1 and 2).
   ASSERT_TRUE(l.esc.post_emergency(CoeEmergency{0x8200, 0x11, {}}));
   l.bus.brd(reg::kType, 1);  // a frame passes: the PDI loads the new emergency into SM1
   const std::array<std::uint8_t, 1> act2{sm_activate::kEnable};
-  EXPECT_EQ(l.bus.fpwr(l.st, static_cast<std::uint16_t>(reg::sm(1) + 6U), act2).wkc, 1);
+  EXPECT_EQ(l.bus.fpwr(l.st, reg::sm_activation(1), act2).wkc, 1);
   r = l.get();
   EXPECT_EQ(decode_emergency(r.bytes()).emergency.error_code, 0x8100);
   r = l.get();
   EXPECT_EQ(decode_emergency(r.bytes()).emergency.error_code, 0x8200);
   EXPECT_EQ(decode_emergency(r.bytes()).mailbox.counter, 2);
-  EXPECT_EQ(l.bus.fprd(l.st, static_cast<std::uint16_t>(reg::sm(1) + 7U), 1).data[0] & 0x02, 0x00);
+  EXPECT_EQ(l.bus.fprd(l.st, reg::sm_pdi_control(1), 1).data[0] & sm_pdi_control::kRepeatAck, 0x00);
 
   // The same request counter twice: the second is a repeat and gets no second answer.
   const std::size_t n = encode_sdo_upload_request(l.req, 3, 0x1000, 0);

@@ -14,10 +14,6 @@ namespace {
 constexpr std::size_t kInitiateOverhead = kMailboxHeaderSize + kCoeHeaderSize + kSdoHeaderSize;
 constexpr std::size_t kSegmentOverhead = kMailboxHeaderSize + kCoeHeaderSize + 1;
 
-constexpr std::uint16_t kSm1Status = reg::sm(1) + 5;     // 080Dh
-constexpr std::uint16_t kSm1Activate = reg::sm(1) + 6;   // 080Eh
-constexpr std::uint16_t kSm1PdiControl = reg::sm(1) + 7; // 080Fh
-
 }  // namespace
 
 std::string_view to_string(CoeSdoStatus s) noexcept {
@@ -218,7 +214,7 @@ void CoeSdoClient::poll(core::TimePoint now, Transactions& tx) noexcept {
     case Phase::Idle:
       // Nothing of ours in flight: still look for emergencies now and then.
       if (emergencies_ != nullptr && now >= next_status_poll_) {
-        if (queue(tx, Command::FPRD, kSm1Status, 1)) next_status_poll_ = now + timing_.poll_interval;
+        if (queue(tx, Command::FPRD, reg::sm_status(1), 1)) next_status_poll_ = now + timing_.poll_interval;
       }
       return;
     case Phase::Write:
@@ -231,7 +227,7 @@ void CoeSdoClient::poll(core::TimePoint now, Transactions& tx) noexcept {
       }
       return;
     case Phase::Wait:
-      if (now >= next_status_poll_ && queue(tx, Command::FPRD, kSm1Status, 1)) {
+      if (now >= next_status_poll_ && queue(tx, Command::FPRD, reg::sm_status(1), 1)) {
         next_status_poll_ = now + timing_.poll_interval;
       }
       return;
@@ -242,11 +238,11 @@ void CoeSdoClient::poll(core::TimePoint now, Transactions& tx) noexcept {
       // Toggle the repeat request in SM1's activate register [ETG.1000.4 §6 SyncManager: repeat].
       const std::array<std::uint8_t, 1> act{
           static_cast<std::uint8_t>(sm_activate::kEnable | (repeat_bit_ ? sm_activate::kRepeat : 0))};
-      (void)queue(tx, Command::FPWR, kSm1Activate, 1, act);
+      (void)queue(tx, Command::FPWR, reg::sm_activation(1), 1, act);
       return;
     }
     case Phase::RepeatWait:
-      if (now >= next_status_poll_ && queue(tx, Command::FPRD, kSm1PdiControl, 1)) {
+      if (now >= next_status_poll_ && queue(tx, Command::FPRD, reg::sm_pdi_control(1), 1)) {
         next_status_poll_ = now + timing_.poll_interval;
       }
       return;
@@ -294,7 +290,7 @@ void CoeSdoClient::on_result(std::uint32_t tag, const DatagramAnswer& a) noexcep
       }
       return;
     case Phase::RepeatWait:
-      if (!lost && a.wkc == 1 && !a.data.empty() && ((a.data[0] & 0x02) != 0) == repeat_bit_) phase_ = Phase::Read;
+      if (!lost && a.wkc == 1 && !a.data.empty() && ((a.data[0] & sm_pdi_control::kRepeatAck) != 0) == repeat_bit_) phase_ = Phase::Read;
       return;
   }
 }
