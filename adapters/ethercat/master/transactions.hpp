@@ -117,7 +117,6 @@ class Transactions {
     std::uint64_t order = 0;  // queue order of Building frames
     core::TimePoint deadline{};
     std::array<std::uint8_t, kMaxFrameSize> bytes{};
-    std::size_t size = 0;
     FrameBuilder builder{std::span<std::uint8_t>{}, kBroadcastMac, kBroadcastMac};
     std::array<Entry, kMaxDatagramsPerFrame> entries{};
     std::size_t count = 0;
