@@ -6,6 +6,7 @@
 
 #include <string>
 
+#include "adapters/ethercat/sim/coe_server.hpp"
 #include "adapters/ethercat/sim/object_dictionary.hpp"
 #include "tests/ethercat_sim/coe_line.hpp"
 
@@ -298,6 +299,30 @@ TEST(EthercatSimMailbox, FullMailboxRefusesWrite) {
   ASSERT_EQ(l.bus.link().receive(rx), 1U);
   EXPECT_EQ(get_u16(rx[0].view(), s1.slot.wkc_offset), 1);
   EXPECT_EQ(get_u16(rx[0].view(), s2.slot.wkc_offset), 0);
+}
+
+TEST(EthercatSimMailbox, OutboxCountsWhatItCannotQueue) {
+  // A full outbox, an encoding that fails and a message dropped from the front are each counted;
+  // a queued message takes the next mailbox counter [ETG.1000.6 mailbox header, Cnt].
+  MailboxOutbox out(1, kMbxSize);
+  const auto error_reply = [](std::span<std::uint8_t> buf) {
+    return encode_mailbox_error(buf, 0, mailbox_error_code::kUnsupportedProtocol);
+  };
+  EXPECT_TRUE(out.emit(error_reply));
+  EXPECT_EQ(out.dropped(), 0U);
+  ASSERT_FALSE(out.empty());
+  EXPECT_EQ(decode_mailbox(out.front()).header.counter, 1);
+  EXPECT_FALSE(out.emit(error_reply));  // full
+  EXPECT_EQ(out.dropped(), 1U);
+  out.pop();
+  EXPECT_FALSE(out.emit([](std::span<std::uint8_t>) { return std::size_t{0}; }));  // could not encode
+  EXPECT_EQ(out.dropped(), 2U);
+  EXPECT_TRUE(out.empty());
+  EXPECT_TRUE(out.emit(error_reply));
+  EXPECT_EQ(decode_mailbox(out.front()).header.counter, 2);
+  out.drop_front();
+  EXPECT_EQ(out.dropped(), 3U);
+  EXPECT_TRUE(out.empty());
 }
 
 }  // namespace

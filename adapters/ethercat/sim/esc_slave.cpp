@@ -593,8 +593,7 @@ void EscSlave::mailbox_received() noexcept {
   sms_[0].mailbox_full = false;
   mem_[reg::sm_status(0)] = static_cast<std::uint8_t>(mem_[reg::sm_status(0)] & ~(sm_status::kMailboxFull | sm_status::kInterruptWrite));
   if (v.error != MailboxError::None) {
-    const auto buf = outbox_.reserve();
-    if (!buf.empty()) outbox_.commit(encode_mailbox_error(buf, 0, mailbox_error_code::kInvalidSize));
+    outbox_.emit([](std::span<std::uint8_t> buf) { return encode_mailbox_error(buf, 0, mailbox_error_code::kInvalidSize); });
     return;
   }
   // A counter equal to the previous one is a repeated request (the master did not see the WKC)
@@ -609,8 +608,9 @@ void EscSlave::mailbox_received() noexcept {
     coe_.on_request(box, state_, outbox_);
     return;
   }
-  const auto buf = outbox_.reserve();
-  if (!buf.empty()) outbox_.commit(encode_mailbox_error(buf, 0, mailbox_error_code::kUnsupportedProtocol));
+  outbox_.emit([](std::span<std::uint8_t> buf) {
+    return encode_mailbox_error(buf, 0, mailbox_error_code::kUnsupportedProtocol);
+  });
 }
 
 void EscSlave::load_sm1() noexcept {
@@ -618,8 +618,7 @@ void EscSlave::load_sm1() noexcept {
   const std::span<std::uint8_t> buf = sm_buffer(1);
   const auto msg = outbox_.front();
   if (msg.size() > buf.size()) {  // SM1 shorter than the SII's (or outside memory): drop, never cut
-    outbox_.pop();
-    outbox_.count_drop();
+    outbox_.drop_front();
     return;
   }
   std::fill(buf.begin(), buf.end(), std::uint8_t{0});
@@ -654,15 +653,7 @@ void EscSlave::sm1_repeat() noexcept {
 
 bool EscSlave::post_emergency(const CoeEmergency& e) noexcept {
   if (!has_mailbox_) return false;
-  const auto buf = outbox_.reserve();
-  if (buf.empty()) {
-    outbox_.count_drop();
-    return false;
-  }
-  const std::size_t n = encode_emergency(buf, 0, e);
-  if (n == 0) return false;
-  outbox_.commit(n);
-  return true;
+  return outbox_.emit([&](std::span<std::uint8_t> buf) { return encode_emergency(buf, 0, e); });
 }
 
 // ---- PDI cycle --------------------------------------------------------------------------------
