@@ -134,51 +134,48 @@ void CoeSdoClient::finish(Slot& s, SlotState state, std::uint32_t abort_code) no
   write_due_ = false;
 }
 
-void CoeSdoClient::prepare_initiate(Slot& s) noexcept {
+template <class Encode>
+void CoeSdoClient::prepare(Expect expect, Encode&& encode) noexcept {
+  // The whole SM0 mailbox is written (its last byte hands it to the slave): zero what follows the
+  // request, stamp the next mailbox counter.
   counter_ = next_mailbox_counter(counter_);
-  std::fill(out_.begin(), out_.end(), std::uint8_t{0});
   const std::span<std::uint8_t> out(out_.data(), mailbox_.rx_size);
-  std::size_t n = 0;
-  if (s.upload) {
-    n = encode_sdo_upload_request(out, counter_, s.index, s.subindex);
-  } else if (s.capacity <= 4) {  // expedited [ETG.1000.6 §5.6.2.1]
-    n = encode_sdo_download_expedited(out, counter_, s.index, s.subindex, {s.from, s.capacity});
-    s.done = s.capacity;
-  } else {  // normal: as much as the mailbox carries, segments for the rest
-    const std::size_t first = std::min(s.capacity, static_cast<std::size_t>(mailbox_.rx_size) - kInitiateOverhead);
-    n = encode_sdo_download_normal(out, counter_, s.index, s.subindex, static_cast<std::uint32_t>(s.capacity),
-                                   {s.from, first});
-    s.done = first;
-  }
-  out_size_ = n == 0 ? 0 : mailbox_.rx_size;
-  expect_ = Expect::Initiate;
-  toggle_ = false;
+  std::fill(out.begin(), out.end(), std::uint8_t{0});
+  out_size_ = encode(out) == 0 ? 0 : out.size();
+  expect_ = expect;
   phase_ = Phase::Write;
   write_due_ = true;
+}
+
+void CoeSdoClient::prepare_initiate(Slot& s) noexcept {
+  toggle_ = false;
+  prepare(Expect::Initiate, [&](std::span<std::uint8_t> out) -> std::size_t {
+    if (s.upload) return encode_sdo_upload_request(out, counter_, s.index, s.subindex);
+    if (s.capacity <= 4) {  // expedited [ETG.1000.6 §5.6.2.1]
+      s.done = s.capacity;
+      return encode_sdo_download_expedited(out, counter_, s.index, s.subindex, {s.from, s.capacity});
+    }
+    // Normal: as much as the mailbox carries, segments for the rest.
+    const std::size_t first = std::min(s.capacity, out.size() - kInitiateOverhead);
+    s.done = first;
+    return encode_sdo_download_normal(out, counter_, s.index, s.subindex, static_cast<std::uint32_t>(s.capacity),
+                                      {s.from, first});
+  });
 }
 
 void CoeSdoClient::prepare_download_segment(Slot& s) noexcept {
-  counter_ = next_mailbox_counter(counter_);
-  std::fill(out_.begin(), out_.end(), std::uint8_t{0});
-  const std::size_t chunk = std::min(s.capacity - s.done, static_cast<std::size_t>(mailbox_.rx_size) - kSegmentOverhead);
-  const bool last = s.done + chunk >= s.capacity;
-  (void)encode_sdo_download_segment(std::span<std::uint8_t>(out_.data(), mailbox_.rx_size), counter_, toggle_, last,
-                                    {s.from + s.done, chunk});
-  s.done += chunk;
-  out_size_ = mailbox_.rx_size;
-  expect_ = Expect::Segment;
-  phase_ = Phase::Write;
-  write_due_ = true;
+  prepare(Expect::Segment, [&](std::span<std::uint8_t> out) {
+    const std::size_t chunk = std::min(s.capacity - s.done, out.size() - kSegmentOverhead);
+    const bool last = s.done + chunk >= s.capacity;
+    const std::size_t n = encode_sdo_download_segment(out, counter_, toggle_, last, {s.from + s.done, chunk});
+    s.done += chunk;
+    return n;
+  });
 }
 
 void CoeSdoClient::prepare_upload_segment() noexcept {
-  counter_ = next_mailbox_counter(counter_);
-  std::fill(out_.begin(), out_.end(), std::uint8_t{0});
-  (void)encode_sdo_upload_segment_request(std::span<std::uint8_t>(out_.data(), mailbox_.rx_size), counter_, toggle_);
-  out_size_ = mailbox_.rx_size;
-  expect_ = Expect::Segment;
-  phase_ = Phase::Write;
-  write_due_ = true;
+  prepare(Expect::Segment,
+          [&](std::span<std::uint8_t> out) { return encode_sdo_upload_segment_request(out, counter_, toggle_); });
 }
 
 void CoeSdoClient::start_next(core::TimePoint now) noexcept {
@@ -390,12 +387,12 @@ void CoeSdoClient::on_sdo(Slot& s, const CoeSdo& sdo) noexcept {
       finish(s, SlotState::Done, 0);
       return;
     }
-    s.total = sdo.size;
-    if (s.total > s.capacity) {
+    const std::size_t total = sdo.size;  // the size the server indicated
+    if (total > s.capacity) {
       finish(s, SlotState::Failed, cia402::sdo_abort_code::kOutOfMemory);
       return;
     }
-    if (s.done >= s.total) {
+    if (s.done >= total) {
       finish(s, SlotState::Done, 0);
     } else {
       prepare_upload_segment();
