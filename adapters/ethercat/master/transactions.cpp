@@ -190,12 +190,4 @@ std::size_t Transactions::frames_in_flight() const noexcept {
       std::count_if(slots_.begin(), slots_.end(), [](const FrameSlot& s) { return s.state == SlotState::InFlight; }));
 }
 
-std::size_t Transactions::datagrams_pending() const noexcept {
-  std::size_t n = 0;
-  for (const auto& s : slots_) {
-    if (s.state != SlotState::Free) n += s.count;
-  }
-  return n;
-}
-
 }  // namespace drivegate::ethercat

@@ -98,7 +98,6 @@ class Transactions {
   void forget(const DatagramOwner* owner) noexcept;
 
   [[nodiscard]] std::size_t frames_in_flight() const noexcept;
-  [[nodiscard]] std::size_t datagrams_pending() const noexcept;  // queued or in flight
   [[nodiscard]] const TransactionCounters& counters() const noexcept { return counters_; }
   [[nodiscard]] const FrameErrorCounters& frame_errors() const noexcept { return frame_errors_; }
 

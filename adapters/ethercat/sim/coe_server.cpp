@@ -74,7 +74,6 @@ void CoeServer::reset() noexcept {
 }
 
 void CoeServer::on_request(std::span<const std::uint8_t> mailbox, AlState state, MailboxOutbox& out) noexcept {
-  ++requests_;
   const CoeView c = decode_coe(mailbox);
   if (c.error != MailboxError::None) {
     // A CoE header cut off: mailbox error "size too short" [ETG.1000.6 mailbox error reply].

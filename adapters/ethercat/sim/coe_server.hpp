@@ -37,7 +37,6 @@ class MailboxOutbox {
   // Puts a message back at the front (a repeat request, see EscSlave), counter unchanged.
   bool push_front(std::span<const std::uint8_t> msg) noexcept;
   bool empty() const noexcept { return count_ == 0; }
-  std::size_t size() const noexcept { return count_; }
   bool full() const noexcept { return count_ == slots_.size(); }
   std::span<const std::uint8_t> front() const noexcept;
   void pop() noexcept;
@@ -77,9 +76,6 @@ class CoeServer {
   // Forgets an open segmented transfer (the slave went to INIT).
   void reset() noexcept;
 
-  void set_dictionary(ObjectDictionary* od) noexcept { od_ = od; }
-  std::uint64_t requests() const noexcept { return requests_; }
-
  private:
   void sdo(std::span<const std::uint8_t> mailbox, AlState state, MailboxOutbox& out) noexcept;
   void info(std::span<const std::uint8_t> mailbox, MailboxOutbox& out) noexcept;
@@ -96,7 +92,6 @@ class CoeServer {
   std::size_t done_ = 0;    // bytes transferred so far
   bool toggle_ = false;     // toggle the next segment must carry
   std::array<std::uint16_t, 512> list_{};
-  std::uint64_t requests_ = 0;
 };
 
 }  // namespace drivegate::ethercat::sim

@@ -33,10 +33,9 @@ EscSlave::EscSlave(const EscConfig& config, std::span<const std::uint8_t> sii, S
       app_(app),
       mem_(kMemorySize, 0),
       sii_(sii.begin(), sii.end()),
-      sii_info_storage_(1),
+      sii_info_(std::make_unique<SiiInfo>()),
       outbox_(config.mailbox_queue, 0),
       coe_(app != nullptr ? app->object_dictionary() : nullptr, config.max_object_bytes) {
-  sii_info_ = sii_info_storage_.data();
   parse_sii(sii_, *sii_info_);
   has_mailbox_ = sii_info_->standard_mailbox.present();
   if (has_mailbox_) {
@@ -44,7 +43,6 @@ EscSlave::EscSlave(const EscConfig& config, std::span<const std::uint8_t> sii, S
     last_sent_.assign(sii_info_->standard_mailbox.tx_size, 0);
   }
   const std::size_t ram = static_cast<std::size_t>(cfg_.ram_kib) * 1024;
-  outputs_.assign(ram, 0);
   inputs_.assign(ram, 0);
   zeros_.assign(ram, 0);
 
@@ -692,7 +690,7 @@ void EscSlave::pdi_cycle(std::uint64_t now_ns) noexcept {
   }
   watchdog_check(now_ns);
   if (app_ == nullptr) return;
-  const std::size_t out_n = std::min(app_->output_size(), outputs_.size());
+  const std::size_t out_n = std::min(app_->output_size(), zeros_.size());
   const std::size_t in_n = std::min(app_->input_size(), inputs_.size());
   std::span<const std::uint8_t> outputs(zeros_.data(), out_n);
   if (state_ == AlState::Op && outputs_valid_ && out_n > 0) {

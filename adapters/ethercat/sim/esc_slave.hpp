@@ -23,6 +23,7 @@
 #include <bitset>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -120,7 +121,6 @@ class EscSlave {
   // slave "stuck in SAFE-OP"); when it is above it now, it drops there on its own with the error
   // set, as after a local error [ETG.1000.6 §5.3.2]. AlState::Op lifts the fault.
   void limit_state(AlState highest, std::uint16_t code) noexcept;
-  const SiiInfo& sii_info() const noexcept { return *sii_info_; }
   std::uint64_t mailbox_repeats() const noexcept { return repeats_; }
   std::uint64_t mailbox_duplicates() const noexcept { return duplicates_; }
 
@@ -168,8 +168,7 @@ class EscSlave {
   std::vector<std::uint8_t> mem_;            // 64 KiB
   std::bitset<0x1000> writable_;             // ECAT-writable register bytes
   std::vector<std::uint8_t> sii_;            // EEPROM image
-  std::vector<SiiInfo> sii_info_storage_;    // one element (large: kept off the stack)
-  SiiInfo* sii_info_ = nullptr;
+  std::unique_ptr<SiiInfo> sii_info_;        // large: kept off the stack
   std::array<SmState, 16> sms_{};
   AlState state_ = AlState::Init;
   AlState highest_ = AlState::Op;   // limit_state()
@@ -188,9 +187,8 @@ class EscSlave {
   std::uint64_t duplicates_ = 0;
 
   // process data
-  std::vector<std::uint8_t> outputs_;
   std::vector<std::uint8_t> inputs_;
-  std::vector<std::uint8_t> zeros_;
+  std::vector<std::uint8_t> zeros_;          // the outputs an application sees outside OP
   bool outputs_valid_ = false;
   bool wd_triggered_ = false;                // SM2 written since the last PDI cycle
   std::uint64_t wd_last_ns_ = 0;
