@@ -170,14 +170,12 @@ SmEntry EscSlave::sm(unsigned n) const noexcept {
   return e.value_or(SmEntry{});
 }
 
-std::span<std::uint8_t> EscSlave::sm_buffer(unsigned n) noexcept {
-  const SmEntry e = sm(n);
+std::span<std::uint8_t> EscSlave::sm_buffer(const SmEntry& e) noexcept {
   if (static_cast<std::uint32_t>(e.physical_start) + e.length > kMemorySize) return {};
   return {mem_.data() + e.physical_start, e.length};
 }
 
-bool EscSlave::sm_active(unsigned n) const noexcept {
-  const SmEntry e = sm(n);
+bool EscSlave::sm_active(const SmEntry& e) noexcept {
   return e.enabled() && (e.pdi_control & sm_pdi_control::kDeactivate) == 0 && e.length != 0;
 }
 
@@ -204,8 +202,8 @@ bool EscSlave::sm_allows(std::uint32_t start, std::uint32_t len, Rw rw) const no
 
 void EscSlave::sm_after(std::uint32_t start, std::uint32_t len, Rw rw) noexcept {
   for (unsigned n = 0; n < cfg_.sm_count; ++n) {
-    if (!sm_active(n)) continue;
     const SmEntry e = sm(n);
+    if (!sm_active(e)) continue;
     const std::uint32_t last = static_cast<std::uint32_t>(e.physical_start) + e.length - 1U;
     if (!overlaps(start, len, last, 1)) continue;  // buffer state changes with the last byte
     const bool mailbox = (e.control & sm_control::kModeMask) == sm_control::kModeMailbox;
@@ -218,7 +216,7 @@ void EscSlave::sm_after(std::uint32_t start, std::uint32_t len, Rw rw) noexcept 
     } else if (mailbox && !ecat_writes && rw == Rw::Read) {
       if (n == 1 && has_mailbox_) {
         // Keep what the master just read: a repeat request asks for exactly this mailbox again.
-        const std::span<const std::uint8_t> buf = sm_buffer(1);
+        const std::span<const std::uint8_t> buf = sm_buffer(e);
         last_sent_size_ = std::min(buf.size(), last_sent_.size());
         std::copy_n(buf.begin(), last_sent_size_, last_sent_.begin());
       }
@@ -302,9 +300,7 @@ bool EscSlave::phys_write(std::uint32_t ado, std::span<const std::uint8_t> data)
     if (cfg_.dc_supported && ado <= reg::kDcSystemTime && ado + len >= reg::kDcSystemTime + 4U) {
       const std::uint32_t received = get_u32(data, reg::kDcSystemTime - ado);
       const auto local = static_cast<std::uint32_t>(local_time(now_ns_) + u64(reg::kDcSystemTimeOffset));
-      const auto diff = static_cast<std::int32_t>(local - received);
-      const std::uint32_t mag = diff < 0 ? static_cast<std::uint32_t>(-static_cast<std::int64_t>(diff)) : static_cast<std::uint32_t>(diff);
-      set32(reg::kDcSystemTimeDifference, (mag & 0x7FFFFFFFU) | (diff < 0 ? 0x80000000U : 0U));
+      set32(reg::kDcSystemTimeDifference, encode_system_time_difference(static_cast<std::int32_t>(local - received)));
     }
     register_written(ado, len);
   }

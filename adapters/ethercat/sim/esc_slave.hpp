@@ -140,8 +140,10 @@ class EscSlave {
   SmEntry sm(unsigned n) const noexcept;
   // The SM's buffer in memory; empty when it would reach past 64 KiB (the master may configure
   // anything after the state checks passed).
-  std::span<std::uint8_t> sm_buffer(unsigned n) noexcept;
-  bool sm_active(unsigned n) const noexcept;
+  std::span<std::uint8_t> sm_buffer(unsigned n) noexcept { return sm_buffer(sm(n)); }
+  std::span<std::uint8_t> sm_buffer(const SmEntry& e) noexcept;
+  bool sm_active(unsigned n) const noexcept { return sm_active(sm(n)); }
+  static bool sm_active(const SmEntry& e) noexcept;
   // Checks an ECAT access to [start, start+len): false when an SM refuses it.
   bool sm_allows(std::uint32_t start, std::uint32_t len, Rw rw) const noexcept;
   // Side effects of a completed access (mailbox full/empty, buffer written).

@@ -266,5 +266,12 @@ constexpr std::int32_t decode_system_time_difference(std::uint32_t raw) noexcept
   const auto magnitude = static_cast<std::int32_t>(raw & 0x7FFFFFFFU);
   return (raw & 0x80000000U) ? -magnitude : magnitude;
 }
+// The register value of a signed difference in ns (the inverse of the decoder; the magnitude is
+// kept to 31 bits).
+constexpr std::uint32_t encode_system_time_difference(std::int32_t diff) noexcept {
+  const std::uint32_t magnitude =
+      diff < 0 ? static_cast<std::uint32_t>(-static_cast<std::int64_t>(diff)) : static_cast<std::uint32_t>(diff);
+  return (magnitude & 0x7FFFFFFFU) | (diff < 0 ? 0x80000000U : 0U);
+}
 
 }  // namespace drivegate::ethercat
