@@ -1,6 +1,6 @@
 // The EtherCAT slave simulator (adapters/ethercat/sim) under arbitrary datagram sequences: a line
-// of a CoE slave (mailbox at 1000h/1080h, SDO server over a small dictionary) and a generic I/O
-// slave. The input is a script of operations:
+// of the CoE test slave (adapters/ethercat/sim/coe_test_slave.hpp: mailbox at 1000h/1080h, SDO
+// server over a small dictionary) and a generic I/O slave. The input is a script of operations:
 //   F0h-FFh         advance the time by (b & 0Fh) ms (PDI cycles, watchdogs)
 //   E0h-EFh         fault (b % 6): power slave 1 off / on, cable break after 0 / repair, drop one
 //                   frame, corrupt one frame
@@ -15,9 +15,9 @@
 #include <vector>
 
 #include "adapters/ethercat/link/memory_link.hpp"
+#include "adapters/ethercat/sim/coe_test_slave.hpp"
 #include "adapters/ethercat/sim/esc_slave.hpp"
 #include "adapters/ethercat/sim/generic_io.hpp"
-#include "adapters/ethercat/sim/object_dictionary.hpp"
 #include "adapters/ethercat/sim/sim_line.hpp"
 #include "adapters/ethercat/wire/frame.hpp"
 
@@ -26,49 +26,12 @@ namespace {
 using namespace drivegate::ethercat;
 using namespace drivegate::ethercat::sim;
 
-class App final : public SlaveApplication {
- public:
-  App() {
-    const std::array<std::uint8_t, 4> v4{0x92, 0x01, 0x02, 0x00};
-    od.add_variable(0x1000, data_type::kUnsigned32, object_access::kReadPreOp | object_access::kReadSafeOp, "Device type", v4);
-    const std::array<std::uint8_t, 2> v2{1, 2};
-    od.add_variable(0x2000, data_type::kUnsigned16, 0x003F, "Parameter", v2);
-    const std::vector<std::uint8_t> big(200, 0x5A);
-    od.add_variable(0x2001, data_type::kOctetString, 0x003F, "Long", big);
-  }
-  std::size_t output_size() const noexcept override { return 2; }
-  std::size_t input_size() const noexcept override { return 2; }
-  void exchange(std::span<const std::uint8_t>, std::span<std::uint8_t> in, AlState, std::uint64_t) noexcept override {
-    if (in.size() >= 2) in[0] = static_cast<std::uint8_t>(in[0] + 1);
-  }
-  ObjectDictionary* object_dictionary() noexcept override { return &od; }
-  SimpleObjectDictionary od;
-};
-
-std::vector<std::uint8_t> coe_sii() {
-  const std::array<SiiSyncManager, 4> sms{
-      SiiSyncManager{0x1000, 128, sm_control::kMailboxOut, 0, 1, sii_sm_type::kMailboxOut},
-      SiiSyncManager{0x1080, 128, sm_control::kMailboxIn, 0, 1, sii_sm_type::kMailboxIn},
-      SiiSyncManager{0x1100, 2, sm_control::kOutputs, 0, 1, sii_sm_type::kOutputs},
-      SiiSyncManager{0x1180, 2, sm_control::kInputs, 0, 1, sii_sm_type::kInputs},
-  };
-  SiiProfile p;
-  p.identity = SiiIdentity{0x66F, 1, 1, 1};
-  p.standard_mailbox = SiiMailbox{0x1000, 128, 0x1080, 128};
-  p.mailbox_protocols = mailbox_protocol::kCoE;
-  p.name = "fuzz";
-  p.sync_managers = sms;
-  std::vector<std::uint8_t> image(2048, 0);
-  image.resize(build_sii(p, image).size);
-  return image;
-}
-
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size > 8192) return 0;
-  static const std::vector<std::uint8_t> sii = coe_sii();
-  App app;
+  static const std::vector<std::uint8_t> sii = coe_test::coe_sii();
+  coe_test::CoeApp app;
   GenericIoSlave io(2, 2, SiiIdentity{1, 2, 3, 4});
   EscConfig dc;
   dc.dc_supported = true;

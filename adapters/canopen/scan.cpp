@@ -25,11 +25,12 @@ namespace {
 
 using namespace std::chrono_literals;
 
-// Abort codes that mean "the node has no such object" [CiA 301 §7.2.4.3.17].
-constexpr std::uint32_t kNoObject = 0x06020000;
-constexpr std::uint32_t kNoSubIndex = 0x06090011;
-constexpr std::uint32_t kTimeout = 0x05040000;
-constexpr std::uint32_t kOutOfMemory = 0x05040005;
+// Abort codes the scan acts on: the node has no such object, the node did not answer, the value
+// does not fit [CiA 301 §7.2.4.3.17].
+using cia402::sdo_abort_code::kNoObject;
+using cia402::sdo_abort_code::kNoSubIndex;
+using cia402::sdo_abort_code::kOutOfMemory;
+using cia402::sdo_abort_code::kTimeout;
 
 constexpr ObjectId kDeviceType{0x1000, 0};
 // The identity reads after the probe, in CanopenScan::Node::reads order.

@@ -118,55 +118,55 @@ TEST(SlavePdoObjects, MappingRules) {
   ASSERT_EQ(s.write({0x1401, 1}, 0x80000301), 0U);  // RPDO2 invalid
   ASSERT_EQ(s.write({0x1601, 0}, 0), 0U);
   // Entries: objects that exist and may go this way, with their exact length.
-  EXPECT_EQ(s.write({0x1601, 1}, entry(obj::kStatusword)), sdo_abort_code::kNotMappable);  // TPDO-only object
-  EXPECT_EQ(s.write({0x1601, 1}, entry(obj::kSupportedDriveModes)), sdo_abort_code::kNotMappable);
-  EXPECT_EQ(s.write({0x1601, 1}, 0x22220010), sdo_abort_code::kNotMappable);  // does not exist
-  EXPECT_EQ(s.write({0x1601, 1}, 0x60400020), sdo_abort_code::kNotMappable);  // CW as 32 bit
-  EXPECT_EQ(s.write({0x1601, 1}, 0x60400008), sdo_abort_code::kNotMappable);  // part of CW
-  EXPECT_EQ(s.write({0x1601, 9}, entry(obj::kControlword)), sdo_abort_code::kNoSubIndex);
-  EXPECT_EQ(s.write({0x1601, 1}, entry(obj::kControlword), 2), sdo_abort_code::kTypeMismatch);
+  EXPECT_EQ(s.write({0x1601, 1}, entry(obj::kStatusword)), cia402::sdo_abort_code::kNotMappable);  // TPDO-only object
+  EXPECT_EQ(s.write({0x1601, 1}, entry(obj::kSupportedDriveModes)), cia402::sdo_abort_code::kNotMappable);
+  EXPECT_EQ(s.write({0x1601, 1}, 0x22220010), cia402::sdo_abort_code::kNotMappable);  // does not exist
+  EXPECT_EQ(s.write({0x1601, 1}, 0x60400020), cia402::sdo_abort_code::kNotMappable);  // CW as 32 bit
+  EXPECT_EQ(s.write({0x1601, 1}, 0x60400008), cia402::sdo_abort_code::kNotMappable);  // part of CW
+  EXPECT_EQ(s.write({0x1601, 9}, entry(obj::kControlword)), cia402::sdo_abort_code::kNoSubIndex);
+  EXPECT_EQ(s.write({0x1601, 1}, entry(obj::kControlword), 2), cia402::sdo_abort_code::kTypeMismatch);
   ASSERT_EQ(s.write({0x1601, 1}, entry(obj::kControlword), 4), 0U);
   // Count: <= 8 and only over entries that are set.
-  EXPECT_EQ(s.write({0x1601, 0}, 9), sdo_abort_code::kValueRange);
+  EXPECT_EQ(s.write({0x1601, 0}, 9), cia402::sdo_abort_code::kValueRange);
   EXPECT_EQ(s.write({0x1601, 0}, 2), 0U);  // entry 2 still holds the default 6060h
   ASSERT_EQ(s.write({0x1601, 0}, 0), 0U);
   ASSERT_EQ(s.write({0x1601, 2}, 0), 0U);
-  EXPECT_EQ(s.write({0x1601, 0}, 2), sdo_abort_code::kNotMappable);  // entry 2 is empty now
-  EXPECT_EQ(s.write({0x1601, 0}, 1, 4), sdo_abort_code::kTypeMismatch);
+  EXPECT_EQ(s.write({0x1601, 0}, 2), cia402::sdo_abort_code::kNotMappable);  // entry 2 is empty now
+  EXPECT_EQ(s.write({0x1601, 0}, 1, 4), cia402::sdo_abort_code::kTypeMismatch);
   EXPECT_EQ(s.write({0x1601, 0}, 1, 1), 0U);
   EXPECT_EQ(s.write({0x1601, 1}, 0), 0U);  // clearing an entry is allowed while invalid
-  EXPECT_EQ(s.read({0x1601, 9}).abort_code, sdo_abort_code::kNoSubIndex);
+  EXPECT_EQ(s.read({0x1601, 9}).abort_code, cia402::sdo_abort_code::kNoSubIndex);
 }
 
 TEST(SlavePdoObjects, CommunicationParameterRules) {
   AkdSlave a;
   auto& s = a.slave;
-  EXPECT_EQ(s.write({0x1800, 0}, 5), sdo_abort_code::kReadOnly);
-  EXPECT_EQ(s.write({0x1400, 3}, 10), sdo_abort_code::kNoSubIndex);  // RPDOs: no inhibit time
-  EXPECT_EQ(s.write({0x1400, 5}, 10), sdo_abort_code::kNoSubIndex);  // ... and no event timer
-  EXPECT_EQ(s.read({0x1400, 5}).abort_code, sdo_abort_code::kNoSubIndex);
-  EXPECT_EQ(s.write({0x1800, 4}, 0), sdo_abort_code::kNoSubIndex);
-  EXPECT_EQ(s.write({0x1800, 6}, 0), sdo_abort_code::kNoSubIndex);
-  EXPECT_EQ(s.write({0x1404, 1}, 0x205), sdo_abort_code::kNoObject);
-  EXPECT_EQ(s.read({0x1C00, 0}).abort_code, sdo_abort_code::kNoObject);
+  EXPECT_EQ(s.write({0x1800, 0}, 5), cia402::sdo_abort_code::kReadOnly);
+  EXPECT_EQ(s.write({0x1400, 3}, 10), cia402::sdo_abort_code::kNoSubIndex);  // RPDOs: no inhibit time
+  EXPECT_EQ(s.write({0x1400, 5}, 10), cia402::sdo_abort_code::kNoSubIndex);  // ... and no event timer
+  EXPECT_EQ(s.read({0x1400, 5}).abort_code, cia402::sdo_abort_code::kNoSubIndex);
+  EXPECT_EQ(s.write({0x1800, 4}, 0), cia402::sdo_abort_code::kNoSubIndex);
+  EXPECT_EQ(s.write({0x1800, 6}, 0), cia402::sdo_abort_code::kNoSubIndex);
+  EXPECT_EQ(s.write({0x1404, 1}, 0x205), cia402::sdo_abort_code::kNoObject);
+  EXPECT_EQ(s.read({0x1C00, 0}).abort_code, cia402::sdo_abort_code::kNoObject);
   EXPECT_FALSE(sim::SlavePdos::owns(0x1404));
   EXPECT_TRUE(sim::SlavePdos::owns(0x1A03));
   // COB-ID: the id only changes while invalid; no 29-bit ids; a valid PDO needs an id.
-  EXPECT_EQ(s.write({0x1800, 1}, 0x00000191), sdo_abort_code::kValueRange);
+  EXPECT_EQ(s.write({0x1800, 1}, 0x00000191), cia402::sdo_abort_code::kValueRange);
   EXPECT_EQ(s.write({0x1800, 1}, 0x40000181), 0U);  // same id, bit 30 only
-  EXPECT_EQ(s.write({0x1800, 1}, 0x20000181), sdo_abort_code::kValueRange);
-  EXPECT_EQ(s.write({0x1800, 1}, 0x00010181), sdo_abort_code::kValueRange);
+  EXPECT_EQ(s.write({0x1800, 1}, 0x20000181), cia402::sdo_abort_code::kValueRange);
+  EXPECT_EQ(s.write({0x1800, 1}, 0x00010181), cia402::sdo_abort_code::kValueRange);
   EXPECT_EQ(s.write({0x1800, 1}, 0x80000191), 0U);
-  EXPECT_EQ(s.write({0x1800, 1}, 0x00000000), sdo_abort_code::kValueRange);
+  EXPECT_EQ(s.write({0x1800, 1}, 0x00000000), cia402::sdo_abort_code::kValueRange);
   EXPECT_EQ(s.write({0x1800, 1}, 0x00000191), 0U);
-  EXPECT_EQ(s.write({0x1800, 1}, 0x191, 2), sdo_abort_code::kTypeMismatch);
+  EXPECT_EQ(s.write({0x1800, 1}, 0x191, 2), cia402::sdo_abort_code::kTypeMismatch);
   // Transmission type: 0..240, 254, 255 by default; values past the type's width are range errors.
   for (const std::uint32_t t : {241U, 252U, 253U}) {
-    EXPECT_EQ(s.write({0x1800, 2}, t), sdo_abort_code::kValueRange);
+    EXPECT_EQ(s.write({0x1800, 2}, t), cia402::sdo_abort_code::kValueRange);
   }
   for (const std::uint32_t t : {0U, 1U, 240U, 254U, 255U}) EXPECT_EQ(s.write({0x1800, 2}, t), 0U);
-  EXPECT_EQ(s.write({0x1800, 2}, 0x101), sdo_abort_code::kValueRange);
-  EXPECT_EQ(s.write({0x1800, 3}, 0x10000), sdo_abort_code::kValueRange);
+  EXPECT_EQ(s.write({0x1800, 2}, 0x101), cia402::sdo_abort_code::kValueRange);
+  EXPECT_EQ(s.write({0x1800, 3}, 0x10000), cia402::sdo_abort_code::kValueRange);
   EXPECT_EQ(s.write({0x1800, 3}, 0xFFFF, 2), 0U);
 }
 
@@ -180,16 +180,16 @@ TEST(SlavePdoObjects, Sd6FixedMappingPersonaRefusesMappingWrites) {
   EXPECT_EQ(s.read({0x1600, 0}).value, 6U);
   EXPECT_EQ(s.read({0x1A03, 0}).value, 6U);
   EXPECT_EQ(s.read({0x1600, 3}).value, 0x60FF0020U);
-  EXPECT_EQ(s.read({0x1600, 7}).abort_code, sdo_abort_code::kNoSubIndex);
+  EXPECT_EQ(s.read({0x1600, 7}).abort_code, cia402::sdo_abort_code::kNoSubIndex);
   ASSERT_EQ(s.write({0x1400, 1}, 0x80000205), 0U);  // even while invalid
-  EXPECT_EQ(s.write({0x1600, 0}, 0), sdo_abort_code::kReadOnly);
-  EXPECT_EQ(s.write({0x1600, 1}, entry(obj::kControlword)), sdo_abort_code::kReadOnly);
-  EXPECT_EQ(s.write({0x1600, 7}, 0), sdo_abort_code::kNoSubIndex);
+  EXPECT_EQ(s.write({0x1600, 0}, 0), cia402::sdo_abort_code::kReadOnly);
+  EXPECT_EQ(s.write({0x1600, 1}, entry(obj::kControlword)), cia402::sdo_abort_code::kReadOnly);
+  EXPECT_EQ(s.write({0x1600, 7}, 0), cia402::sdo_abort_code::kNoSubIndex);
   EXPECT_EQ(s.read({0x1600, 1}).value, 0x60400010U);
   // Transmission types 1..240 and 254 only (quirk 3).
-  EXPECT_EQ(s.write({0x1800, 2}, 255), sdo_abort_code::kValueRange);
-  EXPECT_EQ(s.write({0x1800, 2}, 0), sdo_abort_code::kValueRange);
-  EXPECT_EQ(s.write({0x1400, 2}, 241), sdo_abort_code::kValueRange);
+  EXPECT_EQ(s.write({0x1800, 2}, 255), cia402::sdo_abort_code::kValueRange);
+  EXPECT_EQ(s.write({0x1800, 2}, 0), cia402::sdo_abort_code::kValueRange);
+  EXPECT_EQ(s.write({0x1400, 2}, 241), cia402::sdo_abort_code::kValueRange);
   EXPECT_EQ(s.write({0x1800, 2}, 240), 0U);
   EXPECT_EQ(s.write({0x1800, 2}, 254), 0U);
   // The fixed RPDO1 maps CW and 60FFh (6 bytes); empty slots map nothing.

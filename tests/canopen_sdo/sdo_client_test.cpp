@@ -235,7 +235,7 @@ TEST(SdoClientTimeouts, RetriesFromInitiateThenAbortsWithTimeout) {
   EXPECT_EQ(c.result(id).status, SdoStatus::InFlight);
   EXPECT_EQ(poll(c, kT0 + 300ms, tx), (Frames{{0x605, {0x80, 0x00, 0x10, 0x00, 0x00, 0x00, 0x04, 0x05}}}));
   EXPECT_EQ(c.result(id).status, SdoStatus::Failed);
-  EXPECT_EQ(c.result(id).abort_code, sdo_abort_code::kTimeout);
+  EXPECT_EQ(c.result(id).abort_code, cia402::sdo_abort_code::kTimeout);
   EXPECT_EQ(cia402::sdo_abort_text(c.result(id).abort_code), "SDO protocol timed out");
   EXPECT_EQ(c.counters().retries, 2U);
   EXPECT_EQ(c.counters().timeouts, 1U);
@@ -273,7 +273,7 @@ TEST(SdoClientTimeouts, TimeoutBetweenSegmentsAbortsWithoutRetry) {
   EXPECT_EQ(poll(c, kT0 + 10ms, tx), (Frames{{0x605, {0x60, 0, 0, 0, 0, 0, 0, 0}}}));
   EXPECT_EQ(c.next_deadline(), kT0 + 110ms);
   EXPECT_EQ(poll(c, kT0 + 110ms, tx), (Frames{{0x605, {0x80, 0x00, 0x20, 0x01, 0x00, 0x00, 0x04, 0x05}}}));
-  EXPECT_EQ(c.result(id).abort_code, sdo_abort_code::kTimeout);
+  EXPECT_EQ(c.result(id).abort_code, cia402::sdo_abort_code::kTimeout);
   EXPECT_EQ(c.counters().retries, 0U);
   EXPECT_EQ(c.counters().timeouts, 1U);
 }
@@ -306,7 +306,7 @@ TEST(SdoClientErrors, ToggleErrorInUploadAbortsWith05030000) {
   c.on_frame(frame(0x585, {0x00, 8, 9, 10, 11, 12, 13, 14}), kT0);  // toggle 0 again
   EXPECT_EQ(poll(c, kT0, tx), (Frames{{0x605, {0x80, 0x00, 0x20, 0x01, 0x00, 0x00, 0x03, 0x05}}}));
   EXPECT_EQ(c.result(id).status, SdoStatus::Failed);
-  EXPECT_EQ(c.result(id).abort_code, sdo_abort_code::kToggle);
+  EXPECT_EQ(c.result(id).abort_code, cia402::sdo_abort_code::kToggle);
   EXPECT_TRUE(c.data(id).empty());
 }
 
@@ -320,7 +320,7 @@ TEST(SdoClientErrors, ToggleErrorInDownloadAbortsWith05030000) {
   poll(c, kT0, tx);
   c.on_frame(frame(0x585, {0x30, 0, 0, 0, 0, 0, 0, 0}), kT0);  // confirms toggle 1, sent was 0
   EXPECT_EQ(poll(c, kT0, tx), (Frames{{0x605, {0x80, 0x00, 0x20, 0x01, 0x00, 0x00, 0x03, 0x05}}}));
-  EXPECT_EQ(c.result(id).abort_code, sdo_abort_code::kToggle);
+  EXPECT_EQ(c.result(id).abort_code, cia402::sdo_abort_code::kToggle);
 }
 
 TEST(SdoClientErrors, ServerAbortFailsWithTheServersCodeAndText) {
@@ -347,7 +347,7 @@ TEST(SdoClientErrors, UploadLargerThanMaxDataAbortsOutOfMemory) {
   poll(c, kT0, tx);
   c.on_frame(frame(0x585, {0x41, 0x08, 0x10, 0x00, 100, 0, 0, 0}), kT0);
   EXPECT_EQ(poll(c, kT0, tx), (Frames{{0x605, {0x80, 0x08, 0x10, 0x00, 0x05, 0x00, 0x04, 0x05}}}));
-  EXPECT_EQ(c.result(big).abort_code, sdo_abort_code::kOutOfMemory);
+  EXPECT_EQ(c.result(big).abort_code, cia402::sdo_abort_code::kOutOfMemory);
 
   const auto unsized = c.read(0, {0x1009, 0});
   poll(c, kT0, tx);
@@ -359,7 +359,7 @@ TEST(SdoClientErrors, UploadLargerThanMaxDataAbortsOutOfMemory) {
     toggle = !toggle;
   }
   EXPECT_EQ(poll(c, kT0, tx), (Frames{{0x605, {0x80, 0x09, 0x10, 0x00, 0x05, 0x00, 0x04, 0x05}}}));
-  EXPECT_EQ(c.result(unsized).abort_code, sdo_abort_code::kOutOfMemory);
+  EXPECT_EQ(c.result(unsized).abort_code, cia402::sdo_abort_code::kOutOfMemory);
   EXPECT_EQ(c.counters().failed, 2U);
 }
 
@@ -372,7 +372,7 @@ TEST(SdoClientErrors, LastSegmentShortOfTheIndicatedSizeFails) {
   poll(c, kT0, tx);
   c.on_frame(frame(0x585, {0x01, 1, 2, 3, 4, 5, 6, 7}), kT0);  // last after 7 of 16 bytes
   EXPECT_EQ(poll(c, kT0, tx), (Frames{{0x605, {0x80, 0x00, 0x20, 0x01, 0x13, 0x00, 0x07, 0x06}}}));
-  EXPECT_EQ(c.result(id).abort_code, sdo_abort_code::kTooShort);
+  EXPECT_EQ(c.result(id).abort_code, cia402::sdo_abort_code::kTooShort);
 }
 
 TEST(SdoClientRequests, CancelWhileQueuedSkipsTheRequest) {
@@ -552,7 +552,7 @@ TEST(SdoClientChannels, SeveralChannelsInterleave) {
   // Node 7 never answered: only its channel times out.
   EXPECT_EQ(c.next_deadline(), kT0 + 100ms);
   EXPECT_EQ(poll(c, kT0 + 100ms, tx), (Frames{{0x607, {0x80, 0x00, 0x10, 0x00, 0x00, 0x00, 0x04, 0x05}}}));
-  EXPECT_EQ(c.result(n7).abort_code, sdo_abort_code::kTimeout);
+  EXPECT_EQ(c.result(n7).abort_code, cia402::sdo_abort_code::kTimeout);
   EXPECT_EQ(c.counters().completed, 2U);
 }
 
@@ -694,7 +694,7 @@ TEST(SdoClientAllocation, CyclicPathAllocatesNothing) {
   EXPECT_EQ(allocations, 0U);
   EXPECT_EQ(up.status, SdoStatus::Done);
   EXPECT_EQ(up.size, 16);
-  EXPECT_EQ(timed_out.abort_code, sdo_abort_code::kTimeout);
+  EXPECT_EQ(timed_out.abort_code, cia402::sdo_abort_code::kTimeout);
 }
 
 // Every abort code the digests list has a text (AKD part 1 §10.4, SD6 §6.5).

@@ -204,7 +204,7 @@ TEST(SdoLoopback, InjectedAbortReachesTheCallerWithItsText) {
   EXPECT_EQ(cia402::sdo_abort_text(client.result(refused).abort_code), "invalid value for parameter (download only)");
   EXPECT_EQ(client.result(accepted).status, SdoStatus::Done);
   EXPECT_EQ(od.value({0x6060, 0}), Bytes{3});
-  EXPECT_EQ(client.result(missing).abort_code, sdo_abort_code::kNoObject);
+  EXPECT_EQ(client.result(missing).abort_code, cia402::sdo_abort_code::kNoObject);
   EXPECT_EQ(cia402::sdo_abort_text(client.result(missing).abort_code), "object does not exist in the object dictionary");
 }
 
@@ -222,7 +222,7 @@ TEST(SdoLoopback, SilentServerMakesTheClientRetryAndGiveUp) {
   for (core::TimePoint now = kT0; bus.busy(); now += 10ms) bus.round(now);
   EXPECT_EQ(bus.take_client_frames(), 5U);
   EXPECT_EQ(server.counters().ignored_silent, 5U);
-  EXPECT_EQ(client.result(id).abort_code, sdo_abort_code::kTimeout);
+  EXPECT_EQ(client.result(id).abort_code, cia402::sdo_abort_code::kTimeout);
   EXPECT_EQ(client.counters().retries, 3U);
 
   server.set_silent(false);

@@ -114,14 +114,14 @@ class TestBackend final : public sim::SdoBackend {
 
   sim::SdoReadResult sdo_read(ObjectId id, std::span<std::uint8_t> out) noexcept override {
     const Entry* e = find(id);
-    if (e == nullptr) return {sdo_abort_code::kNoObject, 0};
+    if (e == nullptr) return {cia402::sdo_abort_code::kNoObject, 0};
     std::copy_n(e->bytes.begin(), std::min(e->size, out.size()), out.begin());
     return {0, e->size};
   }
   std::uint32_t sdo_write(ObjectId id, std::span<const std::uint8_t> data) noexcept override {
     Entry* e = find(id);
-    if (e == nullptr) return sdo_abort_code::kNoObject;
-    if (!e->writable) return sdo_abort_code::kReadOnly;
+    if (e == nullptr) return cia402::sdo_abort_code::kNoObject;
+    if (!e->writable) return cia402::sdo_abort_code::kReadOnly;
     std::copy(data.begin(), data.end(), e->bytes.begin());
     e->size = data.size();
     ++writes_;

@@ -13,6 +13,7 @@
 #include <span>
 #include <vector>
 
+#include "adapters/ethercat/wire/al_status.hpp"
 #include "adapters/ethercat/wire/bytes.hpp"
 #include "adapters/ethercat/wire/frame.hpp"
 #include "adapters/ethercat/wire/registers.hpp"
@@ -79,7 +80,7 @@ struct FakeEsc {
       }
     }
     // 080Dh (SM1 status): mailbox full bit.
-    mem[reg::sm(1) + 5] = static_cast<std::uint8_t>(sm1_full ? sm_status::kMailboxFull : 0);
+    mem[reg::sm_status(1)] = static_cast<std::uint8_t>(sm1_full ? sm_status::kMailboxFull : 0);
     std::copy_n(mem.begin() + ado, out.size(), out.begin());
     // Reading the last byte of SM1 frees the mailbox.
     if (in_sm1 && end >= static_cast<std::size_t>(sm1.physical_start + sm1.length)) {
@@ -93,15 +94,17 @@ struct FakeEsc {
     const std::size_t end = static_cast<std::size_t>(ado) + in.size();
     const SmEntry sm0 = sm(0);
     const bool in_sm0 = sm0.enabled() && ado >= sm0.physical_start && ado < sm0.physical_start + sm0.length;
-    const std::uint8_t old_activate1 = mem[reg::sm(1) + 6];
+    const std::uint8_t old_activate1 = mem[reg::sm_activation(1)];
     std::copy(in.begin(), in.end(), mem.begin() + ado);
     if (ado <= reg::kAlControl && end > reg::kAlControl) al_control(get_u16(mem, reg::kAlControl));
     if (ado <= reg::kSiiControl && end > reg::kSiiControl) sii_command();
-    if (ado <= reg::sm(1) + 6U && end > reg::sm(1) + 6U) {
-      const std::uint8_t now = mem[reg::sm(1) + 6];
+    if (ado <= reg::sm_activation(1) && end > reg::sm_activation(1)) {
+      const std::uint8_t now = mem[reg::sm_activation(1)];
       if (((now ^ old_activate1) & sm_activate::kRepeat) != 0) {  // repeat request toggled
         if (!last_reply.empty()) place_reply();
-        mem[reg::sm(1) + 7] = static_cast<std::uint8_t>((mem[reg::sm(1) + 7] & ~0x02) | (now & sm_activate::kRepeat));
+        const std::uint8_t ack = (now & sm_activate::kRepeat) != 0 ? sm_pdi_control::kRepeatAck : std::uint8_t{0};
+        mem[reg::sm_pdi_control(1)] =
+            static_cast<std::uint8_t>((mem[reg::sm_pdi_control(1)] & ~sm_pdi_control::kRepeatAck) | ack);
       }
     }
     if (in_sm0 && end >= static_cast<std::size_t>(sm0.physical_start + sm0.length)) {
@@ -135,7 +138,7 @@ struct FakeEsc {
       const std::uint16_t rx_size = get_u16(sii, 0x32);
       if (rx_size != 0 && (sm(0).physical_start != rx || sm(0).length != rx_size || !sm(0).enabled() ||
                            !sm(1).enabled())) {
-        code = 0x0016;
+        code = al_status_code::kInvalidMailboxConfigPreOp;
       }
     }
     if (code != 0) {

@@ -158,7 +158,7 @@ TEST(EthercatLineBoot, IdentityMismatchIsReportedWithBothIdentities) {
   const SlaveReport& r = h.boot->slave(1);
   EXPECT_EQ(r.status, SlaveStatus::Failed);
   EXPECT_EQ(r.step, BootStep::Identity);
-  EXPECT_TRUE(r.identity_mismatch);
+  EXPECT_TRUE(r.identity_mismatch());
   EXPECT_EQ(r.found.product_code, 6745U);
   EXPECT_EQ(r.text.view(),
             "slave 2 (0x1002, ESR TrioDrive): identity mismatch: expected vendor 0x0000000F product 0x00001A63 "

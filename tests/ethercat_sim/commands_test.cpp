@@ -63,8 +63,8 @@ TEST(EthercatSimCommands, SmAccessRulesAndBitGranularFmmuIgnored) {
   EXPECT_EQ(l.bus.fprd(st, kGenericInputsAddress, 2).wkc, 0);
   // The PDI-control byte and the SM status byte are read-only for the master.
   const std::array<std::uint8_t, 2> junk{0xFF, 0x00};
-  EXPECT_EQ(l.bus.fpwr(st, static_cast<std::uint16_t>(reg::sm(3) + 5U), junk).wkc, 1);
-  const Reply s = l.bus.fprd(st, static_cast<std::uint16_t>(reg::sm(3) + 5U), 3);
+  EXPECT_EQ(l.bus.fpwr(st, reg::sm_status(3), junk).wkc, 1);
+  const Reply s = l.bus.fprd(st, reg::sm_status(3), 3);
   EXPECT_EQ(s.data[0], 0x00);
   EXPECT_EQ(s.data[1], 0x00);       // activate byte written 0: SM3 disabled
   EXPECT_EQ(s.data[2], 0x01);       // still deactivated by the PDI

@@ -150,7 +150,7 @@ TEST(EthercatSimLine, AlTransitionsAndRefusals) {
   EXPECT_EQ(l.bus.fprd(st, reg::kAlStatusCode, 2).u16(), 0x0013);
   // Down to INIT directly (allowed even with the error set); the SMs are deactivated by the PDI.
   EXPECT_EQ(l.bus.request(st, AlState::Init, true), 0x0001);
-  EXPECT_EQ(l.bus.fprd(st, reg::sm(2) + 7U, 1).data[0] & 0x01, 0x01);
+  EXPECT_EQ(l.bus.fprd(st, reg::sm_pdi_control(2), 1).data[0] & sm_pdi_control::kDeactivate, sm_pdi_control::kDeactivate);
 }
 
 TEST(EthercatSimLine, LrwProcessDataThreeSlaves) {

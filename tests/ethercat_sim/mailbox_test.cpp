@@ -6,6 +6,7 @@
 
 #include <string>
 
+#include "adapters/ethercat/sim/coe_server.hpp"
 #include "adapters/ethercat/sim/object_dictionary.hpp"
 #include "tests/ethercat_sim/coe_line.hpp"
 
@@ -247,24 +248,24 @@ TEST(EthercatSimMailbox, EmergencyRepeatAndCounter) {
   // Repeat request: toggle SM1 activate bit 1; the slave puts the same mailbox back and
   // acknowledges in PDI control bit 1 [ETG.1000.4 Table 59].
   const std::array<std::uint8_t, 1> act{static_cast<std::uint8_t>(sm_activate::kEnable | sm_activate::kRepeat)};
-  EXPECT_EQ(l.bus.fpwr(l.st, static_cast<std::uint16_t>(reg::sm(1) + 6U), act).wkc, 1);
+  EXPECT_EQ(l.bus.fpwr(l.st, reg::sm_activation(1), act).wkc, 1);
   r = l.get();
   ASSERT_TRUE(r.returned);
   EXPECT_EQ(decode_emergency(r.bytes()).mailbox.counter, emcy_counter);
-  EXPECT_EQ(l.bus.fprd(l.st, static_cast<std::uint16_t>(reg::sm(1) + 7U), 1).data[0] & 0x02, 0x02);
+  EXPECT_EQ(l.bus.fprd(l.st, reg::sm_pdi_control(1), 1).data[0] & sm_pdi_control::kRepeatAck, sm_pdi_control::kRepeatAck);
   EXPECT_EQ(l.esc.mailbox_repeats(), 1U);
   // Repeat while a newer mailbox already waits in SM1: the one read last comes first, the newer
   // one after it (counters 1 and 2).
   ASSERT_TRUE(l.esc.post_emergency(CoeEmergency{0x8200, 0x11, {}}));
   l.bus.brd(reg::kType, 1);  // a frame passes: the PDI loads the new emergency into SM1
   const std::array<std::uint8_t, 1> act2{sm_activate::kEnable};
-  EXPECT_EQ(l.bus.fpwr(l.st, static_cast<std::uint16_t>(reg::sm(1) + 6U), act2).wkc, 1);
+  EXPECT_EQ(l.bus.fpwr(l.st, reg::sm_activation(1), act2).wkc, 1);
   r = l.get();
   EXPECT_EQ(decode_emergency(r.bytes()).emergency.error_code, 0x8100);
   r = l.get();
   EXPECT_EQ(decode_emergency(r.bytes()).emergency.error_code, 0x8200);
   EXPECT_EQ(decode_emergency(r.bytes()).mailbox.counter, 2);
-  EXPECT_EQ(l.bus.fprd(l.st, static_cast<std::uint16_t>(reg::sm(1) + 7U), 1).data[0] & 0x02, 0x00);
+  EXPECT_EQ(l.bus.fprd(l.st, reg::sm_pdi_control(1), 1).data[0] & sm_pdi_control::kRepeatAck, 0x00);
 
   // The same request counter twice: the second is a repeat and gets no second answer.
   const std::size_t n = encode_sdo_upload_request(l.req, 3, 0x1000, 0);
@@ -298,6 +299,30 @@ TEST(EthercatSimMailbox, FullMailboxRefusesWrite) {
   ASSERT_EQ(l.bus.link().receive(rx), 1U);
   EXPECT_EQ(get_u16(rx[0].view(), s1.slot.wkc_offset), 1);
   EXPECT_EQ(get_u16(rx[0].view(), s2.slot.wkc_offset), 0);
+}
+
+TEST(EthercatSimMailbox, OutboxCountsWhatItCannotQueue) {
+  // A full outbox, an encoding that fails and a message dropped from the front are each counted;
+  // a queued message takes the next mailbox counter [ETG.1000.6 mailbox header, Cnt].
+  MailboxOutbox out(1, kMbxSize);
+  const auto error_reply = [](std::span<std::uint8_t> buf) {
+    return encode_mailbox_error(buf, 0, mailbox_error_code::kUnsupportedProtocol);
+  };
+  EXPECT_TRUE(out.emit(error_reply));
+  EXPECT_EQ(out.dropped(), 0U);
+  ASSERT_FALSE(out.empty());
+  EXPECT_EQ(decode_mailbox(out.front()).header.counter, 1);
+  EXPECT_FALSE(out.emit(error_reply));  // full
+  EXPECT_EQ(out.dropped(), 1U);
+  out.pop();
+  EXPECT_FALSE(out.emit([](std::span<std::uint8_t>) { return std::size_t{0}; }));  // could not encode
+  EXPECT_EQ(out.dropped(), 2U);
+  EXPECT_TRUE(out.empty());
+  EXPECT_TRUE(out.emit(error_reply));
+  EXPECT_EQ(decode_mailbox(out.front()).header.counter, 2);
+  out.drop_front();
+  EXPECT_EQ(out.dropped(), 3U);
+  EXPECT_TRUE(out.empty());
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 
 #include "adapters/ethercat/master/coe_sdo_client.hpp"
 #include "adapters/ethercat/master/line_boot.hpp"
+#include "core/clock.hpp"
 #include "tests/ethercat_sim/coe_line.hpp"
 
 namespace drivegate::ethercat::sim {
@@ -30,7 +31,7 @@ struct Interop {
   void cycle() {
     if (boot) boot->poll(now, tx);
     for (auto& c : clients) c->poll(now, tx);
-    line.set_time(static_cast<std::uint64_t>(now.time_since_epoch().count()));
+    line.set_time(static_cast<std::uint64_t>(core::to_ns(now)));
     for (const auto& f : tx.take_frames(now + 1ms)) {
       link.send(FrameView(f.data(), f.size()));
       std::array<FrameBuffer, 1> rx;

@@ -6,7 +6,7 @@ namespace drivegate::canopen {
 namespace {
 
 bool missing_object(std::uint32_t code) noexcept {
-  return code == sdo_abort_code::kNoObject || code == sdo_abort_code::kNoSubIndex;
+  return code == cia402::sdo_abort_code::kNoObject || code == cia402::sdo_abort_code::kNoSubIndex;
 }
 
 }  // namespace
@@ -74,7 +74,7 @@ NodeBoot::Status NodeBoot::step(SdoClient& sdo, ProcessImage& image) noexcept {
   if (r.status == SdoStatus::Failed) {
     // A seed the drive cannot answer leaves the image value as it is (0 at first).
     const bool missing = missing_object(r.abort_code);
-    if (s.kind == BootStep::Kind::Write && s.refused != 0 && r.abort_code != sdo_abort_code::kTimeout) {
+    if (s.kind == BootStep::Kind::Write && s.refused != 0 && r.abort_code != cia402::sdo_abort_code::kTimeout) {
       found_ = static_cast<std::uint8_t>((found_ & ~s.refused) | s.sets);
       refusal_ = r.abort_code;
     } else if (s.kind != BootStep::Kind::Seed && !(s.kind == BootStep::Kind::Probe && missing) &&

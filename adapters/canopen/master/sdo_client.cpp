@@ -198,7 +198,7 @@ void SdoClient::cancel(SdoRequestId id) noexcept {
     // transfer through the caller's buffer cannot go on without it: it is aborted.
     case SlotState::InFlight:
       s->state = SlotState::Cancelled;
-      if (s->external()) fail_and_abort(ch, *s, sdo_abort_code::kGeneral);
+      if (s->external()) fail_and_abort(ch, *s, cia402::sdo_abort_code::kGeneral);
       break;
     case SlotState::Done:
     case SlotState::Failed: s->state = SlotState::Free; break;
@@ -275,7 +275,7 @@ void SdoClient::on_upload(Channel& ch, Slot& slot, const SdoMessage& m) noexcept
       // (stoeber-sd6-canopen.md §6.4); without it all four bytes are handed up.
       const std::uint8_t n = m.size_indicated || slot.expected_size == 0 ? m.length : slot.expected_size;
       if (n > slot.room()) {
-        fail_and_abort(ch, slot, sdo_abort_code::kOutOfMemory);
+        fail_and_abort(ch, slot, cia402::sdo_abort_code::kOutOfMemory);
         return;
       }
       std::copy_n(m.data.begin(), n, slot.sink());
@@ -285,7 +285,7 @@ void SdoClient::on_upload(Channel& ch, Slot& slot, const SdoMessage& m) noexcept
       return;
     }
     if (m.size_indicated && m.size > slot.room()) {
-      fail_and_abort(ch, slot, sdo_abort_code::kOutOfMemory);
+      fail_and_abort(ch, slot, cia402::sdo_abort_code::kOutOfMemory);
       return;
     }
     ch.total = m.size;
@@ -303,23 +303,23 @@ void SdoClient::on_upload(Channel& ch, Slot& slot, const SdoMessage& m) noexcept
     return;
   }
   if (m.toggle != ch.toggle) {
-    fail_and_abort(ch, slot, sdo_abort_code::kToggle);
+    fail_and_abort(ch, slot, cia402::sdo_abort_code::kToggle);
     return;
   }
   const std::size_t received = std::size_t{ch.offset} + m.length;
   if (received > slot.room()) {
-    fail_and_abort(ch, slot, sdo_abort_code::kOutOfMemory);
+    fail_and_abort(ch, slot, cia402::sdo_abort_code::kOutOfMemory);
     return;
   }
   if (ch.total_indicated && received > ch.total) {
-    fail_and_abort(ch, slot, sdo_abort_code::kTooLong);
+    fail_and_abort(ch, slot, cia402::sdo_abort_code::kTooLong);
     return;
   }
   std::copy_n(m.data.begin(), m.length, slot.sink() + ch.offset);
   ch.offset = static_cast<std::uint16_t>(received);
   if (m.last) {
     if (ch.total_indicated && received != ch.total) {
-      fail_and_abort(ch, slot, sdo_abort_code::kTooShort);
+      fail_and_abort(ch, slot, cia402::sdo_abort_code::kTooShort);
       return;
     }
     slot.size = ch.offset;
@@ -353,7 +353,7 @@ void SdoClient::on_download(Channel& ch, Slot& slot, const SdoMessage& m) noexce
     return;
   }
   if (m.toggle != ch.toggle) {
-    fail_and_abort(ch, slot, sdo_abort_code::kToggle);
+    fail_and_abort(ch, slot, cia402::sdo_abort_code::kToggle);
     return;
   }
   if (ch.last_sent) {
@@ -457,8 +457,8 @@ void SdoClient::poll(core::TimePoint now, TxQueue& tx, std::size_t max_frames) n
         ch.deadline = now + timing_.timeout;
       } else {
         ++counters_.timeouts;
-        send(ch, sdo_abort(slot.object, sdo_abort_code::kTimeout), tx);
-        finish(ch, slot, SlotState::Failed, sdo_abort_code::kTimeout);
+        send(ch, sdo_abort(slot.object, cia402::sdo_abort_code::kTimeout), tx);
+        finish(ch, slot, SlotState::Failed, cia402::sdo_abort_code::kTimeout);
       }
     }
     if (ch.phase == Phase::Idle && ch.fifo_size > 0) {

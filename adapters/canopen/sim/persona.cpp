@@ -309,7 +309,7 @@ constexpr Persona kGenericNoWatch = generic_without("generic-no-watch", false, f
 // A drive whose 1016h:01 entry is fixed (read-only): it has 1016h but takes no gateway entry.
 constexpr Persona fixed_heartbeat() {
   Persona p = generic_without("generic-fixed-heartbeat", true, false);
-  p.heartbeat_consumer_abort = sdo_abort_code::kReadOnly;
+  p.heartbeat_consumer_abort = cia402::sdo_abort_code::kReadOnly;
   return p;
 }
 constexpr Persona kGenericFixedHeartbeat = fixed_heartbeat();

@@ -24,7 +24,7 @@ bool SdoServer::on_frame(const CanFrame& frame, core::TimePoint now) noexcept {
   }
   if (d.error != SdoDecodeError::None || d.message.command == SdoCommand::Block) {
     ++counters_.unknown_command;
-    abort(state_ != State::Idle ? object_ : d.message.object, sdo_abort_code::kUnknownCommand);
+    abort(state_ != State::Idle ? object_ : d.message.object, cia402::sdo_abort_code::kUnknownCommand);
     return true;
   }
   on_request(d.message, now);
@@ -56,7 +56,7 @@ void SdoServer::on_request(const SdoMessage& m, core::TimePoint now) noexcept {
       if (state_ != wanted) {
         // No transfer, or one in the other direction: the specifier does not fit [CiA 301].
         ++counters_.unexpected;
-        abort(state_ != State::Idle ? object_ : ObjectId{}, sdo_abort_code::kUnknownCommand);
+        abort(state_ != State::Idle ? object_ : ObjectId{}, cia402::sdo_abort_code::kUnknownCommand);
       } else if (wanted == State::Download) {
         download_segment(m, now);
       } else {
@@ -80,7 +80,7 @@ void SdoServer::initiate_upload(ObjectId object, core::TimePoint now) noexcept {
     return;
   }
   if (r.size > kBufferSize) {
-    abort(object, sdo_abort_code::kOutOfMemory);
+    abort(object, cia402::sdo_abort_code::kOutOfMemory);
     return;
   }
   if (r.size >= 1 && r.size <= 4) {
@@ -115,7 +115,7 @@ void SdoServer::initiate_download(const SdoMessage& m, core::TimePoint now) noex
     return;
   }
   if (m.size_indicated && m.size > kBufferSize) {
-    abort(m.object, sdo_abort_code::kOutOfMemory);
+    abort(m.object, cia402::sdo_abort_code::kOutOfMemory);
     return;
   }
   state_ = State::Download;
@@ -131,23 +131,23 @@ void SdoServer::initiate_download(const SdoMessage& m, core::TimePoint now) noex
 void SdoServer::download_segment(const SdoMessage& m, core::TimePoint now) noexcept {
   if (m.toggle != toggle_) {
     ++counters_.toggle_errors;
-    abort(object_, sdo_abort_code::kToggle);
+    abort(object_, cia402::sdo_abort_code::kToggle);
     return;
   }
   const std::size_t received = offset_ + m.length;
   if (received > kBufferSize) {
-    abort(object_, sdo_abort_code::kOutOfMemory);
+    abort(object_, cia402::sdo_abort_code::kOutOfMemory);
     return;
   }
   if (size_indicated_ && received > size_) {
-    abort(object_, sdo_abort_code::kTooLong);
+    abort(object_, cia402::sdo_abort_code::kTooLong);
     return;
   }
   std::copy_n(m.data.begin(), m.length, buffer_.begin() + static_cast<std::ptrdiff_t>(offset_));
   offset_ = received;
   if (m.last) {
     if (size_indicated_ && received != size_) {
-      abort(object_, sdo_abort_code::kTooShort);
+      abort(object_, cia402::sdo_abort_code::kTooShort);
       return;
     }
     // The object is written before the last segment is confirmed, so that a refused value is
@@ -170,7 +170,7 @@ void SdoServer::download_segment(const SdoMessage& m, core::TimePoint now) noexc
 void SdoServer::upload_segment(const SdoMessage& m, core::TimePoint now) noexcept {
   if (m.toggle != toggle_) {
     ++counters_.toggle_errors;
-    abort(object_, sdo_abort_code::kToggle);
+    abort(object_, cia402::sdo_abort_code::kToggle);
     return;
   }
   const std::size_t n = std::min<std::size_t>(7, size_ - offset_);
@@ -207,7 +207,7 @@ void SdoServer::abort(ObjectId object, std::uint32_t code) noexcept {
 void SdoServer::poll(core::TimePoint now, TxQueue& tx) noexcept {
   if (state_ != State::Idle && now >= deadline_) {
     ++counters_.timeouts;
-    abort(object_, sdo_abort_code::kTimeout);
+    abort(object_, cia402::sdo_abort_code::kTimeout);
   }
   for (; !outbox_.empty(); outbox_.pop()) {
     if (!tx.push(outbox_.front())) ++counters_.tx_full;

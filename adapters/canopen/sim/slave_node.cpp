@@ -11,7 +11,7 @@
 namespace drivegate::canopen::sim {
 namespace {
 
-namespace abort = sdo_abort_code;
+namespace abort = cia402::sdo_abort_code;
 using cia402::DataType;
 using cia402::ObjectId;
 using cia402::sim::Access;

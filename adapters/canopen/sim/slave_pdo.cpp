@@ -10,7 +10,7 @@
 namespace drivegate::canopen::sim {
 namespace {
 
-namespace abort = sdo_abort_code;
+namespace abort = cia402::sdo_abort_code;
 
 // The slot of a parameter object (RPDO 1..4 = 0..3, TPDO 1..4 = 4..7) and whether it is the
 // mapping; -1 for other indices.

@@ -9,6 +9,7 @@
 #include <span>
 
 #include "profiles/cia402/objects.hpp"
+#include "profiles/cia402/sdo_abort.hpp"
 
 namespace drivegate::canopen {
 
@@ -74,27 +75,5 @@ SdoBytes sdo_upload_expedited_response(ObjectId o, std::uint32_t value, std::uin
 SdoBytes sdo_upload_initiate_response(ObjectId o, std::uint32_t total_size) noexcept;  // 41h
 SdoBytes sdo_upload_segment(bool toggle, std::span<const std::uint8_t> bytes, bool last) noexcept;
 SdoBytes sdo_abort(ObjectId o, std::uint32_t code) noexcept;                          // 80h
-
-// CiA 301 abort codes used by the client and server [CiA 301 §7.2.4.3.17; AKD part 1 §10.4].
-namespace sdo_abort_code {
-inline constexpr std::uint32_t kToggle = 0x05030000;
-inline constexpr std::uint32_t kTimeout = 0x05040000;
-inline constexpr std::uint32_t kUnknownCommand = 0x05040001;
-inline constexpr std::uint32_t kOutOfMemory = 0x05040005;
-inline constexpr std::uint32_t kUnsupportedAccess = 0x06010000;
-inline constexpr std::uint32_t kWriteOnly = 0x06010001;
-inline constexpr std::uint32_t kReadOnly = 0x06010002;
-inline constexpr std::uint32_t kNoObject = 0x06020000;
-inline constexpr std::uint32_t kNotMappable = 0x06040041;
-inline constexpr std::uint32_t kPdoLength = 0x06040042;
-inline constexpr std::uint32_t kTypeMismatch = 0x06070010;
-inline constexpr std::uint32_t kTooLong = 0x06070012;
-inline constexpr std::uint32_t kTooShort = 0x06070013;
-inline constexpr std::uint32_t kNoSubIndex = 0x06090011;
-inline constexpr std::uint32_t kValueRange = 0x06090030;
-inline constexpr std::uint32_t kGeneral = 0x08000000;
-inline constexpr std::uint32_t kCannotStore = 0x08000020;
-inline constexpr std::uint32_t kDeviceState = 0x08000022;
-}  // namespace sdo_abort_code
 
 }  // namespace drivegate::canopen

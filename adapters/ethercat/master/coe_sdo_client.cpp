@@ -4,24 +4,15 @@
 
 #include "adapters/ethercat/wire/bytes.hpp"
 #include "adapters/ethercat/wire/registers.hpp"
+#include "profiles/cia402/sdo_abort.hpp"
 
 namespace drivegate::ethercat {
 namespace {
-
-// CiA 301 §7.2.4.3.17 abort codes the client raises itself (CoE reuses them, ETG.1000.6 §5.6.2.7.2).
-constexpr std::uint32_t kAbortToggle = 0x05030000;
-constexpr std::uint32_t kAbortTimeout = 0x05040000;
-constexpr std::uint32_t kAbortOutOfMemory = 0x05040005;
-constexpr std::uint32_t kAbortGeneral = 0x08000000;
 
 // Bytes in front of the data: mailbox header 6 + CoE header 2 + SDO command, index, subindex, size
 // (8) for a normal initiate; + command byte (1) for a segment [ETG.1000.6 §5.6.2.2-§5.6.2.5].
 constexpr std::size_t kInitiateOverhead = kMailboxHeaderSize + kCoeHeaderSize + kSdoHeaderSize;
 constexpr std::size_t kSegmentOverhead = kMailboxHeaderSize + kCoeHeaderSize + 1;
-
-constexpr std::uint16_t kSm1Status = reg::sm(1) + 5;     // 080Dh
-constexpr std::uint16_t kSm1Activate = reg::sm(1) + 6;   // 080Eh
-constexpr std::uint16_t kSm1PdiControl = reg::sm(1) + 7; // 080Fh
 
 }  // namespace
 
@@ -143,51 +134,48 @@ void CoeSdoClient::finish(Slot& s, SlotState state, std::uint32_t abort_code) no
   write_due_ = false;
 }
 
-void CoeSdoClient::prepare_initiate(Slot& s) noexcept {
+template <class Encode>
+void CoeSdoClient::prepare(Expect expect, Encode&& encode) noexcept {
+  // The whole SM0 mailbox is written (its last byte hands it to the slave): zero what follows the
+  // request, stamp the next mailbox counter.
   counter_ = next_mailbox_counter(counter_);
-  std::fill(out_.begin(), out_.end(), std::uint8_t{0});
   const std::span<std::uint8_t> out(out_.data(), mailbox_.rx_size);
-  std::size_t n = 0;
-  if (s.upload) {
-    n = encode_sdo_upload_request(out, counter_, s.index, s.subindex);
-  } else if (s.capacity <= 4) {  // expedited [ETG.1000.6 §5.6.2.1]
-    n = encode_sdo_download_expedited(out, counter_, s.index, s.subindex, {s.from, s.capacity});
-    s.done = s.capacity;
-  } else {  // normal: as much as the mailbox carries, segments for the rest
-    const std::size_t first = std::min(s.capacity, static_cast<std::size_t>(mailbox_.rx_size) - kInitiateOverhead);
-    n = encode_sdo_download_normal(out, counter_, s.index, s.subindex, static_cast<std::uint32_t>(s.capacity),
-                                   {s.from, first});
-    s.done = first;
-  }
-  out_size_ = n == 0 ? 0 : mailbox_.rx_size;
-  expect_ = Expect::Initiate;
-  toggle_ = false;
+  std::fill(out.begin(), out.end(), std::uint8_t{0});
+  out_size_ = encode(out) == 0 ? 0 : out.size();
+  expect_ = expect;
   phase_ = Phase::Write;
   write_due_ = true;
+}
+
+void CoeSdoClient::prepare_initiate(Slot& s) noexcept {
+  toggle_ = false;
+  prepare(Expect::Initiate, [&](std::span<std::uint8_t> out) -> std::size_t {
+    if (s.upload) return encode_sdo_upload_request(out, counter_, s.index, s.subindex);
+    if (s.capacity <= 4) {  // expedited [ETG.1000.6 §5.6.2.1]
+      s.done = s.capacity;
+      return encode_sdo_download_expedited(out, counter_, s.index, s.subindex, {s.from, s.capacity});
+    }
+    // Normal: as much as the mailbox carries, segments for the rest.
+    const std::size_t first = std::min(s.capacity, out.size() - kInitiateOverhead);
+    s.done = first;
+    return encode_sdo_download_normal(out, counter_, s.index, s.subindex, static_cast<std::uint32_t>(s.capacity),
+                                      {s.from, first});
+  });
 }
 
 void CoeSdoClient::prepare_download_segment(Slot& s) noexcept {
-  counter_ = next_mailbox_counter(counter_);
-  std::fill(out_.begin(), out_.end(), std::uint8_t{0});
-  const std::size_t chunk = std::min(s.capacity - s.done, static_cast<std::size_t>(mailbox_.rx_size) - kSegmentOverhead);
-  const bool last = s.done + chunk >= s.capacity;
-  (void)encode_sdo_download_segment(std::span<std::uint8_t>(out_.data(), mailbox_.rx_size), counter_, toggle_, last,
-                                    {s.from + s.done, chunk});
-  s.done += chunk;
-  out_size_ = mailbox_.rx_size;
-  expect_ = Expect::Segment;
-  phase_ = Phase::Write;
-  write_due_ = true;
+  prepare(Expect::Segment, [&](std::span<std::uint8_t> out) {
+    const std::size_t chunk = std::min(s.capacity - s.done, out.size() - kSegmentOverhead);
+    const bool last = s.done + chunk >= s.capacity;
+    const std::size_t n = encode_sdo_download_segment(out, counter_, toggle_, last, {s.from + s.done, chunk});
+    s.done += chunk;
+    return n;
+  });
 }
 
 void CoeSdoClient::prepare_upload_segment() noexcept {
-  counter_ = next_mailbox_counter(counter_);
-  std::fill(out_.begin(), out_.end(), std::uint8_t{0});
-  (void)encode_sdo_upload_segment_request(std::span<std::uint8_t>(out_.data(), mailbox_.rx_size), counter_, toggle_);
-  out_size_ = mailbox_.rx_size;
-  expect_ = Expect::Segment;
-  phase_ = Phase::Write;
-  write_due_ = true;
+  prepare(Expect::Segment,
+          [&](std::span<std::uint8_t> out) { return encode_sdo_upload_segment_request(out, counter_, toggle_); });
 }
 
 void CoeSdoClient::start_next(core::TimePoint now) noexcept {
@@ -216,14 +204,14 @@ void CoeSdoClient::poll(core::TimePoint now, Transactions& tx) noexcept {
   if (waiting_) return;
   if (active_ != nullptr && now >= deadline_) {
     ++counters_.timeouts;
-    finish(*active_, SlotState::Failed, kAbortTimeout);
+    finish(*active_, SlotState::Failed, cia402::sdo_abort_code::kTimeout);
   }
   if (active_ == nullptr) start_next(now);
   switch (phase_) {
     case Phase::Idle:
       // Nothing of ours in flight: still look for emergencies now and then.
       if (emergencies_ != nullptr && now >= next_status_poll_) {
-        if (queue(tx, Command::FPRD, kSm1Status, 1)) next_status_poll_ = now + timing_.poll_interval;
+        if (queue(tx, Command::FPRD, reg::sm_status(1), 1)) next_status_poll_ = now + timing_.poll_interval;
       }
       return;
     case Phase::Write:
@@ -232,11 +220,11 @@ void CoeSdoClient::poll(core::TimePoint now, Transactions& tx) noexcept {
         (void)queue(tx, Command::FPWR, mailbox_.rx_offset, static_cast<std::uint16_t>(out_size_),
                     std::span<const std::uint8_t>(out_.data(), out_size_));
       } else if (out_size_ == 0 && active_ != nullptr) {
-        finish(*active_, SlotState::Failed, kAbortGeneral);  // could not encode (cannot happen when valid())
+        finish(*active_, SlotState::Failed, cia402::sdo_abort_code::kGeneral);  // could not encode (cannot happen when valid())
       }
       return;
     case Phase::Wait:
-      if (now >= next_status_poll_ && queue(tx, Command::FPRD, kSm1Status, 1)) {
+      if (now >= next_status_poll_ && queue(tx, Command::FPRD, reg::sm_status(1), 1)) {
         next_status_poll_ = now + timing_.poll_interval;
       }
       return;
@@ -247,11 +235,11 @@ void CoeSdoClient::poll(core::TimePoint now, Transactions& tx) noexcept {
       // Toggle the repeat request in SM1's activate register [ETG.1000.4 §6 SyncManager: repeat].
       const std::array<std::uint8_t, 1> act{
           static_cast<std::uint8_t>(sm_activate::kEnable | (repeat_bit_ ? sm_activate::kRepeat : 0))};
-      (void)queue(tx, Command::FPWR, kSm1Activate, 1, act);
+      (void)queue(tx, Command::FPWR, reg::sm_activation(1), 1, act);
       return;
     }
     case Phase::RepeatWait:
-      if (now >= next_status_poll_ && queue(tx, Command::FPRD, kSm1PdiControl, 1)) {
+      if (now >= next_status_poll_ && queue(tx, Command::FPRD, reg::sm_pdi_control(1), 1)) {
         next_status_poll_ = now + timing_.poll_interval;
       }
       return;
@@ -299,7 +287,7 @@ void CoeSdoClient::on_result(std::uint32_t tag, const DatagramAnswer& a) noexcep
       }
       return;
     case Phase::RepeatWait:
-      if (!lost && a.wkc == 1 && !a.data.empty() && ((a.data[0] & 0x02) != 0) == repeat_bit_) phase_ = Phase::Read;
+      if (!lost && a.wkc == 1 && !a.data.empty() && ((a.data[0] & sm_pdi_control::kRepeatAck) != 0) == repeat_bit_) phase_ = Phase::Read;
       return;
   }
 }
@@ -321,7 +309,7 @@ void CoeSdoClient::on_mailbox(std::span<const std::uint8_t> mb) noexcept {
     const MailboxErrorReply e = decode_mailbox_error(mb);
     if (active_ != nullptr) {
       active_->result.mailbox_error = e.detail;
-      finish(*active_, SlotState::Failed, kAbortGeneral);
+      finish(*active_, SlotState::Failed, cia402::sdo_abort_code::kGeneral);
     } else {
       ++counters_.unexpected;
     }
@@ -375,7 +363,7 @@ void CoeSdoClient::on_sdo(Slot& s, const CoeSdo& sdo) noexcept {
     return;
   }
   if (!initiate && sdo.toggle != toggle_) {  // CiA 301 §7.2.4.3: toggle alternates per segment
-    finish(s, SlotState::Failed, kAbortToggle);
+    finish(s, SlotState::Failed, cia402::sdo_abort_code::kToggle);
     return;
   }
   if (!s.upload) {
@@ -389,7 +377,7 @@ void CoeSdoClient::on_sdo(Slot& s, const CoeSdo& sdo) noexcept {
   }
   // Upload: copy what came.
   if (s.done + sdo.data.size() > s.capacity) {
-    finish(s, SlotState::Failed, kAbortOutOfMemory);
+    finish(s, SlotState::Failed, cia402::sdo_abort_code::kOutOfMemory);
     return;
   }
   std::copy(sdo.data.begin(), sdo.data.end(), s.into + s.done);
@@ -399,12 +387,12 @@ void CoeSdoClient::on_sdo(Slot& s, const CoeSdo& sdo) noexcept {
       finish(s, SlotState::Done, 0);
       return;
     }
-    s.total = sdo.size;
-    if (s.total > s.capacity) {
-      finish(s, SlotState::Failed, kAbortOutOfMemory);
+    const std::size_t total = sdo.size;  // the size the server indicated
+    if (total > s.capacity) {
+      finish(s, SlotState::Failed, cia402::sdo_abort_code::kOutOfMemory);
       return;
     }
-    if (s.done >= s.total) {
+    if (s.done >= total) {
       finish(s, SlotState::Done, 0);
     } else {
       prepare_upload_segment();

@@ -106,7 +106,6 @@ class CoeSdoClient final : public DatagramOwner {
     const std::uint8_t* from = nullptr;    // download source (caller's or inline)
     std::size_t capacity = 0;              // of into / size of from
     std::size_t done = 0;                  // bytes received / sent
-    std::size_t total = 0;                 // upload: size the server indicated
     std::array<std::uint8_t, kInline> inline_bytes{};
     CoeSdoResult result{};
   };
@@ -117,6 +116,10 @@ class CoeSdoClient final : public DatagramOwner {
                   const std::uint8_t* from, std::size_t size) noexcept;
   [[nodiscard]] const Slot* find(CoeSdoId id) const noexcept;
   void start_next(core::TimePoint now) noexcept;
+  // Writes the next request into out_ (zeroed, the SM0 mailbox size) with `encode(out)`, which
+  // returns the bytes encoded (0: failed, the transfer fails at the next poll), and moves to Write.
+  template <class Encode>
+  void prepare(Expect expect, Encode&& encode) noexcept;
   void prepare_initiate(Slot& s) noexcept;
   void prepare_download_segment(Slot& s) noexcept;
   void prepare_upload_segment() noexcept;

@@ -25,11 +25,12 @@ constexpr std::size_t kFmmuBlockBytes = 16 * reg::kFmmuSize;  // 16 FMMUs [ETG.1
 constexpr std::size_t kSmBlockBytes = 16 * reg::kSmSize;      // 16 SyncManagers [ETG.1000.4 Table 59]
 constexpr std::array<std::uint8_t, kFmmuBlockBytes> kZeros{};
 
-// End of the SII category list within the first `size` bytes: the category list starts at word
-// 40h, each category is type, size (words), data [ETG.1000.6 §5.4]. Returns true when the end
+// End of the SII category list within the bytes read so far: the category list starts at word
+// 40h, each category is type, size (words), data [ETG.1000.6 §5.4]. `at` is the offset of the next
+// category header not yet walked (kSiiHeaderBytes at first); it is advanced over the categories
+// whose header has been read, so each chunk walks only what is new. Returns true when the end
 // marker (type FFFFh) has been read.
-bool sii_end_seen(std::span<const std::uint8_t> image) noexcept {
-  std::size_t at = kSiiHeaderBytes;
+bool sii_end_seen(std::span<const std::uint8_t> image, std::size_t& at) noexcept {
   while (at + 2 <= image.size()) {
     if (get_u16(image, at) == static_cast<std::uint16_t>(SiiCategory::End)) return true;
     if (at + 4 > image.size()) return false;
@@ -241,10 +242,7 @@ void LineBoot::on_result(std::uint32_t tag, const DatagramAnswer& a) noexcept {
       s.pending.due = true;
       return;
     }
-    fail(s, s.phase == Phase::Mailbox ? BootStep::Mailbox
-            : s.phase >= Phase::AlRequest ? BootStep::Transition
-                                          : BootStep::Sii,
-         "no answer to %.*s 0x%04X (frame lost %d times)", static_cast<int>(command_name(a.command).size()),
+    fail(s, step_of(s.phase), "no answer to %.*s 0x%04X (frame lost %d times)", static_cast<int>(command_name(a.command).size()),
          command_name(a.command).data(), static_cast<unsigned>(a.address >> 16), config_.retries + 1);
     return;
   }
@@ -317,6 +315,7 @@ void LineBoot::line_group_done() noexcept {
     s.report.step = BootStep::Sii;
     s.image_size = 0;
     s.sii_word = 0;
+    s.sii_next_category = kSiiHeaderBytes;
     s.phase = Phase::SiiStatus;
     s.deadline = now_ + config_.sii_timeout;
     slave_phase(s);
@@ -389,13 +388,15 @@ void LineBoot::slave_phase(Slave& s) noexcept {
   }
 }
 
+BootStep LineBoot::step_of(Phase p) noexcept {
+  if (p == Phase::Mailbox) return BootStep::Mailbox;
+  return p >= Phase::AlRequest ? BootStep::Transition : BootStep::Sii;
+}
+
 void LineBoot::slave_answer(Slave& s, const DatagramAnswer& a) noexcept {
   // Every datagram here addresses one slave by its station address: WKC 1 when it executed it.
   if (a.wkc != 1) {
-    const BootStep step = s.phase == Phase::Mailbox ? BootStep::Mailbox
-                          : s.phase >= Phase::AlRequest ? BootStep::Transition
-                                                        : BootStep::Sii;
-    fail(s, step, "%.*s 0x%04X not executed (WKC %u)", static_cast<int>(command_name(a.command).size()),
+    fail(s, step_of(s.phase), "%.*s 0x%04X not executed (WKC %u)", static_cast<int>(command_name(a.command).size()),
          command_name(a.command).data(), static_cast<unsigned>(a.address >> 16), a.wkc);
     return;
   }
@@ -474,7 +475,7 @@ void LineBoot::sii_chunk(Slave& s, std::span<const std::uint8_t> data) noexcept 
   s.image_size += n;
   s.sii_word += static_cast<std::uint32_t>(data.size() / 2);
   const std::span<const std::uint8_t> image(s.image.data(), s.image_size);
-  if (s.image_size >= kSiiHeaderBytes && sii_end_seen(image)) {
+  if (s.image_size >= kSiiHeaderBytes && sii_end_seen(image, s.sii_next_category)) {
     parse_sii(image, s.info);
     if (!s.info.ok()) {
       SiiProblem first = SiiProblem::ImageTooShort;
@@ -515,7 +516,6 @@ void LineBoot::identify(Slave& s) noexcept {
   }
   const ExpectedSlave& e = expected_[s.report.position];
   if (f.vendor_id != e.vendor_id || f.product_code != e.product_code || (e.revision != 0 && f.revision != e.revision)) {
-    s.report.identity_mismatch = true;
     fail(s, BootStep::Identity,
          "identity mismatch: expected vendor 0x%08X product 0x%08X revision 0x%08X, found vendor 0x%08X product "
          "0x%08X revision 0x%08X",

@@ -82,9 +82,13 @@ struct SlaveReport {
   AlState state = AlState::Init;  // last state read (INIT after the reset)
   AlState target = AlState::Init; // of the last transition requested
   std::uint16_t al_code = 0;      // AL status code of a refused transition
-  bool identity_mismatch = false;
   SiiIdentity found{};
   core::FixedString<240> text{};  // the failure / extra-slave sentence; empty when fine
+
+  // The slave's identity differs from the configured one (it stopped at the identity step).
+  [[nodiscard]] bool identity_mismatch() const noexcept {
+    return status == SlaveStatus::Failed && step == BootStep::Identity;
+  }
 };
 
 enum class LineStatus : std::uint8_t { Idle, Running, Done, Failed };
@@ -146,6 +150,7 @@ class LineBoot final : public DatagramOwner {
     std::uint16_t al_status_raw = 0;
     bool eight_byte_reads = false;
     std::uint32_t sii_word = 0;  // next word address to read
+    std::size_t sii_next_category = 0;  // image offset of the next SII category header to walk
     std::size_t image_size = 0;
     std::array<std::uint8_t, kMaxSiiBytes> image{};
     SiiInfo info{};
@@ -161,6 +166,8 @@ class LineBoot final : public DatagramOwner {
   void queue_addresses(Transactions& tx) noexcept;
   void slave_answer(Slave& s, const DatagramAnswer& a) noexcept;
   void slave_phase(Slave& s) noexcept;  // sets the pending datagram of the phase just entered
+  // The boot step a slave in phase `p` is at (the step a failure there is reported under).
+  [[nodiscard]] static BootStep step_of(Phase p) noexcept;
   void sii_chunk(Slave& s, std::span<const std::uint8_t> data) noexcept;
   void identify(Slave& s) noexcept;
   void begin_transition(Slave& s, AlState target) noexcept;

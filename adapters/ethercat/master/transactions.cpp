@@ -31,7 +31,6 @@ Transactions::FrameSlot* Transactions::open_slot() noexcept {
     s.index = index;
     s.order = next_order_++;
     s.count = 0;
-    s.size = 0;
     // Broadcast destination: slaves forward any destination [ETG.1000.4 §5.3].
     s.builder = FrameBuilder(s.bytes, kBroadcastMac, source_);
     return &s;
@@ -84,10 +83,9 @@ std::span<const std::span<const std::uint8_t>> Transactions::take_frames(core::T
       s.state = SlotState::Free;
       continue;
     }
-    s.size = frame.size();
     s.deadline = deadline;
     s.state = SlotState::InFlight;
-    outgoing_[out++] = std::span<const std::uint8_t>(s.bytes.data(), s.size);
+    outgoing_[out++] = frame;
     ++counters_.frames_sent;
   }
   return {outgoing_.data(), out};
@@ -111,32 +109,32 @@ bool Transactions::matches(const Entry& e, const Datagram& d, std::uint8_t index
 }
 
 bool Transactions::on_frame(std::span<const std::uint8_t> frame) noexcept {
-  FrameParser first(frame);
-  Datagram d;
-  if (!first.next(d)) {
-    ++counters_.malformed;
-    frame_errors_.count(first.error() == FrameError::None ? FrameError::EmptyFrame : first.error());
-    return false;
-  }
+  // One pass over the frame: the first datagram's index names the frame in flight, each datagram
+  // is checked against the one sent in its place and kept. Results are all or nothing: delivered
+  // only when the whole frame is well-formed and matches.
+  std::array<Datagram, kMaxDatagramsPerFrame> got{};
   FrameSlot* slot = nullptr;
-  for (auto& s : slots_) {
-    if (s.state == SlotState::InFlight && s.index == d.header.index) slot = &s;
-  }
-  // Check the whole frame before delivering anything: results are all or nothing.
+  bool same = true;
   std::size_t n = 0;
-  bool same = slot != nullptr;
-  {
-    FrameParser p(frame);
-    Datagram x;
-    while (p.next(x)) {
-      if (slot != nullptr && (n >= slot->count || !matches(slot->entries[n], x, slot->index))) same = false;
-      ++n;
+  FrameParser p(frame);
+  Datagram d;
+  while (p.next(d)) {
+    if (n == 0) {
+      for (auto& s : slots_) {
+        if (s.state == SlotState::InFlight && s.index == d.header.index) slot = &s;
+      }
     }
-    if (p.error() != FrameError::None) {
-      ++counters_.malformed;
-      frame_errors_.count(p.error());
-      return false;
+    if (slot != nullptr && n < slot->count && matches(slot->entries[n], d, slot->index)) {
+      got[n] = d;
+    } else {
+      same = false;
     }
+    ++n;
+  }
+  if (p.error() != FrameError::None || n == 0) {
+    ++counters_.malformed;
+    frame_errors_.count(p.error() == FrameError::None ? FrameError::EmptyFrame : p.error());
+    return false;
   }
   if (slot == nullptr) {
     ++counters_.foreign;
@@ -146,13 +144,11 @@ bool Transactions::on_frame(std::span<const std::uint8_t> frame) noexcept {
     ++counters_.mismatched;
     return false;
   }
-  FrameParser p(frame);
-  std::size_t i = 0;
-  while (p.next(d)) {
-    const Entry& e = slot->entries[i++];
+  for (std::size_t i = 0; i < n; ++i) {
+    const Entry& e = slot->entries[i];
     ++counters_.datagrams_answered;
     if (e.owner != nullptr) {
-      e.owner->on_result(e.tag, DatagramAnswer{DatagramOutcome::Answered, e.command, e.address, d.data, d.wkc});
+      e.owner->on_result(e.tag, DatagramAnswer{DatagramOutcome::Answered, e.command, e.address, got[i].data, got[i].wkc});
     }
   }
   ++counters_.frames_returned;
@@ -192,14 +188,6 @@ void Transactions::forget(const DatagramOwner* owner) noexcept {
 std::size_t Transactions::frames_in_flight() const noexcept {
   return static_cast<std::size_t>(
       std::count_if(slots_.begin(), slots_.end(), [](const FrameSlot& s) { return s.state == SlotState::InFlight; }));
-}
-
-std::size_t Transactions::datagrams_pending() const noexcept {
-  std::size_t n = 0;
-  for (const auto& s : slots_) {
-    if (s.state != SlotState::Free) n += s.count;
-  }
-  return n;
 }
 
 }  // namespace drivegate::ethercat

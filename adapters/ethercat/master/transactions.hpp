@@ -98,7 +98,6 @@ class Transactions {
   void forget(const DatagramOwner* owner) noexcept;
 
   [[nodiscard]] std::size_t frames_in_flight() const noexcept;
-  [[nodiscard]] std::size_t datagrams_pending() const noexcept;  // queued or in flight
   [[nodiscard]] const TransactionCounters& counters() const noexcept { return counters_; }
   [[nodiscard]] const FrameErrorCounters& frame_errors() const noexcept { return frame_errors_; }
 
@@ -117,7 +116,6 @@ class Transactions {
     std::uint64_t order = 0;  // queue order of Building frames
     core::TimePoint deadline{};
     std::array<std::uint8_t, kMaxFrameSize> bytes{};
-    std::size_t size = 0;
     FrameBuilder builder{std::span<std::uint8_t>{}, kBroadcastMac, kBroadcastMac};
     std::array<Entry, kMaxDatagramsPerFrame> entries{};
     std::size_t count = 0;

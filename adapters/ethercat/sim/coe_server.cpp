@@ -19,14 +19,15 @@ std::span<std::uint8_t> MailboxOutbox::reserve() noexcept {
   return {s.bytes.data(), s.bytes.size()};
 }
 
-void MailboxOutbox::commit(std::size_t size) noexcept {
-  if (full() || size < kMailboxHeaderSize || size > mailbox_size_) return;
+bool MailboxOutbox::commit(std::size_t size) noexcept {
+  if (full() || size < kMailboxHeaderSize || size > mailbox_size_) return false;
   Slot& s = slots_[(head_ + count_) % slots_.size()];
   counter_ = next_mailbox_counter(counter_);
   // Mailbox header byte 5: type bits 0-3, counter bits 4-6 [ETG.1000.6 mailbox header].
   s.bytes[5] = static_cast<std::uint8_t>((s.bytes[5] & 0x0F) | (counter_ << 4));
   s.size = size;
   ++count_;
+  return true;
 }
 
 bool MailboxOutbox::push_front(std::span<const std::uint8_t> msg) noexcept {
@@ -51,6 +52,12 @@ void MailboxOutbox::pop() noexcept {
   --count_;
 }
 
+void MailboxOutbox::drop_front() noexcept {
+  if (count_ == 0) return;
+  pop();
+  ++dropped_;
+}
+
 void MailboxOutbox::clear() noexcept {
   head_ = 0;
   count_ = 0;
@@ -67,20 +74,19 @@ void CoeServer::reset() noexcept {
 }
 
 void CoeServer::on_request(std::span<const std::uint8_t> mailbox, AlState state, MailboxOutbox& out) noexcept {
-  ++requests_;
   const CoeView c = decode_coe(mailbox);
   if (c.error != MailboxError::None) {
     // A CoE header cut off: mailbox error "size too short" [ETG.1000.6 mailbox error reply].
-    const auto buf = out.reserve();
-    if (!buf.empty()) out.commit(encode_mailbox_error(buf, 0, mailbox_error_code::kSizeTooShort));
+    out.emit([](std::span<std::uint8_t> buf) { return encode_mailbox_error(buf, 0, mailbox_error_code::kSizeTooShort); });
     return;
   }
   switch (static_cast<CoeService>(c.service)) {
     case CoeService::SdoRequest: sdo(mailbox, state, out); break;
     case CoeService::SdoInformation: info(mailbox, out); break;
     default: {
-      const auto buf = out.reserve();
-      if (!buf.empty()) out.commit(encode_mailbox_error(buf, 0, mailbox_error_code::kServiceNotSupported));
+      out.emit([](std::span<std::uint8_t> buf) {
+        return encode_mailbox_error(buf, 0, mailbox_error_code::kServiceNotSupported);
+      });
       break;
     }
   }
@@ -88,20 +94,20 @@ void CoeServer::on_request(std::span<const std::uint8_t> mailbox, AlState state,
 
 void CoeServer::abort(MailboxOutbox& out, std::uint16_t index, std::uint8_t subindex, std::uint32_t code) noexcept {
   reset();
-  const auto buf = out.reserve();
-  if (buf.empty()) return;
-  out.commit(encode_sdo_abort(buf, 0, index, subindex, code));
+  out.emit([&](std::span<std::uint8_t> buf) { return encode_sdo_abort(buf, 0, index, subindex, code); });
 }
 
 void CoeServer::upload_segment(bool toggle, MailboxOutbox& out) noexcept {
-  const auto buf = out.reserve();
-  if (buf.empty()) return;
   // Segment: mailbox header, CoE header, command byte, data [ETG.1000.6 §5.6.2.6].
   const std::size_t room = out.mailbox_size() - kMailboxHeaderSize - kCoeHeaderSize - 1;
   const std::size_t n = std::min(room, size_ - done_);
   const bool last = done_ + n >= size_;
-  out.commit(encode_sdo_upload_segment_response(buf, 0, toggle, last,
-                                                std::span<const std::uint8_t>(buffer_.data() + done_, n)));
+  const std::span<const std::uint8_t> data(buffer_.data() + done_, n);
+  if (!out.emit([&](std::span<std::uint8_t> buf) {
+        return encode_sdo_upload_segment_response(buf, 0, toggle, last, data);
+      })) {
+    return;
+  }
   done_ += n;
   toggle_ = !toggle;
   if (last) reset();
@@ -112,32 +118,36 @@ void CoeServer::sdo(std::span<const std::uint8_t> mailbox, AlState state, Mailbo
   if (v.error != MailboxError::None) {
     // An undecodable command specifier aborts [CiA 301 §7.2.4.3.17 05040001h]; a cut-off SDO
     // cannot name its object.
-    abort(out, 0, 0, abort_code::kUnknownCommand);
+    abort(out, 0, 0, cia402::sdo_abort_code::kUnknownCommand);
     return;
   }
   const CoeSdo& s = v.sdo;
   if (s.complete_access) {
-    abort(out, s.index, s.subindex, abort_code::kUnsupportedAccess);
+    abort(out, s.index, s.subindex, cia402::sdo_abort_code::kUnsupportedAccess);
     return;
   }
   switch (s.command) {
     case SdoCommand::UploadInitiateRequest: {
       reset();
-      if (od_ == nullptr) return abort(out, s.index, s.subindex, abort_code::kObjectDoesNotExist);
+      if (od_ == nullptr) return abort(out, s.index, s.subindex, cia402::sdo_abort_code::kNoObject);
       const OdReadResult r = od_->read(s.index, s.subindex, buffer_, state);
       if (r.abort_code != 0) return abort(out, s.index, s.subindex, r.abort_code);
-      const auto buf = out.reserve();
-      if (buf.empty()) return;
       if (r.size > 0 && r.size <= 4) {
-        out.commit(encode_sdo_upload_expedited_response(buf, 0, s.index, s.subindex,
-                                                        std::span<const std::uint8_t>(buffer_.data(), r.size)));
+        const std::span<const std::uint8_t> value(buffer_.data(), r.size);
+        out.emit([&](std::span<std::uint8_t> buf) {
+          return encode_sdo_upload_expedited_response(buf, 0, s.index, s.subindex, value);
+        });
         return;
       }
       // Normal upload [ETG.1000.6 §5.6.2.4]: complete size, then what fits after the 16 header bytes.
       const std::size_t room = out.mailbox_size() - kMailboxHeaderSize - kCoeHeaderSize - kSdoHeaderSize - 0;
       const std::size_t n = std::min(room, r.size);
-      out.commit(encode_sdo_upload_normal_response(buf, 0, s.index, s.subindex, static_cast<std::uint32_t>(r.size),
-                                                   std::span<const std::uint8_t>(buffer_.data(), n)));
+      const std::span<const std::uint8_t> first(buffer_.data(), n);
+      if (!out.emit([&](std::span<std::uint8_t> buf) {
+            return encode_sdo_upload_normal_response(buf, 0, s.index, s.subindex, static_cast<std::uint32_t>(r.size), first);
+          })) {
+        return;
+      }
       if (n < r.size) {
         transfer_ = Transfer::Upload;
         index_ = s.index;
@@ -149,24 +159,23 @@ void CoeServer::sdo(std::span<const std::uint8_t> mailbox, AlState state, Mailbo
       return;
     }
     case SdoCommand::UploadSegmentRequest:
-      if (transfer_ != Transfer::Upload) return abort(out, 0, 0, abort_code::kUnknownCommand);
-      if (s.toggle != toggle_) return abort(out, index_, subindex_, abort_code::kToggleNotAlternated);
+      if (transfer_ != Transfer::Upload) return abort(out, 0, 0, cia402::sdo_abort_code::kUnknownCommand);
+      if (s.toggle != toggle_) return abort(out, index_, subindex_, cia402::sdo_abort_code::kToggle);
       upload_segment(s.toggle, out);
       return;
     case SdoCommand::DownloadInitiateRequest: {
       reset();
-      if (od_ == nullptr) return abort(out, s.index, s.subindex, abort_code::kObjectDoesNotExist);
+      if (od_ == nullptr) return abort(out, s.index, s.subindex, cia402::sdo_abort_code::kNoObject);
       if (s.expedited || s.data.size() >= s.size) {
         const std::span<const std::uint8_t> value =
             s.expedited ? s.data : s.data.first(std::min<std::size_t>(s.data.size(), s.size));
         const std::uint32_t code = od_->write(s.index, s.subindex, value, state);
         if (code != 0) return abort(out, s.index, s.subindex, code);
-        const auto buf = out.reserve();
-        if (!buf.empty()) out.commit(encode_sdo_download_response(buf, 0, s.index, s.subindex));
+        out.emit([&](std::span<std::uint8_t> buf) { return encode_sdo_download_response(buf, 0, s.index, s.subindex); });
         return;
       }
       // Segmented download: collect the segments, write at the last one [ETG.1000.6 §5.6.2.3].
-      if (s.size > buffer_.size()) return abort(out, s.index, s.subindex, abort_code::kOutOfMemory);
+      if (s.size > buffer_.size()) return abort(out, s.index, s.subindex, cia402::sdo_abort_code::kOutOfMemory);
       std::memcpy(buffer_.data(), s.data.data(), s.data.size());
       transfer_ = Transfer::Download;
       index_ = s.index;
@@ -174,13 +183,12 @@ void CoeServer::sdo(std::span<const std::uint8_t> mailbox, AlState state, Mailbo
       size_ = s.size;
       done_ = s.data.size();
       toggle_ = false;
-      const auto buf = out.reserve();
-      if (!buf.empty()) out.commit(encode_sdo_download_response(buf, 0, s.index, s.subindex));
+      out.emit([&](std::span<std::uint8_t> buf) { return encode_sdo_download_response(buf, 0, s.index, s.subindex); });
       return;
     }
     case SdoCommand::DownloadSegmentRequest: {
-      if (transfer_ != Transfer::Download) return abort(out, 0, 0, abort_code::kUnknownCommand);
-      if (s.toggle != toggle_) return abort(out, index_, subindex_, abort_code::kToggleNotAlternated);
+      if (transfer_ != Transfer::Download) return abort(out, 0, 0, cia402::sdo_abort_code::kUnknownCommand);
+      if (s.toggle != toggle_) return abort(out, index_, subindex_, cia402::sdo_abort_code::kToggle);
       const std::size_t n = std::min(s.data.size(), size_ - done_);
       // Bytes beyond the announced size are the segment padding (at least 7 bytes), not data.
       std::memcpy(buffer_.data() + done_, s.data.data(), n);
@@ -193,37 +201,35 @@ void CoeServer::sdo(std::span<const std::uint8_t> mailbox, AlState state, Mailbo
         const std::size_t done = done_;
         const std::size_t size = size_;
         reset();
-        if (done < size) return abort(out, index, subindex, abort_code::kLengthTooLow);
-        const std::uint32_t code = od_ == nullptr ? abort_code::kObjectDoesNotExist
+        if (done < size) return abort(out, index, subindex, cia402::sdo_abort_code::kTooShort);
+        const std::uint32_t code = od_ == nullptr ? cia402::sdo_abort_code::kNoObject
                                                   : od_->write(index, subindex,
                                                                std::span<const std::uint8_t>(buffer_.data(), size), state);
         if (code != 0) return abort(out, index, subindex, code);
       } else if (done_ >= size_ && s.data.size() > n) {
-        return abort(out, index_, subindex_, abort_code::kLengthTooHigh);
+        return abort(out, index_, subindex_, cia402::sdo_abort_code::kTooLong);
       }
-      const auto buf = out.reserve();
-      if (!buf.empty()) out.commit(encode_sdo_download_segment_response(buf, 0, toggle));
+      out.emit([&](std::span<std::uint8_t> buf) { return encode_sdo_download_segment_response(buf, 0, toggle); });
       return;
     }
     case SdoCommand::Abort:
       reset();  // a client abort ends the transfer; no answer [ETG.1000.6 §5.6.2.7]
       return;
     default:
-      return abort(out, s.index, s.subindex, abort_code::kUnknownCommand);
+      return abort(out, s.index, s.subindex, cia402::sdo_abort_code::kUnknownCommand);
   }
 }
 
 void CoeServer::info(std::span<const std::uint8_t> mailbox, MailboxOutbox& out) noexcept {
   const SdoInfoView v = decode_sdo_info(mailbox);
   auto error = [&](std::uint32_t code) {
-    const auto buf = out.reserve();
-    if (!buf.empty()) out.commit(encode_sdo_info_error(buf, 0, code));
+    out.emit([&](std::span<std::uint8_t> buf) { return encode_sdo_info_error(buf, 0, code); });
   };
-  if (v.error != MailboxError::None || od_ == nullptr) return error(abort_code::kUnknownCommand);
+  if (v.error != MailboxError::None || od_ == nullptr) return error(cia402::sdo_abort_code::kUnknownCommand);
   switch (v.opcode) {
     case SdoInfoOpcode::GetOdListRequest: {
       const auto type = static_cast<OdListType>(v.list_type);
-      if (v.list_type > static_cast<std::uint16_t>(OdListType::Startup)) return error(abort_code::kUnsupportedAccess);
+      if (v.list_type > static_cast<std::uint16_t>(OdListType::Startup)) return error(cia402::sdo_abort_code::kUnsupportedAccess);
       std::size_t total = 0;
       if (type == OdListType::Lengths) {
         // List type 0: the five list lengths [ETG.1000.6 §5.6.3.3].
@@ -243,13 +249,13 @@ void CoeServer::info(std::span<const std::uint8_t> mailbox, MailboxOutbox& out) 
       for (std::size_t f = 0; f < fragments; ++f) {
         const std::size_t cap = first ? room - 1 : room;
         const std::size_t n = std::min(cap, total - at);
-        const auto buf = out.reserve();
-        if (buf.empty()) {
-          out.count_drop();
+        const auto left = static_cast<std::uint16_t>(fragments - 1 - f);
+        const std::span<const std::uint16_t> part(list_.data() + at, n);
+        if (!out.emit([&](std::span<std::uint8_t> buf) {
+              return encode_get_od_list_response(buf, 0, type, first, left, part);
+            })) {
           return;
         }
-        out.commit(encode_get_od_list_response(buf, 0, type, first, static_cast<std::uint16_t>(fragments - 1 - f),
-                                               std::span<const std::uint16_t>(list_.data() + at, n)));
         at += n;
         first = false;
       }
@@ -257,25 +263,23 @@ void CoeServer::info(std::span<const std::uint8_t> mailbox, MailboxOutbox& out) 
     }
     case SdoInfoOpcode::GetObjectDescriptionRequest: {
       SdoInfoObjectDescription d;
-      if (!od_->describe_object(v.object.index, d)) return error(abort_code::kObjectDoesNotExist);
-      const auto buf = out.reserve();
-      if (!buf.empty()) out.commit(encode_get_object_description_response(buf, 0, d));
+      if (!od_->describe_object(v.object.index, d)) return error(cia402::sdo_abort_code::kNoObject);
+      out.emit([&](std::span<std::uint8_t> buf) { return encode_get_object_description_response(buf, 0, d); });
       return;
     }
     case SdoInfoOpcode::GetEntryDescriptionRequest: {
       SdoInfoEntryDescription d;
       if (!od_->describe_entry(v.entry.index, v.entry.subindex, d)) {
         SdoInfoObjectDescription o;
-        return error(od_->describe_object(v.entry.index, o) ? abort_code::kSubindexDoesNotExist
-                                                             : abort_code::kObjectDoesNotExist);
+        return error(od_->describe_object(v.entry.index, o) ? cia402::sdo_abort_code::kNoSubIndex
+                                                             : cia402::sdo_abort_code::kNoObject);
       }
       d.value_info = 0;  // no unit/default/min/max offered
-      const auto buf = out.reserve();
-      if (!buf.empty()) out.commit(encode_get_entry_description_response(buf, 0, d));
+      out.emit([&](std::span<std::uint8_t> buf) { return encode_get_entry_description_response(buf, 0, d); });
       return;
     }
     default:
-      return error(abort_code::kUnknownCommand);
+      return error(cia402::sdo_abort_code::kUnknownCommand);
   }
 }
 

@@ -23,20 +23,28 @@ namespace drivegate::ethercat::sim {
 class MailboxOutbox {
  public:
   MailboxOutbox(std::size_t capacity, std::size_t mailbox_size);
-  // Space for the next message (empty when full); commit() queues the bytes written, stamping the
-  // mailbox counter [ETG.1000.6 mailbox header: 1..7, each new message takes the next one].
-  std::span<std::uint8_t> reserve() noexcept;
-  void commit(std::size_t size) noexcept;
+  // Queues the next message: `encode(buf)` writes it into `buf` (zeroed, mailbox_size() bytes)
+  // and returns the bytes written (0: could not encode). The mailbox counter is stamped [ETG.1000.6
+  // mailbox header: 1..7, each new message takes the next one]. False, and the message counted in
+  // dropped(), when the outbox is full or the encoding failed.
+  template <class Encode>
+  bool emit(Encode&& encode) noexcept {
+    const std::span<std::uint8_t> buf = reserve();
+    if (!buf.empty() && commit(encode(buf))) return true;
+    ++dropped_;
+    return false;
+  }
   // Puts a message back at the front (a repeat request, see EscSlave), counter unchanged.
   bool push_front(std::span<const std::uint8_t> msg) noexcept;
   bool empty() const noexcept { return count_ == 0; }
-  std::size_t size() const noexcept { return count_; }
   bool full() const noexcept { return count_ == slots_.size(); }
   std::span<const std::uint8_t> front() const noexcept;
   void pop() noexcept;
+  // Pops the front message without delivering it (counted in dropped()).
+  void drop_front() noexcept;
   void clear() noexcept;
+  // Messages lost: the outbox was full, the encoding failed, or drop_front().
   std::uint64_t dropped() const noexcept { return dropped_; }
-  void count_drop() noexcept { ++dropped_; }
   std::size_t mailbox_size() const noexcept { return mailbox_size_; }
 
  private:
@@ -44,6 +52,11 @@ class MailboxOutbox {
     std::vector<std::uint8_t> bytes;
     std::size_t size = 0;
   };
+  // Space for the next message (empty when full); commit() queues the bytes written (false when
+  // `size` is not a whole mailbox that fits).
+  std::span<std::uint8_t> reserve() noexcept;
+  bool commit(std::size_t size) noexcept;
+
   std::vector<Slot> slots_;
   std::size_t mailbox_size_ = 0;
   std::size_t head_ = 0;
@@ -63,9 +76,6 @@ class CoeServer {
   // Forgets an open segmented transfer (the slave went to INIT).
   void reset() noexcept;
 
-  void set_dictionary(ObjectDictionary* od) noexcept { od_ = od; }
-  std::uint64_t requests() const noexcept { return requests_; }
-
  private:
   void sdo(std::span<const std::uint8_t> mailbox, AlState state, MailboxOutbox& out) noexcept;
   void info(std::span<const std::uint8_t> mailbox, MailboxOutbox& out) noexcept;
@@ -82,7 +92,6 @@ class CoeServer {
   std::size_t done_ = 0;    // bytes transferred so far
   bool toggle_ = false;     // toggle the next segment must carry
   std::array<std::uint16_t, 512> list_{};
-  std::uint64_t requests_ = 0;
 };
 
 }  // namespace drivegate::ethercat::sim

@@ -19,9 +19,6 @@ constexpr std::uint16_t kAlInvalidOutputConfig = 0x001D;
 constexpr std::uint16_t kAlInvalidInputConfig = 0x001E;
 // DL control bit 24: station alias enabled for FPxx addressing [ETG.1000.4 Table 31, 0100h].
 constexpr std::uint32_t kDlControlAlias = 0x01000000;
-// SM PDI control (byte 7): bit 0 deactivate, bit 1 repeat acknowledge [ETG.1000.4 Table 59].
-constexpr std::uint8_t kPdiDeactivate = 0x01;
-constexpr std::uint8_t kPdiRepeatAck = 0x02;
 // Watchdog tick: (divider + 2) × 40 ns [ETG.1000.4 watchdog divider 0400h; digest §8.2].
 constexpr std::uint64_t kWatchdogBaseNs = 40;
 
@@ -36,10 +33,9 @@ EscSlave::EscSlave(const EscConfig& config, std::span<const std::uint8_t> sii, S
       app_(app),
       mem_(kMemorySize, 0),
       sii_(sii.begin(), sii.end()),
-      sii_info_storage_(1),
+      sii_info_(std::make_unique<SiiInfo>()),
       outbox_(config.mailbox_queue, 0),
       coe_(app != nullptr ? app->object_dictionary() : nullptr, config.max_object_bytes) {
-  sii_info_ = sii_info_storage_.data();
   parse_sii(sii_, *sii_info_);
   has_mailbox_ = sii_info_->standard_mailbox.present();
   if (has_mailbox_) {
@@ -47,7 +43,6 @@ EscSlave::EscSlave(const EscConfig& config, std::span<const std::uint8_t> sii, S
     last_sent_.assign(sii_info_->standard_mailbox.tx_size, 0);
   }
   const std::size_t ram = static_cast<std::size_t>(cfg_.ram_kib) * 1024;
-  outputs_.assign(ram, 0);
   inputs_.assign(ram, 0);
   zeros_.assign(ram, 0);
 
@@ -73,7 +68,7 @@ EscSlave::EscSlave(const EscConfig& config, std::span<const std::uint8_t> sii, S
   for (unsigned n = 0; n < cfg_.fmmu_count; ++n) allow(reg::fmmu(n), 13);  // 13-15 reserved
   for (unsigned n = 0; n < cfg_.sm_count; ++n) {
     allow(reg::sm(n), 5);      // start, length, control; 5 status is read-only
-    allow(reg::sm(n) + 6U, 1); // activate; 7 PDI control is read-only
+    allow(reg::sm_activation(n), 1);  // activate; PDI control is read-only
   }
   if (cfg_.dc_supported) {
     allow(reg::kDcSystemTimeOffset, 8);
@@ -126,7 +121,7 @@ void EscSlave::power_on() noexcept {
   std::uint16_t sii_ctl = cfg_.sii_read_8_bytes ? sii_control::kRead8Bytes : 0;
   if (sii_.size() > 2048) sii_ctl = static_cast<std::uint16_t>(sii_ctl | sii_control::kTwoAddressBytes);
   set16(reg::kSiiControl, sii_ctl);
-  for (unsigned n = 0; n < cfg_.sm_count; ++n) mem_[reg::sm(n) + 7U] = kPdiDeactivate;
+  for (unsigned n = 0; n < cfg_.sm_count; ++n) mem_[reg::sm_pdi_control(n)] = sm_pdi_control::kDeactivate;
   sms_ = {};
   state_ = AlState::Init;
   sii_busy_ = 0;
@@ -175,15 +170,13 @@ SmEntry EscSlave::sm(unsigned n) const noexcept {
   return e.value_or(SmEntry{});
 }
 
-std::span<std::uint8_t> EscSlave::sm_buffer(unsigned n) noexcept {
-  const SmEntry e = sm(n);
+std::span<std::uint8_t> EscSlave::sm_buffer(const SmEntry& e) noexcept {
   if (static_cast<std::uint32_t>(e.physical_start) + e.length > kMemorySize) return {};
   return {mem_.data() + e.physical_start, e.length};
 }
 
-bool EscSlave::sm_active(unsigned n) const noexcept {
-  const SmEntry e = sm(n);
-  return e.enabled() && (e.pdi_control & kPdiDeactivate) == 0 && e.length != 0;
+bool EscSlave::sm_active(const SmEntry& e) noexcept {
+  return e.enabled() && (e.pdi_control & sm_pdi_control::kDeactivate) == 0 && e.length != 0;
 }
 
 bool EscSlave::sm_allows(std::uint32_t start, std::uint32_t len, Rw rw) const noexcept {
@@ -192,7 +185,7 @@ bool EscSlave::sm_allows(std::uint32_t start, std::uint32_t len, Rw rw) const no
     if (!e.enabled() || !overlaps(start, len, e.physical_start, e.length)) continue;
     // Enabled by the master but deactivated by the PDI (INIT, or the slave has not reached the
     // state that uses it): the area is locked [ETG.1000.4 Table 59, PDI control bit 0].
-    if ((e.pdi_control & kPdiDeactivate) != 0) return false;
+    if ((e.pdi_control & sm_pdi_control::kDeactivate) != 0) return false;
     const bool mailbox = (e.control & sm_control::kModeMask) == sm_control::kModeMailbox;
     const bool ecat_writes = (e.control & sm_control::kDirectionMask) == sm_control::kDirectionWrite;
     if (mailbox) {
@@ -209,13 +202,13 @@ bool EscSlave::sm_allows(std::uint32_t start, std::uint32_t len, Rw rw) const no
 
 void EscSlave::sm_after(std::uint32_t start, std::uint32_t len, Rw rw) noexcept {
   for (unsigned n = 0; n < cfg_.sm_count; ++n) {
-    if (!sm_active(n)) continue;
     const SmEntry e = sm(n);
+    if (!sm_active(e)) continue;
     const std::uint32_t last = static_cast<std::uint32_t>(e.physical_start) + e.length - 1U;
     if (!overlaps(start, len, last, 1)) continue;  // buffer state changes with the last byte
     const bool mailbox = (e.control & sm_control::kModeMask) == sm_control::kModeMailbox;
     const bool ecat_writes = (e.control & sm_control::kDirectionMask) == sm_control::kDirectionWrite;
-    const std::uint16_t status_at = static_cast<std::uint16_t>(reg::sm(n) + 5U);
+    const std::uint16_t status_at = reg::sm_status(n);
     if (mailbox && ecat_writes && rw == Rw::Write) {
       sms_[n].mailbox_full = true;
       mem_[status_at] = static_cast<std::uint8_t>(mem_[status_at] | sm_status::kMailboxFull | sm_status::kInterruptWrite);
@@ -223,7 +216,7 @@ void EscSlave::sm_after(std::uint32_t start, std::uint32_t len, Rw rw) noexcept 
     } else if (mailbox && !ecat_writes && rw == Rw::Read) {
       if (n == 1 && has_mailbox_) {
         // Keep what the master just read: a repeat request asks for exactly this mailbox again.
-        const std::span<const std::uint8_t> buf = sm_buffer(1);
+        const std::span<const std::uint8_t> buf = sm_buffer(e);
         last_sent_size_ = std::min(buf.size(), last_sent_.size());
         std::copy_n(buf.begin(), last_sent_size_, last_sent_.begin());
       }
@@ -244,11 +237,11 @@ void EscSlave::sm_after(std::uint32_t start, std::uint32_t len, Rw rw) noexcept 
 
 void EscSlave::set_pdi_deactivate(unsigned n, bool deactivate) noexcept {
   if (n >= cfg_.sm_count) return;
-  const auto at = static_cast<std::uint16_t>(reg::sm(n) + 7U);
-  mem_[at] = static_cast<std::uint8_t>(deactivate ? (mem_[at] | kPdiDeactivate) : (mem_[at] & ~kPdiDeactivate));
+  const auto at = reg::sm_pdi_control(n);
+  mem_[at] = static_cast<std::uint8_t>(deactivate ? (mem_[at] | sm_pdi_control::kDeactivate) : (mem_[at] & ~sm_pdi_control::kDeactivate));
   if (deactivate) {
     sms_[n].mailbox_full = false;
-    mem_[reg::sm(n) + 5U] = 0;
+    mem_[reg::sm_status(n)] = 0;
   }
 }
 
@@ -307,9 +300,7 @@ bool EscSlave::phys_write(std::uint32_t ado, std::span<const std::uint8_t> data)
     if (cfg_.dc_supported && ado <= reg::kDcSystemTime && ado + len >= reg::kDcSystemTime + 4U) {
       const std::uint32_t received = get_u32(data, reg::kDcSystemTime - ado);
       const auto local = static_cast<std::uint32_t>(local_time(now_ns_) + u64(reg::kDcSystemTimeOffset));
-      const auto diff = static_cast<std::int32_t>(local - received);
-      const std::uint32_t mag = diff < 0 ? static_cast<std::uint32_t>(-static_cast<std::int64_t>(diff)) : static_cast<std::uint32_t>(diff);
-      set32(reg::kDcSystemTimeDifference, (mag & 0x7FFFFFFFU) | (diff < 0 ? 0x80000000U : 0U));
+      set32(reg::kDcSystemTimeDifference, encode_system_time_difference(static_cast<std::int32_t>(local - received)));
     }
     register_written(ado, len);
   }
@@ -322,9 +313,9 @@ void EscSlave::register_written(std::uint32_t start, std::uint32_t len) noexcept
   // An SM the master disables is reset: its mailbox is empty again [ETG.1000.4 Table 59,
   // activate bit 0].
   for (unsigned n = 0; n < cfg_.sm_count; ++n) {
-    if (overlaps(start, len, reg::sm(n), kSmEntrySize) && (mem_[reg::sm(n) + 6U] & sm_activate::kEnable) == 0) {
+    if (overlaps(start, len, reg::sm(n), kSmEntrySize) && (mem_[reg::sm_activation(n)] & sm_activate::kEnable) == 0) {
       sms_[n].mailbox_full = false;
-      mem_[reg::sm(n) + 5U] = 0;
+      mem_[reg::sm_status(n)] = 0;
     }
   }
   // A write to the error counters clears them [ETG.1000.4 Table 31, 0300h-0313h].
@@ -594,10 +585,9 @@ void EscSlave::mailbox_received() noexcept {
   const MailboxView v = decode_mailbox(box);
   // The PDI has read the mailbox: SM0 is empty again.
   sms_[0].mailbox_full = false;
-  mem_[reg::sm(0) + 5U] = static_cast<std::uint8_t>(mem_[reg::sm(0) + 5U] & ~(sm_status::kMailboxFull | sm_status::kInterruptWrite));
+  mem_[reg::sm_status(0)] = static_cast<std::uint8_t>(mem_[reg::sm_status(0)] & ~(sm_status::kMailboxFull | sm_status::kInterruptWrite));
   if (v.error != MailboxError::None) {
-    const auto buf = outbox_.reserve();
-    if (!buf.empty()) outbox_.commit(encode_mailbox_error(buf, 0, mailbox_error_code::kInvalidSize));
+    outbox_.emit([](std::span<std::uint8_t> buf) { return encode_mailbox_error(buf, 0, mailbox_error_code::kInvalidSize); });
     return;
   }
   // A counter equal to the previous one is a repeated request (the master did not see the WKC)
@@ -612,8 +602,9 @@ void EscSlave::mailbox_received() noexcept {
     coe_.on_request(box, state_, outbox_);
     return;
   }
-  const auto buf = outbox_.reserve();
-  if (!buf.empty()) outbox_.commit(encode_mailbox_error(buf, 0, mailbox_error_code::kUnsupportedProtocol));
+  outbox_.emit([](std::span<std::uint8_t> buf) {
+    return encode_mailbox_error(buf, 0, mailbox_error_code::kUnsupportedProtocol);
+  });
 }
 
 void EscSlave::load_sm1() noexcept {
@@ -621,23 +612,22 @@ void EscSlave::load_sm1() noexcept {
   const std::span<std::uint8_t> buf = sm_buffer(1);
   const auto msg = outbox_.front();
   if (msg.size() > buf.size()) {  // SM1 shorter than the SII's (or outside memory): drop, never cut
-    outbox_.pop();
-    outbox_.count_drop();
+    outbox_.drop_front();
     return;
   }
   std::fill(buf.begin(), buf.end(), std::uint8_t{0});
   std::copy(msg.begin(), msg.end(), buf.begin());
   outbox_.pop();
   sms_[1].mailbox_full = true;
-  mem_[reg::sm(1) + 5U] = static_cast<std::uint8_t>(mem_[reg::sm(1) + 5U] | sm_status::kMailboxFull);
+  mem_[reg::sm_status(1)] = static_cast<std::uint8_t>(mem_[reg::sm_status(1)] | sm_status::kMailboxFull);
 }
 
 void EscSlave::sm1_repeat() noexcept {
   // Repeat request: the master toggled SM1 activate bit 1; the slave puts the last mailbox back
   // into SM1 and answers with PDI control bit 1 = the request [ETG.1000.4 Table 59; ETG.1000.6
   // mailbox repeat].
-  const auto pdi_at = static_cast<std::uint16_t>(reg::sm(1) + 7U);
-  const bool request = (mem_[reg::sm(1) + 6U] & sm_activate::kRepeat) != 0;
+  const auto pdi_at = reg::sm_pdi_control(1);
+  const bool request = (mem_[reg::sm_activation(1)] & sm_activate::kRepeat) != 0;
   ++repeats_;
   const std::span<std::uint8_t> buf = sm_buffer(1);
   if (sms_[1].mailbox_full) {
@@ -650,22 +640,14 @@ void EscSlave::sm1_repeat() noexcept {
     std::fill(buf.begin(), buf.end(), std::uint8_t{0});
     std::copy(last_sent_.begin(), last_sent_.begin() + static_cast<std::ptrdiff_t>(last_sent_size_), buf.begin());
     sms_[1].mailbox_full = true;
-    mem_[reg::sm(1) + 5U] = static_cast<std::uint8_t>(mem_[reg::sm(1) + 5U] | sm_status::kMailboxFull);
+    mem_[reg::sm_status(1)] = static_cast<std::uint8_t>(mem_[reg::sm_status(1)] | sm_status::kMailboxFull);
   }
-  mem_[pdi_at] = static_cast<std::uint8_t>(request ? (mem_[pdi_at] | kPdiRepeatAck) : (mem_[pdi_at] & ~kPdiRepeatAck));
+  mem_[pdi_at] = static_cast<std::uint8_t>(request ? (mem_[pdi_at] | sm_pdi_control::kRepeatAck) : (mem_[pdi_at] & ~sm_pdi_control::kRepeatAck));
 }
 
 bool EscSlave::post_emergency(const CoeEmergency& e) noexcept {
   if (!has_mailbox_) return false;
-  const auto buf = outbox_.reserve();
-  if (buf.empty()) {
-    outbox_.count_drop();
-    return false;
-  }
-  const std::size_t n = encode_emergency(buf, 0, e);
-  if (n == 0) return false;
-  outbox_.commit(n);
-  return true;
+  return outbox_.emit([&](std::span<std::uint8_t> buf) { return encode_emergency(buf, 0, e); });
 }
 
 // ---- PDI cycle --------------------------------------------------------------------------------
@@ -693,8 +675,8 @@ void EscSlave::pdi_cycle(std::uint64_t now_ns) noexcept {
   }
   if (has_mailbox_ && state_ != AlState::Init) {
     if (mailbox_pending_) mailbox_received();
-    const bool request = (mem_[reg::sm(1) + 6U] & sm_activate::kRepeat) != 0;
-    const bool acked = (mem_[reg::sm(1) + 7U] & kPdiRepeatAck) != 0;
+    const bool request = (mem_[reg::sm_activation(1)] & sm_activate::kRepeat) != 0;
+    const bool acked = (mem_[reg::sm_pdi_control(1)] & sm_pdi_control::kRepeatAck) != 0;
     if (request != acked && sm_active(1)) sm1_repeat();
     load_sm1();
   }
@@ -704,7 +686,7 @@ void EscSlave::pdi_cycle(std::uint64_t now_ns) noexcept {
   }
   watchdog_check(now_ns);
   if (app_ == nullptr) return;
-  const std::size_t out_n = std::min(app_->output_size(), outputs_.size());
+  const std::size_t out_n = std::min(app_->output_size(), zeros_.size());
   const std::size_t in_n = std::min(app_->input_size(), inputs_.size());
   std::span<const std::uint8_t> outputs(zeros_.data(), out_n);
   if (state_ == AlState::Op && outputs_valid_ && out_n > 0) {

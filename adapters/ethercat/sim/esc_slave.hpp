@@ -23,6 +23,7 @@
 #include <bitset>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -120,7 +121,6 @@ class EscSlave {
   // slave "stuck in SAFE-OP"); when it is above it now, it drops there on its own with the error
   // set, as after a local error [ETG.1000.6 §5.3.2]. AlState::Op lifts the fault.
   void limit_state(AlState highest, std::uint16_t code) noexcept;
-  const SiiInfo& sii_info() const noexcept { return *sii_info_; }
   std::uint64_t mailbox_repeats() const noexcept { return repeats_; }
   std::uint64_t mailbox_duplicates() const noexcept { return duplicates_; }
 
@@ -140,8 +140,10 @@ class EscSlave {
   SmEntry sm(unsigned n) const noexcept;
   // The SM's buffer in memory; empty when it would reach past 64 KiB (the master may configure
   // anything after the state checks passed).
-  std::span<std::uint8_t> sm_buffer(unsigned n) noexcept;
-  bool sm_active(unsigned n) const noexcept;
+  std::span<std::uint8_t> sm_buffer(unsigned n) noexcept { return sm_buffer(sm(n)); }
+  std::span<std::uint8_t> sm_buffer(const SmEntry& e) noexcept;
+  bool sm_active(unsigned n) const noexcept { return sm_active(sm(n)); }
+  static bool sm_active(const SmEntry& e) noexcept;
   // Checks an ECAT access to [start, start+len): false when an SM refuses it.
   bool sm_allows(std::uint32_t start, std::uint32_t len, Rw rw) const noexcept;
   // Side effects of a completed access (mailbox full/empty, buffer written).
@@ -168,8 +170,7 @@ class EscSlave {
   std::vector<std::uint8_t> mem_;            // 64 KiB
   std::bitset<0x1000> writable_;             // ECAT-writable register bytes
   std::vector<std::uint8_t> sii_;            // EEPROM image
-  std::vector<SiiInfo> sii_info_storage_;    // one element (large: kept off the stack)
-  SiiInfo* sii_info_ = nullptr;
+  std::unique_ptr<SiiInfo> sii_info_;        // large: kept off the stack
   std::array<SmState, 16> sms_{};
   AlState state_ = AlState::Init;
   AlState highest_ = AlState::Op;   // limit_state()
@@ -188,9 +189,8 @@ class EscSlave {
   std::uint64_t duplicates_ = 0;
 
   // process data
-  std::vector<std::uint8_t> outputs_;
   std::vector<std::uint8_t> inputs_;
-  std::vector<std::uint8_t> zeros_;
+  std::vector<std::uint8_t> zeros_;          // the outputs an application sees outside OP
   bool outputs_valid_ = false;
   bool wd_triggered_ = false;                // SM2 written since the last PDI cycle
   std::uint64_t wd_last_ns_ = 0;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <utility>
 
 namespace drivegate::ethercat::sim {
 namespace {
@@ -27,6 +28,11 @@ bool writable(std::uint16_t access, AlState s) noexcept {
   }
 }
 
+// Sort key of the entries: index, then subindex.
+constexpr std::uint32_t entry_key(std::uint16_t index, std::uint8_t subindex) noexcept {
+  return (static_cast<std::uint32_t>(index) << 8) | subindex;
+}
+
 }  // namespace
 
 void SimpleObjectDictionary::add_object(std::uint16_t index, std::uint8_t object_code, std::string_view name) {
@@ -46,10 +52,9 @@ void SimpleObjectDictionary::add_entry(const OdEntrySpec& e) {
   values_.insert(values_.end(), e.value.begin(), e.value.end());
   largest_ = std::max(largest_, e.value.size());
   const Entry entry{e.index, e.subindex, e.data_type, e.access, e.name, offset, e.value.size()};
-  const auto key = [](const Entry& x) { return (static_cast<std::uint32_t>(x.index) << 8) | x.subindex; };
-  const auto it = std::lower_bound(entries_.begin(), entries_.end(), entry,
-                                   [&](const Entry& a, const Entry& b) { return key(a) < key(b); });
-  if (it != entries_.end() && key(*it) == key(entry)) {
+  const auto it = std::lower_bound(entries_.begin(), entries_.end(), entry_key(e.index, e.subindex),
+                                   [](const Entry& a, std::uint32_t k) { return entry_key(a.index, a.subindex) < k; });
+  if (it != entries_.end() && it->index == e.index && it->subindex == e.subindex) {
     *it = entry;
   } else {
     entries_.insert(it, entry);
@@ -70,40 +75,36 @@ const SimpleObjectDictionary::Object* SimpleObjectDictionary::find_object(std::u
 
 const SimpleObjectDictionary::Entry* SimpleObjectDictionary::find_entry(std::uint16_t index,
                                                                         std::uint8_t subindex) const noexcept {
-  for (const Entry& e : entries_) {
-    if (e.index == index && e.subindex == subindex) return &e;
-  }
-  return nullptr;
+  const auto it = std::lower_bound(entries_.begin(), entries_.end(), entry_key(index, subindex),
+                                   [](const Entry& e, std::uint32_t k) { return entry_key(e.index, e.subindex) < k; });
+  return (it != entries_.end() && it->index == index && it->subindex == subindex) ? &*it : nullptr;
 }
 SimpleObjectDictionary::Entry* SimpleObjectDictionary::find_entry(std::uint16_t index, std::uint8_t subindex) noexcept {
-  for (Entry& e : entries_) {
-    if (e.index == index && e.subindex == subindex) return &e;
-  }
-  return nullptr;
+  return const_cast<Entry*>(std::as_const(*this).find_entry(index, subindex));
 }
 
 OdReadResult SimpleObjectDictionary::read(std::uint16_t index, std::uint8_t subindex, std::span<std::uint8_t> out,
                                           AlState state) noexcept {
-  if (find_object(index) == nullptr) return {abort_code::kObjectDoesNotExist, 0};
+  if (find_object(index) == nullptr) return {cia402::sdo_abort_code::kNoObject, 0};
   const Entry* e = find_entry(index, subindex);
-  if (e == nullptr) return {abort_code::kSubindexDoesNotExist, 0};
+  if (e == nullptr) return {cia402::sdo_abort_code::kNoSubIndex, 0};
   if (!readable(e->access, state)) {
-    return {writable_any(e->access) ? abort_code::kWriteOnly : abort_code::kStateForbids, 0};
+    return {writable_any(e->access) ? cia402::sdo_abort_code::kWriteOnly : cia402::sdo_abort_code::kDeviceState, 0};
   }
-  if (e->size > out.size()) return {abort_code::kOutOfMemory, 0};
+  if (e->size > out.size()) return {cia402::sdo_abort_code::kOutOfMemory, 0};
   if (e->size > 0) std::memcpy(out.data(), values_.data() + e->offset, e->size);
   return {0, e->size};
 }
 
 std::uint32_t SimpleObjectDictionary::write(std::uint16_t index, std::uint8_t subindex,
                                             std::span<const std::uint8_t> data, AlState state) noexcept {
-  if (find_object(index) == nullptr) return abort_code::kObjectDoesNotExist;
+  if (find_object(index) == nullptr) return cia402::sdo_abort_code::kNoObject;
   Entry* e = find_entry(index, subindex);
-  if (e == nullptr) return abort_code::kSubindexDoesNotExist;
-  if (!writable_any(e->access)) return abort_code::kReadOnly;
-  if (!writable(e->access, state)) return abort_code::kStateForbids;
-  if (data.size() > e->size) return abort_code::kLengthTooHigh;
-  if (data.size() < e->size) return abort_code::kLengthTooLow;
+  if (e == nullptr) return cia402::sdo_abort_code::kNoSubIndex;
+  if (!writable_any(e->access)) return cia402::sdo_abort_code::kReadOnly;
+  if (!writable(e->access, state)) return cia402::sdo_abort_code::kDeviceState;
+  if (data.size() > e->size) return cia402::sdo_abort_code::kTooLong;
+  if (data.size() < e->size) return cia402::sdo_abort_code::kTooShort;
   if (e->size > 0) std::memcpy(values_.data() + e->offset, data.data(), e->size);
   return 0;
 }

@@ -14,26 +14,9 @@
 
 #include "adapters/ethercat/wire/mailbox.hpp"
 #include "adapters/ethercat/wire/registers.hpp"
+#include "profiles/cia402/sdo_abort.hpp"
 
 namespace drivegate::ethercat::sim {
-
-// CiA 301 §7.2.4.3.17 abort codes the CoE server uses (ETG.1000.6 §5.6.2.7.2 reuses them).
-namespace abort_code {
-inline constexpr std::uint32_t kToggleNotAlternated = 0x05030000;
-inline constexpr std::uint32_t kTimeout = 0x05040000;
-inline constexpr std::uint32_t kUnknownCommand = 0x05040001;
-inline constexpr std::uint32_t kOutOfMemory = 0x05040005;
-inline constexpr std::uint32_t kUnsupportedAccess = 0x06010000;
-inline constexpr std::uint32_t kWriteOnly = 0x06010001;
-inline constexpr std::uint32_t kReadOnly = 0x06010002;
-inline constexpr std::uint32_t kObjectDoesNotExist = 0x06020000;
-inline constexpr std::uint32_t kLengthMismatch = 0x06070010;
-inline constexpr std::uint32_t kLengthTooHigh = 0x06070012;
-inline constexpr std::uint32_t kLengthTooLow = 0x06070013;
-inline constexpr std::uint32_t kSubindexDoesNotExist = 0x06090011;
-inline constexpr std::uint32_t kGeneralError = 0x08000000;
-inline constexpr std::uint32_t kStateForbids = 0x08000022;  // "... because of the present device state"
-}  // namespace abort_code
 
 struct OdReadResult {
   std::uint32_t abort_code = 0;  // 0 = ok
@@ -48,7 +31,7 @@ class ObjectDictionary {
   // for the access rights [ETG.1000.6 §5.6.3.6 object access bits].
   virtual OdReadResult read(std::uint16_t index, std::uint8_t subindex, std::span<std::uint8_t> out,
                             AlState state) noexcept = 0;
-  // Writes a value; the length must match the entry's (kLengthTooHigh/TooLow otherwise).
+  // Writes a value; the length must match the entry's (kTooLong/kTooShort otherwise).
   virtual std::uint32_t write(std::uint16_t index, std::uint8_t subindex, std::span<const std::uint8_t> data,
                               AlState state) noexcept = 0;
   // SDO information [ETG.1000.6 §5.6.3]. list(): indexes of the list type, in ascending order, up

@@ -56,7 +56,6 @@ class SimLine final : public FrameSink {
   // The time frames pass at; advance() also runs every powered slave's PDI cycle (watchdogs) with
   // no frame.
   void set_time(std::uint64_t now_ns) noexcept { now_ = now_ns; }
-  std::uint64_t time() const noexcept { return now_; }
   void advance(std::uint64_t now_ns) noexcept;
 
   void on_frame(FrameView frame) noexcept override;
@@ -64,7 +63,6 @@ class SimLine final : public FrameSink {
   // Faults.
   void power_off(std::size_t k) noexcept;
   void power_on(std::size_t k) noexcept;
-  bool powered(std::size_t k) const noexcept { return k < slaves_.size() && slaves_[k].powered; }
   void break_after(std::size_t k) noexcept;  // cable between k and k+1 cut
   void repair_cable() noexcept;
   void drop_next(std::size_t frames) noexcept { drop_ = frames; }

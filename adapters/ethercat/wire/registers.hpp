@@ -80,6 +80,12 @@ inline constexpr std::uint16_t kSm0 = 0x0800;
 inline constexpr std::uint16_t kSmSize = 8;
 constexpr std::uint16_t fmmu(unsigned n) noexcept { return static_cast<std::uint16_t>(kFmmu0 + n * kFmmuSize); }
 constexpr std::uint16_t sm(unsigned n) noexcept { return static_cast<std::uint16_t>(kSm0 + n * kSmSize); }
+// The last three bytes of SM n's entry [ETG.1000.4 Table 59]: status (sm_status bits, read-only for
+// the master), activate (sm_activate bits) and PDI control (sm_pdi_control bits, read-only for the
+// master), e.g. 080Dh/080Eh/080Fh for SM1.
+constexpr std::uint16_t sm_status(unsigned n) noexcept { return static_cast<std::uint16_t>(sm(n) + 5U); }
+constexpr std::uint16_t sm_activation(unsigned n) noexcept { return static_cast<std::uint16_t>(sm(n) + 6U); }
+constexpr std::uint16_t sm_pdi_control(unsigned n) noexcept { return static_cast<std::uint16_t>(sm(n) + 7U); }
 // Distributed clocks [ETG.1000.4 Table 31]
 inline constexpr std::uint16_t kDcReceiveTimePort0 = 0x0900;  // u32 each, ports 0..3 at +4
 inline constexpr std::uint16_t kDcReceiveTimePort1 = 0x0904;
@@ -233,13 +239,18 @@ inline constexpr std::uint8_t kDcEvent0Bus = 0x40;
 inline constexpr std::uint8_t kDcEvent0Local = 0x80;
 }  // namespace sm_activate
 
+namespace sm_pdi_control {
+inline constexpr std::uint8_t kDeactivate = 0x01;  // the PDI switched the SM off
+inline constexpr std::uint8_t kRepeatAck = 0x02;   // repeat acknowledge (follows sm_activate::kRepeat)
+}  // namespace sm_pdi_control
+
 struct SmEntry {
   std::uint16_t physical_start = 0;
   std::uint16_t length = 0;
   std::uint8_t control = 0;
   std::uint8_t status = 0;      // read-only for the master; written as 0
   std::uint8_t activate = 0;    // sm_activate bits
-  std::uint8_t pdi_control = 0; // bit 0 deactivate, bit 1 repeat acknowledge (PDI side)
+  std::uint8_t pdi_control = 0; // sm_pdi_control bits (PDI side)
 
   bool enabled() const noexcept { return (activate & sm_activate::kEnable) != 0; }
   bool operator==(const SmEntry&) const = default;
@@ -254,6 +265,13 @@ std::optional<SmEntry> decode_sm(std::span<const std::uint8_t> in) noexcept;
 constexpr std::int32_t decode_system_time_difference(std::uint32_t raw) noexcept {
   const auto magnitude = static_cast<std::int32_t>(raw & 0x7FFFFFFFU);
   return (raw & 0x80000000U) ? -magnitude : magnitude;
+}
+// The register value of a signed difference in ns (the inverse of the decoder; the magnitude is
+// kept to 31 bits).
+constexpr std::uint32_t encode_system_time_difference(std::int32_t diff) noexcept {
+  const std::uint32_t magnitude =
+      diff < 0 ? static_cast<std::uint32_t>(-static_cast<std::int64_t>(diff)) : static_cast<std::uint32_t>(diff);
+  return (magnitude & 0x7FFFFFFFU) | (diff < 0 ? 0x80000000U : 0U);
 }
 
 }  // namespace drivegate::ethercat

@@ -8,27 +8,17 @@
 #include <vector>
 
 #include "profiles/cia402/objects.hpp"
+#include "profiles/cia402/sdo_abort.hpp"
 
 namespace drivegate::cia402::sim {
 
 enum class Access : std::uint8_t { ReadOnly, ReadWrite, WriteOnly };
 
-// CiA 301 SDO abort codes the dictionary and the drive model report.
+// The CiA 301 SDO abort codes (profiles/cia402/sdo_abort.hpp) under the name the dictionary and
+// the drive model use; kStatePrevents is sdo_abort_code::kDeviceState.
 namespace abort_code {
-inline constexpr std::uint32_t kNone = 0;
-inline constexpr std::uint32_t kTimeout = 0x05040000;
-inline constexpr std::uint32_t kOutOfMemory = 0x05040005;
-inline constexpr std::uint32_t kWriteOnly = 0x06010001;  // attempt to read a write-only object
-inline constexpr std::uint32_t kReadOnly = 0x06010002;   // attempt to write a read-only object
-inline constexpr std::uint32_t kNoObject = 0x06020000;
-inline constexpr std::uint32_t kTypeMismatch = 0x06070010;  // data type / length does not match
-inline constexpr std::uint32_t kTooLong = 0x06070012;       // length of service parameter too high
-inline constexpr std::uint32_t kTooShort = 0x06070013;      // length of service parameter too low
-inline constexpr std::uint32_t kNoSubIndex = 0x06090011;
-inline constexpr std::uint32_t kValueRange = 0x06090030;
-inline constexpr std::uint32_t kValueTooHigh = 0x06090031;
-inline constexpr std::uint32_t kValueTooLow = 0x06090032;
-inline constexpr std::uint32_t kStatePrevents = 0x08000022;
+using namespace cia402::sdo_abort_code;
+inline constexpr std::uint32_t kStatePrevents = cia402::sdo_abort_code::kDeviceState;
 }  // namespace abort_code
 
 struct ObjectEntry {
