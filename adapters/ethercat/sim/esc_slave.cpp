@@ -3,20 +3,13 @@
 #include <algorithm>
 #include <cstring>
 
+#include "adapters/ethercat/wire/al_status.hpp"
 #include "adapters/ethercat/wire/bytes.hpp"
 
 namespace drivegate::ethercat::sim {
 namespace {
 
 constexpr std::uint32_t kMemorySize = 0x10000;
-// AL status codes [ETG.1000.6 §5.3.2 Table 11].
-constexpr std::uint16_t kAlInvalidStateChange = 0x0011;
-constexpr std::uint16_t kAlUnknownState = 0x0012;
-constexpr std::uint16_t kAlBootstrapNotSupported = 0x0013;
-constexpr std::uint16_t kAlInvalidMailboxConfig = 0x0016;
-constexpr std::uint16_t kAlSmWatchdog = 0x001B;
-constexpr std::uint16_t kAlInvalidOutputConfig = 0x001D;
-constexpr std::uint16_t kAlInvalidInputConfig = 0x001E;
 // DL control bit 24: station alias enabled for FPxx addressing [ETG.1000.4 Table 31, 0100h].
 constexpr std::uint32_t kDlControlAlias = 0x01000000;
 // Watchdog tick: (divider + 2) × 40 ns [ETG.1000.4 watchdog divider 0400h; digest §8.2].
@@ -452,7 +445,7 @@ void EscSlave::al_control_written() noexcept {
   const bool keep_error = error && !ack;
   const std::uint16_t keep_code = keep_error ? u16(reg::kAlStatusCode) : 0;
   if (!is_valid_state(raw) || raw == 0) {
-    set_al(state_, kAlUnknownState, true);
+    set_al(state_, al_status_code::kUnknownState, true);
     return;
   }
   const auto to = static_cast<AlState>(raw);
@@ -477,7 +470,7 @@ void EscSlave::limit_state(AlState highest, std::uint16_t code) noexcept {
 }
 
 std::uint16_t EscSlave::check_transition(AlState from, AlState to) noexcept {
-  if (to == AlState::Boot || from == AlState::Boot) return kAlBootstrapNotSupported;
+  if (to == AlState::Boot || from == AlState::Boot) return al_status_code::kBootstrapNotSupported;
   if (static_cast<std::uint8_t>(to) > static_cast<std::uint8_t>(highest_)) return limit_code_;
   const auto f = static_cast<std::uint8_t>(from);
   const auto t = static_cast<std::uint8_t>(to);
@@ -486,7 +479,7 @@ std::uint16_t EscSlave::check_transition(AlState from, AlState to) noexcept {
     const bool step = (from == AlState::Init && to == AlState::PreOp) ||
                       (from == AlState::PreOp && to == AlState::SafeOp) ||
                       (from == AlState::SafeOp && to == AlState::Op);
-    if (!step) return kAlInvalidStateChange;
+    if (!step) return al_status_code::kInvalidStateChange;
   }
   if (from == AlState::Init && to == AlState::PreOp && has_mailbox_) {
     // Mailbox SMs as the SII says: SM0 master -> slave, SM1 slave -> master, both 1-buffer and
@@ -500,7 +493,7 @@ std::uint16_t EscSlave::check_transition(AlState from, AlState to) noexcept {
     const bool ok1 = s1.enabled() && s1.physical_start == mb.tx_offset && s1.length == mb.tx_size &&
                      (s1.control & sm_control::kModeMask) == sm_control::kModeMailbox &&
                      (s1.control & sm_control::kDirectionMask) == sm_control::kDirectionRead;
-    if (!ok0 || !ok1) return kAlInvalidMailboxConfig;
+    if (!ok0 || !ok1) return al_status_code::kInvalidMailboxConfigPreOp;
   }
   if (from == AlState::PreOp && to == AlState::SafeOp && app_ != nullptr) {
     // Process data SMs: SM2 outputs, SM3 inputs, buffered, lengths equal to the mapped PDOs
@@ -513,8 +506,8 @@ std::uint16_t EscSlave::check_transition(AlState from, AlState to) noexcept {
              (s.control & sm_control::kDirectionMask) == direction && s.physical_start >= reg::kProcessRam &&
              static_cast<std::uint32_t>(s.physical_start) + s.length <= ram_end;
     };
-    if (!valid(2, app_->output_size(), sm_control::kDirectionWrite)) return kAlInvalidOutputConfig;
-    if (!valid(3, app_->input_size(), sm_control::kDirectionRead)) return kAlInvalidInputConfig;
+    if (!valid(2, app_->output_size(), sm_control::kDirectionWrite)) return al_status_code::kInvalidOutputConfig;
+    if (!valid(3, app_->input_size(), sm_control::kDirectionRead)) return al_status_code::kInvalidInputConfig;
   }
   if (app_ != nullptr) return app_->on_state_change(from, to);
   return 0;
@@ -665,7 +658,7 @@ void EscSlave::watchdog_check(std::uint64_t now_ns) noexcept {
   set16(reg::kWatchdogStatusProcessData, 0);
   if (mem_[reg::kWatchdogCounterProcessData] < 0xFF) ++mem_[reg::kWatchdogCounterProcessData];
   enter_state(AlState::Op, AlState::SafeOp);
-  set_al(AlState::SafeOp, kAlSmWatchdog, true);
+  set_al(AlState::SafeOp, al_status_code::kSmWatchdog, true);
 }
 
 void EscSlave::pdi_cycle(std::uint64_t now_ns) noexcept {

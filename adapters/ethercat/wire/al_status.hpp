@@ -13,6 +13,7 @@ inline constexpr std::uint16_t kNoError = 0x0000;
 inline constexpr std::uint16_t kUnspecified = 0x0001;
 inline constexpr std::uint16_t kInvalidStateChange = 0x0011;
 inline constexpr std::uint16_t kUnknownState = 0x0012;
+inline constexpr std::uint16_t kBootstrapNotSupported = 0x0013;
 inline constexpr std::uint16_t kInvalidMailboxConfigPreOp = 0x0016;
 inline constexpr std::uint16_t kInvalidSmConfig = 0x0017;
 inline constexpr std::uint16_t kSmWatchdog = 0x001B;
