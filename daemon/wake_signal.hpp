@@ -3,9 +3,7 @@
 // or events, DDS listener threads when data arrived. notify() takes no lock and allocates nothing:
 // an atomic exchange, and an eventfd write only for the first notify() since the waiter last woke,
 // so a cycle thread pays one system call at most per wake-up of the bridge.
-#include <poll.h>
 #include <sys/eventfd.h>
-#include <time.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -15,6 +13,8 @@
 #include <cstring>
 #include <stdexcept>
 #include <string>
+
+#include "core/fd_wait.hpp"
 
 namespace drivegate::daemon {
 
@@ -40,16 +40,8 @@ class WakeSignal {
   // this call consumed is visible to the caller afterwards.
   template <typename Clock, typename Duration>
   void wait_until(std::chrono::time_point<Clock, Duration> deadline) noexcept {
-    if (!pending_.load(std::memory_order_acquire)) {
-      const auto left = std::chrono::duration_cast<std::chrono::nanoseconds>(deadline - Clock::now()).count();
-      if (left > 0) {
-        timespec ts{};
-        ts.tv_sec = static_cast<time_t>(left / 1'000'000'000);
-        ts.tv_nsec = static_cast<long>(left % 1'000'000'000);
-        pollfd p{fd_, POLLIN, 0};
-        ::ppoll(&p, 1, &ts, nullptr);
-      }
-    }
+    if (!pending_.load(std::memory_order_acquire))
+      (void)core::wait_readable(fd_, std::chrono::duration_cast<core::Duration>(deadline - Clock::now()));
     std::uint64_t count = 0;
     if (::read(fd_, &count, sizeof count) < 0) {
       // EAGAIN: woken by the deadline, or the notify() is still between its exchange and its write

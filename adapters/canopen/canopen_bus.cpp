@@ -8,6 +8,7 @@
 #include "adapters/canopen/boot_plan.hpp"
 #include "adapters/canopen/flush_queue.hpp"
 #include "adapters/canopen/wire/bit_timing.hpp"
+#include "core/fd_wait.hpp"
 #include "profiles/cia402/master_settings.hpp"
 #include "profiles/cia402/op_modes.hpp"
 #include "profiles/cia402/sdo_abort.hpp"
@@ -654,21 +655,16 @@ void CanopenBus::serve_until(core::TimePoint deadline) noexcept {
     const core::TimePoint until = std::min(stop, due);
     // poll() has just handled what was due, or what is due does not fit before the deadline.
     if (until <= now) return;
-    const auto wait = until - now;
-    timespec ts{};
-    ts.tv_sec = static_cast<time_t>(std::chrono::duration_cast<std::chrono::seconds>(wait).count());
-    ts.tv_nsec = static_cast<long>((wait - std::chrono::seconds(ts.tv_sec)).count());
-    pollfd p{fd, POLLIN, 0};
     ++serve_.waits;
-    const int ready = ::ppoll(&p, 1, &ts, nullptr);
+    const short revents = core::wait_readable(fd, until - now);
     // A timeout: the loop polls the SDO client (its timeout) or returns at `stop`. EINTR: again.
-    if (ready <= 0) continue;
+    if (revents == 0) continue;
     // Read on any event: a socket's pending error (a CAN interface that went down) is reported,
     // and cleared, by the read.
     take_between_cycles(clock_.now());
     // An error or hang-up would wake every ppoll() again at once until the deadline: the cycle's
     // receive() meets the transport's state instead.
-    if ((p.revents & (POLLERR | POLLHUP | POLLNVAL)) != 0) {
+    if ((revents & (POLLERR | POLLHUP | POLLNVAL)) != 0) {
       ++serve_.fd_errors;
       return;
     }

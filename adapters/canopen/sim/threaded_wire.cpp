@@ -1,7 +1,6 @@
 // ThreadedSimWire: see threaded_wire.hpp.
 #include "adapters/canopen/sim/threaded_wire.hpp"
 
-#include <poll.h>
 #include <sys/eventfd.h>
 #include <sys/prctl.h>
 #include <unistd.h>
@@ -11,6 +10,7 @@
 #include <system_error>
 
 #include "adapters/canopen/sim/slave_config.hpp"
+#include "core/fd_wait.hpp"
 
 namespace drivegate::canopen::sim {
 namespace {
@@ -143,12 +143,7 @@ void ThreadedSimWire::run() noexcept {
       }
       wake = std::min(s.bus.next_change(), next_step);
     }
-    const auto wait = std::max(wake - now, core::Duration::zero());
-    timespec ts{};
-    ts.tv_sec = static_cast<time_t>(std::chrono::duration_cast<std::chrono::seconds>(wait).count());
-    ts.tv_nsec = static_cast<long>((wait - std::chrono::seconds(ts.tv_sec)).count());
-    pollfd p{s.wire_changed.get(), POLLIN, 0};
-    if (::ppoll(&p, 1, &ts, nullptr) > 0) drain(s.wire_changed.get());
+    if (core::wait_readable(s.wire_changed.get(), wake - now) != 0) drain(s.wire_changed.get());
   }
 }
 
