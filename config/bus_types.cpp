@@ -40,7 +40,7 @@ std::vector<std::string> BusTypeRegistry::names() const {
 std::vector<std::string> BusTypeRegistry::available_names() const {
   std::vector<std::string> out;
   for (const auto& t : types_)
-    if (t->available) out.push_back(t->name);
+    if (t->available()) out.push_back(t->name);
   return out;
 }
 

@@ -61,15 +61,17 @@ struct ParameterRef {
 // reads WHERE into a bus plan (through the type's own option reader, so a scan and a file agree);
 // the caller then holds the bus (`resource`, as a gateway does) and calls `run`, which only reads
 // from the devices. Both throw core::ScanError or core::BusError with one line a person can act on.
+class BusTypeRegistry;
 struct BusScanner {
-  std::function<BusPlan(const core::ScanRequest& request)> plan;
-  std::function<core::ScanResult(const BusPlan& bus, const core::ScanRequest& request)> run;
+  // `types`: the bus types of the caller (the daemon's registry), for the plan and the device profiles.
+  std::function<BusPlan(const core::ScanRequest& request, const BusTypeRegistry& types)> plan;
+  std::function<core::ScanResult(const BusPlan& bus, const core::ScanRequest& request, const BusTypeRegistry& types)>
+      run;
   [[nodiscard]] explicit operator bool() const noexcept { return plan && run; }
 };
 
 struct BusTypeInfo {
   std::string name;
-  bool available = false;  // an adapter for it is linked in
   std::int64_t min_address = 1;
   std::int64_t max_address = 127;
   std::vector<OptionSpec> options;
@@ -109,6 +111,8 @@ struct BusTypeInfo {
   // The adapter: builds the bus. Throws core::BusError.
   std::function<std::unique_ptr<core::Bus>(const BusPlan& bus)> make_bus;
   BusScanner scan;  // empty: the type cannot scan
+  // An adapter for it is linked in: it can make its buses.
+  [[nodiscard]] bool available() const noexcept { return static_cast<bool>(make_bus); }
 };
 
 class BusTypeRegistry {

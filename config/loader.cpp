@@ -174,7 +174,7 @@ void read_bus(const MapReader& b, const BusTypeRegistry& registry, BusPlan& bus)
     if (!type) {
       b.error("type", "unknown bus type " + in_quotes(*t) + did_you_mean(*t, registry.names()) +
                           " (available: " + join(available) + ")");
-    } else if (!type->available) {
+    } else if (!type->available()) {
       b.error("type", "bus type " + in_quotes(*t) + " has no adapter in this build (available: " + join(available) + ")");
       type = nullptr;
     } else {

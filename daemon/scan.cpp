@@ -56,18 +56,18 @@ std::string format_columns(const std::vector<std::vector<std::string>>& rows) {
 core::ScanResult scan_bus(const core::ScanRequest& request, const config::BusTypeRegistry& types) {
   const auto type = types.find(request.bus_type);
   if (type != nullptr && type->scan) {
-    const config::BusPlan plan = type->scan.plan(request);
+    const config::BusPlan plan = type->scan.plan(request, types);
     // A gateway on this bus would see our requests as another master's (and its devices' answers
     // would confuse both): refuse while one holds the bus, and hold it ourselves while scanning.
     // A bus that holds nothing on this machine has no lock (as daemon/gateway.cpp).
     std::unique_ptr<BusLock> lock;
     if (const auto resource = bus_resource(plan); !resource.empty()) lock = std::make_unique<BusLock>(resource);
-    return type->scan.run(plan, request);
+    return type->scan.run(plan, request, types);
   }
   std::string scans;
   for (const auto& t : types.types())
     if (t->scan) scans += (scans.empty() ? "" : ", ") + t->name;
-  if (type != nullptr && type->available)
+  if (type != nullptr && type->available())
     throw core::ScanError("cannot scan " + request.bus_type + ": " + request.bus_type + " has no bus scan (scans: " +
                           scans + ")");
   if (type != nullptr)

@@ -13,8 +13,6 @@
 #include "adapters/canopen/wire/bit_timing.hpp"
 #include "adapters/canopen/wire/cob_id.hpp"
 #include "config/canopen/bus_options.hpp"
-#include "config/canopen/bus_type.hpp"
-#include "config/ethercat/bus_type.hpp"
 #include "config/canopen/plan.hpp"
 #include "config/loader.hpp"
 #include "profiles/cia402/sdo_abort.hpp"
@@ -382,16 +380,6 @@ namespace {
 
 // The canopen bus type as the configuration reads it: enough for the scan's bus plan and for the
 // canopen sections of device profiles (the adapter's own registration is the daemon's business).
-const config::BusTypeRegistry& scan_types() {
-  static const config::BusTypeRegistry types = [] {
-    config::BusTypeRegistry r;
-    r.add(config::canopen_bus_type());
-    // Profiles also carry other buses' sections: they are read (and checked) like the daemon does.
-    r.add(config::ethercat_bus_type());
-    return r;
-  }();
-  return types;
-}
 
 }  // namespace
 
@@ -418,7 +406,7 @@ bool scan_option_given(const core::ScanRequest& request, const std::string& key)
   return std::any_of(options.begin(), options.end(), [&](const auto& o) { return o.first == key; });
 }
 
-config::BusPlan scan_bus_plan(const core::ScanRequest& request) {
+config::BusPlan scan_bus_plan(const core::ScanRequest& request, const config::BusTypeRegistry& types) {
   const std::string& where = request.where;
   std::string transport = where.substr(0, where.find('?'));
   auto options = where_options(where);
@@ -450,7 +438,7 @@ config::BusPlan scan_bus_plan(const core::ScanRequest& request) {
     y << "      " << key << ": " << value << "\n";
   }
   y << "axes: []\n";
-  const config::LoadOptions load{.device_dirs = request.device_dirs, .bus_types = scan_types()};
+  const config::LoadOptions load{.device_dirs = request.device_dirs, .bus_types = types};
   try {
     auto plan = config::load_plan_from_string(y.str(), "scan", load);
     return std::move(plan.buses.at(0));
@@ -489,8 +477,8 @@ std::string device_type_text(std::uint32_t device_type) {
 }
 
 std::vector<config::DeviceProfile> scan_profiles(const std::vector<std::filesystem::path>& dirs,
-                                                 std::vector<std::string>& notes) {
-  config::DeviceCatalog catalog(dirs, scan_types());
+                                                 const config::BusTypeRegistry& types, std::vector<std::string>& notes) {
+  config::DeviceCatalog catalog(dirs, types);
   std::vector<config::DeviceProfile> out;
   config::Problems problems;
   for (const auto& name : catalog.available())
@@ -723,9 +711,10 @@ core::ScanResult scan_result(const CanopenScan& scan, const config::BusPlan& pla
   return r;
 }
 
-core::ScanResult run_scan(const config::BusPlan& plan, const core::ScanRequest& request) {
+core::ScanResult run_scan(const config::BusPlan& plan, const core::ScanRequest& request,
+                          const config::BusTypeRegistry& types) {
   std::vector<std::string> profile_notes;
-  const auto profiles = scan_profiles(request.device_dirs, profile_notes);
+  const auto profiles = scan_profiles(request.device_dirs, types, profile_notes);
   std::unique_ptr<Transport> transport;
   try {
     transport = make_transport(plan);

@@ -41,6 +41,7 @@
 #include "adapters/canopen/wire/can_frame.hpp"
 #include "adapters/canopen/wire/nmt_codec.hpp"
 #include "adapters/canopen/wire/sdo_codec.hpp"
+#include "config/bus_types.hpp"
 #include "config/plan.hpp"
 #include "core/clock.hpp"
 #include "core/scan.hpp"
@@ -150,12 +151,13 @@ class CanopenScan {
 // WHERE is `INTERFACE` or `socketcan` (SocketCAN) or `udp-multicast`, then options
 // `?key=value&key=value` (socketcan: interface, bitrate; udp-multicast: group, port, interface,
 // bitrate). Throws core::ScanError naming the option and what it takes.
-config::BusPlan scan_bus_plan(const core::ScanRequest& request);
+config::BusPlan scan_bus_plan(const core::ScanRequest& request, const config::BusTypeRegistry& types);
 
 // The scan on the plan's transport in real time, then the table's rows: each node with its device
 // type in words and the device profile (from request.device_dirs) that fits it. Throws
 // core::ScanError when the transport does not open (no AF_CAN in the kernel, no such interface).
-core::ScanResult run_scan(const config::BusPlan& plan, const core::ScanRequest& request);
+core::ScanResult run_scan(const config::BusPlan& plan, const core::ScanRequest& request,
+                          const config::BusTypeRegistry& types);
 
 // The rows of what `scan` saw, profiles matched; what run_scan() returns without the timing.
 // `bitrate_given`: the scan request named the bit rate (SocketCAN does not tell it); when not, the
@@ -169,7 +171,7 @@ bool scan_option_given(const core::ScanRequest& request, const std::string& key)
 // The device profiles with a canopen section in the directories, in name order; broken ones are
 // left out with a note in `notes`.
 std::vector<config::DeviceProfile> scan_profiles(const std::vector<std::filesystem::path>& dirs,
-                                                 std::vector<std::string>& notes);
+                                                 const config::BusTypeRegistry& types, std::vector<std::string>& notes);
 
 // "CiA 402 servo drive", "CiA 401 I/O module", "device profile 405", ... for a 1000h value.
 std::string device_type_text(std::uint32_t device_type);

@@ -44,7 +44,6 @@ std::string resource(const BusPlan& bus) {
 BusTypeInfo canopen_bus_type() {
   BusTypeInfo t;
   t.name = "canopen";
-  t.available = true;
   t.min_address = 1;  // node-IDs 1..127 [CiA 301 §7.3.2]
   t.max_address = 127;
   t.axis_section = "canopen";

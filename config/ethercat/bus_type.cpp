@@ -7,7 +7,6 @@ namespace drivegate::config {
 BusTypeInfo ethercat_bus_type() {
   BusTypeInfo t;
   t.name = "ethercat";
-  t.available = false;
   // Positions on the line; the configured station address is derived from them.
   t.min_address = 1;
   t.max_address = 65535;

@@ -1,7 +1,7 @@
 #pragma once
 // The `ethercat` bus type's configuration. So far the device profiles' `ethercat:` section: a
 // configuration may name the type, and profiles carry their EtherCAT data, but no adapter is linked
-// in yet (`available` false: a bus of this type is refused with that reason).
+// in yet (no make_bus: a bus of this type is refused with that reason).
 #include "config/bus_types.hpp"
 
 namespace drivegate::config {

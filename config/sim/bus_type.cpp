@@ -66,7 +66,6 @@ void describe_sim_axis(const BusPlan&, const AxisPlan& a, DescribeRows& rows) {
 BusTypeInfo sim_bus_type() {
   BusTypeInfo t;
   t.name = "sim";
-  t.available = true;
   t.axis_section = "sim";
   t.options.push_back({"acyclic_latency_cycles", OptionKind::Integer, 1, 1000, std::int64_t{1},
                        "cycles before a simulated drive answers an acyclic read/write", {}});

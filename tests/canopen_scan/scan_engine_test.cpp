@@ -82,7 +82,7 @@ class ScanOnWire : public ::testing::Test {
 
   static std::vector<config::DeviceProfile> profiles() {
     std::vector<std::string> notes;
-    auto p = scan_profiles(config::default_device_dirs(), notes);
+    auto p = scan_profiles(config::default_device_dirs(), config::BusTypeRegistry::builtin(), notes);
     EXPECT_TRUE(notes.empty());
     return p;
   }
@@ -92,7 +92,7 @@ class ScanOnWire : public ::testing::Test {
     r.bus_type = "canopen";
     r.where = "udp-multicast?group=239.1.2.3&port=17555&interface=127.0.0.1";
     r.device_dirs = config::default_device_dirs();
-    return scan_bus_plan(r);
+    return scan_bus_plan(r, config::BusTypeRegistry::builtin());
   }
 
   InprocBus wire_{500000};
@@ -417,14 +417,14 @@ TEST(ScanResultBitRate, NotGivenIsMarkedForCheckingAndSaidToBeAssumed) {
   req.where = "can0";
   EXPECT_FALSE(scan_option_given(req, "bitrate"));
   const CanopenScan scan({}, kT0);
-  auto r = scan_result(scan, scan_bus_plan(req), {}, false);
+  auto r = scan_result(scan, scan_bus_plan(req, config::BusTypeRegistry::builtin()), {}, false);
   EXPECT_EQ(r.bus_option_checks, (std::vector<std::pair<std::string, std::string>>{
                                      {"bitrate", "the bus' bit rate (not read from the interface; set it to the "
                                                  "interface's)"}}));
   EXPECT_NE(r.assumed.find("bit rate not given (500 kbit/s assumed"), std::string::npos) << r.assumed;
   req.where = "can0?bitrate=250000";
   EXPECT_TRUE(scan_option_given(req, "bitrate"));
-  r = scan_result(scan, scan_bus_plan(req), {}, true);
+  r = scan_result(scan, scan_bus_plan(req, config::BusTypeRegistry::builtin()), {}, true);
   EXPECT_TRUE(r.bus_option_checks.empty());
   EXPECT_TRUE(r.assumed.empty());
 }
@@ -510,15 +510,15 @@ TEST(ScanBusPlan, TakesAnInterfaceOrUdpMulticastWithOptions) {
   r.bus_type = "canopen";
   r.device_dirs = config::default_device_dirs();
   r.where = "can1";
-  auto p = scan_bus_plan(r);
+  auto p = scan_bus_plan(r, config::BusTypeRegistry::builtin());
   EXPECT_EQ(p.section<config::CanopenBusOptions>().transport, config::CanTransportKind::SocketCan);
   EXPECT_EQ(p.section<config::CanopenBusOptions>().interface, "can1");
   r.where = "socketcan?interface=vcan0&bitrate=250000";
-  p = scan_bus_plan(r);
+  p = scan_bus_plan(r, config::BusTypeRegistry::builtin());
   EXPECT_EQ(p.section<config::CanopenBusOptions>().interface, "vcan0");
   EXPECT_EQ(p.section<config::CanopenBusOptions>().bitrate, 250000U);
   r.where = "udp-multicast?group=239.1.2.3&port=17000&interface=127.0.0.1";
-  p = scan_bus_plan(r);
+  p = scan_bus_plan(r, config::BusTypeRegistry::builtin());
   EXPECT_EQ(p.section<config::CanopenBusOptions>().transport, config::CanTransportKind::UdpMulticast);
   EXPECT_EQ(p.section<config::CanopenBusOptions>().group, "239.1.2.3");
   EXPECT_EQ(p.section<config::CanopenBusOptions>().port, 17000);
@@ -531,7 +531,7 @@ TEST(ScanBusPlan, RefusesWhatTheConfigurationWouldRefuse) {
     r.where = where;
     r.device_dirs = config::default_device_dirs();
     try {
-      (void)scan_bus_plan(r);
+      (void)scan_bus_plan(r, config::BusTypeRegistry::builtin());
     } catch (const core::ScanError& e) {
       return std::string(e.what());
     }

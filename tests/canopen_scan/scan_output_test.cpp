@@ -250,14 +250,14 @@ TEST(ScanBus, TakesNoLockForABusThatHoldsNothing) {
   config::BusTypeRegistry registry;
   config::BusTypeInfo fake;
   fake.name = "fake";
-  fake.available = true;
+  fake.make_bus = [](const config::BusPlan&) { return std::unique_ptr<core::Bus>{}; };
   fake.resource = [](const config::BusPlan&) { return std::string(); };
-  fake.scan.plan = [&registry](const core::ScanRequest&) {
+  fake.scan.plan = [&registry](const core::ScanRequest&, const config::BusTypeRegistry&) {
     config::BusPlan p;
     p.type_info = registry.find("fake");
     return p;
   };
-  fake.scan.run = [](const config::BusPlan&, const core::ScanRequest&) {
+  fake.scan.run = [](const config::BusPlan&, const core::ScanRequest&, const config::BusTypeRegistry&) {
     core::ScanResult result;
     result.bus_type = "fake";
     return result;

@@ -25,7 +25,6 @@ struct ModuleSection {
 BusTypeInfo ring_bus_type(int& buses_made) {
   BusTypeInfo t;
   t.name = "ringbus";
-  t.available = true;
   t.max_address = 65535;
   t.axis_section = "ringbus";
   t.device_section = "ringbus";
