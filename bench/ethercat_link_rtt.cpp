@@ -60,7 +60,7 @@ Options parse(int argc, char** argv) {
     else if (a == "--busy") o.busy = true;
     else usage();
   }
-  o.size = std::clamp<std::size_t>(o.size, drivegate::ethercat::kMinFrameBytes, drivegate::ethercat::kMaxFrameBytes);
+  o.size = std::clamp<std::size_t>(o.size, drivegate::ethercat::kMinFrameBytes, drivegate::ethercat::kMaxFrameSize);
   o.block = std::max<std::size_t>(o.block, 1);
   return o;
 }

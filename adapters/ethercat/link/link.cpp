@@ -14,9 +14,9 @@ const char* to_string(FrameCheck c) noexcept {
 
 FrameCheck check_frame(std::span<const std::uint8_t> frame) noexcept {
   if (frame.size() < kMinFrameBytes) return FrameCheck::TooShort;
-  if (frame.size() > kMaxFrameBytes) return FrameCheck::TooLong;
-  const auto type = static_cast<std::uint16_t>((frame[12] << 8) | frame[13]);
-  return type == kEtherTypeEthercat ? FrameCheck::Ok : FrameCheck::WrongEtherType;
+  if (frame.size() > kMaxFrameSize) return FrameCheck::TooLong;
+  const auto type = static_cast<std::uint16_t>((frame[kEtherTypeOffset] << 8) | frame[kEtherTypeOffset + 1]);
+  return type == kEtherType ? FrameCheck::Ok : FrameCheck::WrongEtherType;
 }
 
 const char* to_string(LinkState s) noexcept {

@@ -16,6 +16,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "adapters/ethercat/wire/ethernet.hpp"
 #include "core/clock.hpp"
 
 namespace drivegate::ethercat {
@@ -26,15 +27,11 @@ class LinkError : public std::runtime_error {
 };
 
 // EtherCAT frames are Ethernet II frames of EtherType 88A4h (ETG.1000.4, frame structure: Ethernet
-// header, then the 2-byte EtherCAT header, then the datagrams).
-inline constexpr std::uint16_t kEtherTypeEthercat = 0x88A4;
-inline constexpr std::size_t kEthernetHeaderBytes = 14;  // destination 6, source 6, EtherType 2 [IEEE 802.3 §3.1.1]
-inline constexpr std::size_t kEthercatHeaderBytes = 2;   // length 11 bits, reserved 1, type 4 (ETG.1000.4)
-// Shorter than an Ethernet header plus the EtherCAT header cannot be an EtherCAT frame. Frames are
-// not padded to the 60-byte Ethernet minimum here: veth does not pad, a NIC pads on its own.
-inline constexpr std::size_t kMinFrameBytes = kEthernetHeaderBytes + kEthercatHeaderBytes;
-// The largest untagged Ethernet frame without FCS: 1500 bytes of payload [IEEE 802.3 §3.2.7].
-inline constexpr std::size_t kMaxFrameBytes = kEthernetHeaderBytes + 1500;
+// header, then the 2-byte EtherCAT header, then the datagrams); the sizes and the EtherType are in
+// wire/ethernet.hpp. Shorter than an Ethernet header plus the EtherCAT header cannot be an EtherCAT
+// frame. Frames are not padded to the 60-byte Ethernet minimum here: veth does not pad, a NIC pads
+// on its own. The longest is kMaxFrameSize (1514, untagged, without FCS).
+inline constexpr std::size_t kMinFrameBytes = kEthernetHeaderSize + kEcatHeaderSize;
 
 // What a received frame is, by its length and EtherType only.
 enum class FrameCheck : std::uint8_t { Ok, TooShort, TooLong, WrongEtherType };
@@ -45,7 +42,7 @@ const char* to_string(FrameCheck c) noexcept;
 
 // One received frame in memory the caller owns (the socket writes straight into `bytes`).
 struct FrameBuffer {
-  std::array<std::uint8_t, kMaxFrameBytes> bytes{};
+  std::array<std::uint8_t, kMaxFrameSize> bytes{};
   std::size_t size = 0;
 
   [[nodiscard]] std::span<const std::uint8_t> view() const noexcept { return {bytes.data(), size}; }
@@ -71,7 +68,7 @@ enum class SendStatus : std::uint8_t {
 const char* to_string(SendStatus s) noexcept;
 
 // What send() did with its frames, front first: sent + invalid + unsent == frames given. Invalid
-// frames (shorter than kMinFrameBytes or longer than kMaxFrameBytes) are skipped and the rest go on.
+// frames (shorter than kMinFrameBytes or longer than kMaxFrameSize) are skipped and the rest go on.
 struct SendResult {
   std::size_t sent = 0;
   std::size_t invalid = 0;
@@ -86,7 +83,7 @@ struct LinkCounters {
   std::uint64_t tx_down = 0;            // not sent: link down or closed
   std::uint64_t rx_frames = 0;          // delivered by receive()
   std::uint64_t rx_too_short = 0;       // dropped: shorter than kMinFrameBytes
-  std::uint64_t rx_too_long = 0;        // dropped: longer than kMaxFrameBytes
+  std::uint64_t rx_too_long = 0;        // dropped: longer than kMaxFrameSize
   std::uint64_t rx_wrong_ethertype = 0; // dropped: not 88A4h
   std::uint64_t rx_own = 0;             // dropped: an outgoing frame of this host seen back
   std::uint64_t rx_overflow = 0;        // dropped before we saw it: receive queue full

@@ -74,7 +74,7 @@ SendResult MemoryLink::send(std::span<const FrameView> frames) noexcept {
   const bool up = open_ && wire_.load(std::memory_order_relaxed) == LinkState::Up;
   for (std::size_t i = 0; i < frames.size(); ++i) {
     const FrameView f = frames[i];
-    if (f.size() < kMinFrameBytes || f.size() > kMaxFrameBytes) {
+    if (f.size() < kMinFrameBytes || f.size() > kMaxFrameSize) {
       ++r.invalid;
       counters_.tx_invalid.add();
       continue;

@@ -159,7 +159,7 @@ void RawSocketLink::open() {
 bool RawSocketLink::bind_to(int ifindex) noexcept {
   sockaddr_ll address{};
   address.sll_family = AF_PACKET;
-  address.sll_protocol = htons(options_.all_ethertypes ? std::uint16_t{ETH_P_ALL} : kEtherTypeEthercat);
+  address.sll_protocol = htons(options_.all_ethertypes ? std::uint16_t{ETH_P_ALL} : kEtherType);
   address.sll_ifindex = ifindex;
   if (::bind(fd_, reinterpret_cast<const sockaddr*>(&address), sizeof address) != 0) {
     bound_ = false;
@@ -240,7 +240,7 @@ LinkState RawSocketLink::refresh() noexcept {
 
 SendResult RawSocketLink::send(std::span<const FrameView> frames) noexcept {
   SendResult r;
-  const auto valid = [](FrameView f) { return f.size() >= kMinFrameBytes && f.size() <= kMaxFrameBytes; };
+  const auto valid = [](FrameView f) { return f.size() >= kMinFrameBytes && f.size() <= kMaxFrameSize; };
   // What is not sent: the staged frames of the batch from position `staged_from` to `staged_end`
   // (valid ones; the invalid ones among them are counted already) and every frame from `next` on,
   // not looked at yet (each counted invalid or unsent). Every frame is counted once.
