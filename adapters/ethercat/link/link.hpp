@@ -9,7 +9,6 @@
 // allocation, no lock, no logging. open() may allocate and throws LinkError with one line a person
 // can act on. One thread (the bus thread) uses a link; state() and counters() may be read from any.
 #include <array>
-#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -18,6 +17,7 @@
 
 #include "adapters/ethercat/wire/ethernet.hpp"
 #include "core/clock.hpp"
+#include "core/counter_cell.hpp"
 
 namespace drivegate::ethercat {
 
@@ -91,21 +91,12 @@ struct LinkCounters {
   std::uint64_t link_ups = 0;           // recoveries: transitions back to Up
 };
 
-// LinkCounters as relaxed atomics: the bus thread writes them, any thread may read a snapshot. A
-// single writer needs no read-modify-write, so an increment is a relaxed load and store.
-class LinkCounterCell {
- public:
-  void add(std::uint64_t n = 1) noexcept { v_.store(v_.load(std::memory_order_relaxed) + n, std::memory_order_relaxed); }
-  [[nodiscard]] std::uint64_t get() const noexcept { return v_.load(std::memory_order_relaxed); }
-
- private:
-  std::atomic<std::uint64_t> v_{0};
-};
-
+// LinkCounters as relaxed atomics (core::CounterCell): the bus thread writes them, any thread may
+// read a snapshot.
 struct LinkCounterCells {
-  LinkCounterCell tx_frames, tx_invalid, tx_busy, tx_down;
-  LinkCounterCell rx_frames, rx_too_short, rx_too_long, rx_wrong_ethertype, rx_own, rx_overflow;
-  LinkCounterCell link_downs, link_ups;
+  core::CounterCell tx_frames, tx_invalid, tx_busy, tx_down;
+  core::CounterCell rx_frames, rx_too_short, rx_too_long, rx_wrong_ethertype, rx_own, rx_overflow;
+  core::CounterCell link_downs, link_ups;
 
   [[nodiscard]] LinkCounters snapshot() const noexcept;
   // Counts a received frame that check_frame() refused.
