@@ -33,9 +33,17 @@ class LinkError : public std::runtime_error {
 // on its own. The longest is kMaxFrameSize (1514, untagged, without FCS).
 inline constexpr std::size_t kMinFrameBytes = kEthernetHeaderSize + kEcatHeaderSize;
 
+// One frame to send: the whole Ethernet frame.
+using FrameView = std::span<const std::uint8_t>;
+
+// Whether a frame's length lets it go on the link: kMinFrameBytes to kMaxFrameSize. send() skips
+// other frames (counted invalid); check_frame() refuses received ones by the same rule.
+constexpr bool sendable(FrameView frame) noexcept {
+  return frame.size() >= kMinFrameBytes && frame.size() <= kMaxFrameSize;
+}
+
 // What a received frame is, by its length and EtherType only.
 enum class FrameCheck : std::uint8_t { Ok, TooShort, TooLong, WrongEtherType };
-const char* to_string(FrameCheck c) noexcept;
 // The EtherType is big-endian at offset 12 [IEEE 802.3 §3.2.6]. A VLAN-tagged frame (8100h) counts
 // as a wrong EtherType: EtherCAT masters send untagged frames.
 [[nodiscard]] FrameCheck check_frame(std::span<const std::uint8_t> frame) noexcept;
@@ -47,9 +55,6 @@ struct FrameBuffer {
 
   [[nodiscard]] std::span<const std::uint8_t> view() const noexcept { return {bytes.data(), size}; }
 };
-
-// One frame to send: the whole Ethernet frame.
-using FrameView = std::span<const std::uint8_t>;
 
 enum class LinkState : std::uint8_t {
   Closed,     // not opened (or closed)
@@ -65,7 +70,6 @@ enum class SendStatus : std::uint8_t {
   Busy,  // the transmit queue was full: that frame and the ones after it were not sent
   Down,  // the link is down or closed: that frame and the ones after it were not sent
 };
-const char* to_string(SendStatus s) noexcept;
 
 // What send() did with its frames, front first: sent + invalid + unsent == frames given. Invalid
 // frames (shorter than kMinFrameBytes or longer than kMaxFrameSize) are skipped and the rest go on.
@@ -101,6 +105,9 @@ struct LinkCounterCells {
   [[nodiscard]] LinkCounters snapshot() const noexcept;
   // Counts a received frame that check_frame() refused.
   void count_drop(FrameCheck c) noexcept;
+  // Counts a change of the link state: Up to any other state is a link down, back to Up from a
+  // down state a link up (from Closed it is an open, not a recovery).
+  void count_transition(LinkState before, LinkState after) noexcept;
 };
 
 class Link {
