@@ -3,7 +3,6 @@
 #include <algorithm>
 
 #include "adapters/ethercat/wire/bytes.hpp"
-#include "profiles/cia402/sdo_abort.hpp"
 
 namespace drivegate::ethercat {
 
@@ -424,8 +423,6 @@ std::size_t encode_sdo_upload_segment_response(std::span<std::uint8_t> out, std:
   const auto cmd = static_cast<std::uint8_t>((toggle ? 0x10 : 0) | (last ? 0x01 : 0));  // scs 0
   return put_segment(out, counter, CoeService::SdoResponse, cmd, data);
 }
-
-std::string_view sdo_abort_text(std::uint32_t abort_code) noexcept { return cia402::sdo_abort_text(abort_code); }
 
 // ---- Emergency --------------------------------------------------------------------------------
 

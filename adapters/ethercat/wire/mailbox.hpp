@@ -17,6 +17,8 @@
 #include <span>
 #include <string_view>
 
+#include "profiles/cia402/sdo_abort.hpp"
+
 namespace drivegate::ethercat {
 
 inline constexpr std::size_t kMailboxHeaderSize = 6;
@@ -206,8 +208,8 @@ std::size_t encode_sdo_upload_segment_response(std::span<std::uint8_t> out, std:
                                                bool last, std::span<const std::uint8_t> data) noexcept;
 
 // CoE shares the CiA 301 abort codes (ETG.1000.6 §5.6.2.7.2); the texts live in one bus-neutral
-// table (profiles/cia402/sdo_abort.hpp).
-std::string_view sdo_abort_text(std::uint32_t abort_code) noexcept;
+// table: cia402::sdo_abort_text (profiles/cia402/sdo_abort.hpp), named here too for older callers.
+using cia402::sdo_abort_text;
 
 // ---- CoE emergency [ETG.1000.6 §5.6.4] --------------------------------------------------------
 
