@@ -9,17 +9,20 @@
 #include <string>
 #include <vector>
 
+#include "core/bytes.hpp"
+
 namespace drivegate::test {
 
 namespace pcap_detail {
 inline void put32(std::ofstream& f, std::uint32_t v) {
-  const std::array<char, 4> b{static_cast<char>(v & 0xFF), static_cast<char>((v >> 8) & 0xFF),
-                              static_cast<char>((v >> 16) & 0xFF), static_cast<char>(v >> 24)};
-  f.write(b.data(), 4);
+  std::array<std::uint8_t, 4> b{};
+  core::put_u32(b, 0, v);
+  f.write(reinterpret_cast<const char*>(b.data()), b.size());
 }
 inline void put16(std::ofstream& f, std::uint16_t v) {
-  const std::array<char, 2> b{static_cast<char>(v & 0xFF), static_cast<char>(v >> 8)};
-  f.write(b.data(), 2);
+  std::array<std::uint8_t, 2> b{};
+  core::put_u16(b, 0, v);
+  f.write(reinterpret_cast<const char*>(b.data()), b.size());
 }
 }  // namespace pcap_detail
 

@@ -1,11 +1,12 @@
 #include "adapters/ethercat/link/link.hpp"
 
+#include "core/bytes.hpp"
+
 namespace drivegate::ethercat {
 
 FrameCheck check_frame(std::span<const std::uint8_t> frame) noexcept {
   if (!sendable(frame)) return frame.size() < kMinFrameBytes ? FrameCheck::TooShort : FrameCheck::TooLong;
-  const auto type = static_cast<std::uint16_t>((frame[kEtherTypeOffset] << 8) | frame[kEtherTypeOffset + 1]);
-  return type == kEtherType ? FrameCheck::Ok : FrameCheck::WrongEtherType;
+  return core::get_be16(frame, kEtherTypeOffset) == kEtherType ? FrameCheck::Ok : FrameCheck::WrongEtherType;
 }
 
 const char* to_string(LinkState s) noexcept {

@@ -2,10 +2,13 @@
 
 #include <algorithm>
 
-#include "adapters/ethercat/wire/bytes.hpp"
 #include "adapters/ethercat/wire/registers.hpp"
+#include "core/bytes.hpp"
 
 namespace drivegate::ethercat {
+
+using core::put_u32;
+
 namespace {
 
 // CiA 301 §7.2.4.3.17 abort codes the client raises itself (CoE reuses them, ETG.1000.6 §5.6.2.7.2).

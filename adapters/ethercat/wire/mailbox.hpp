@@ -17,6 +17,7 @@
 #include <span>
 #include <string_view>
 
+#include "core/bytes.hpp"
 #include "profiles/cia402/sdo_abort.hpp"
 
 namespace drivegate::ethercat {
@@ -314,7 +315,7 @@ struct SdoInfoView {
   std::span<const std::uint8_t> index_bytes{};  // u16 LE each
   std::size_t index_count() const noexcept { return index_bytes.size() / 2; }
   std::uint16_t index_at(std::size_t i) const noexcept {
-    return static_cast<std::uint16_t>(index_bytes[2 * i] | (index_bytes[2 * i + 1] << 8));
+    return core::get_u16(index_bytes, 2 * i);
   }
   // Get Object Description request: object.index; response: all of object.
   SdoInfoObjectDescription object{};
