@@ -9,9 +9,9 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
-#include <system_error>
 #include <utility>
 
+#include "core/errno_text.hpp"
 #include "core/fd_guard.hpp"
 
 namespace drivegate::ethercat {
@@ -23,7 +23,7 @@ namespace {
 #define PACKET_IGNORE_OUTGOING 23
 #endif
 
-std::string errno_text(int e) { return std::system_category().message(e); }
+using core::errno_text;
 
 [[noreturn]] void fail(const std::string& what) { throw LinkError("ethercat: " + what); }
 
