@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "adapters/ethercat/link/raw_socket_link.hpp"
+#include "tests/ethercat_link/frames.hpp"
 #include "tests/support/netns.hpp"
 
 namespace {
@@ -60,20 +61,10 @@ Options parse(int argc, char** argv) {
     else if (a == "--busy") o.busy = true;
     else usage();
   }
-  o.size = std::clamp<std::size_t>(o.size, drivegate::ethercat::kMinFrameBytes, drivegate::ethercat::kMaxFrameBytes);
+  // Bytes 16..23 carry the sequence number: no frame shorter than that.
+  o.size = std::clamp<std::size_t>(o.size, 24, drivegate::ethercat::kMaxFrameSize);
   o.block = std::max<std::size_t>(o.block, 1);
   return o;
-}
-
-// An EtherCAT-typed frame whose bytes 16..23 carry a sequence number (the link does not look).
-std::vector<std::uint8_t> frame_of(std::size_t size) {
-  std::vector<std::uint8_t> f(size, 0);
-  for (std::size_t i = 0; i < 6; ++i) f[i] = 0xFF;
-  f[6] = 0x02;
-  f[11] = 0x01;
-  f[12] = 0x88;
-  f[13] = 0xA4;
-  return f;
 }
 
 bool wait_in(int fd, bool busy) {
@@ -213,7 +204,8 @@ int main(int argc, char** argv) {
     }
   }
 
-  auto frame = frame_of(o.size);
+  // An EtherCAT-typed frame; bytes 16..23 carry the sequence number (the link does not look).
+  auto frame = drivegate::ethercat::test::make_frame(0, o.size);
   std::vector<std::uint8_t> payload(o.size, 0);
   std::vector<std::uint8_t> udp_in(65536);
   auto in = std::make_unique<FrameBuffer>();

@@ -7,6 +7,8 @@
 #include <cstring>
 #include <limits>
 
+#include "core/bytes.hpp"
+
 namespace drivegate::core {
 namespace {
 
@@ -70,14 +72,11 @@ std::string_view trim(std::string_view s) noexcept {
   return s;
 }
 
-std::uint64_t get_le(std::span<const std::uint8_t> b) noexcept {
-  std::uint64_t v = 0;
-  for (std::size_t i = b.size(); i-- > 0;) v = (v << 8) | b[i];
-  return v;
-}
-
+// Appends `v` as `n` little-endian bytes.
 void put_le(std::vector<std::uint8_t>& out, std::uint64_t v, std::size_t n) {
-  for (std::size_t i = 0; i < n; ++i) out.push_back(static_cast<std::uint8_t>(v >> (8 * i)));
+  const std::size_t at = out.size();
+  out.resize(at + n);
+  core::put_le(std::span(out).subspan(at), v);
 }
 
 unsigned bits_of(ParamType t) noexcept { return static_cast<unsigned>(8 * param_type_size(t)); }
@@ -281,10 +280,10 @@ std::optional<std::string> decode_unicode(std::span<const std::uint8_t> b) {
   if (b.size() % 2 != 0) return std::nullopt;
   std::string out;
   for (std::size_t i = 0; i < b.size(); i += 2) {
-    std::uint32_t u = b[i] | (std::uint32_t{b[i + 1]} << 8);
+    std::uint32_t u = get_u16(b, i);
     if (u >= 0xD800 && u <= 0xDBFF) {
       if (i + 3 >= b.size()) return std::nullopt;
-      const std::uint32_t lo = b[i + 2] | (std::uint32_t{b[i + 3]} << 8);
+      const std::uint32_t lo = get_u16(b, i + 2);
       if (lo < 0xDC00 || lo > 0xDFFF) return std::nullopt;
       u = 0x10000 + ((u - 0xD800) << 10) + (lo - 0xDC00);
       i += 2;

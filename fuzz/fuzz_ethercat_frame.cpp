@@ -10,6 +10,7 @@
 #include <span>
 
 #include "adapters/ethercat/wire/frame.hpp"
+#include "core/bytes.hpp"
 
 namespace {
 
@@ -34,7 +35,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     seen[n++] = d;
   }
   if (p.error() != FrameError::None || p.info().vlan || size > kMaxFrameSize) return 0;
-  const std::uint16_t ecat_word = static_cast<std::uint16_t>(data[14] | (data[15] << 8));
+  const std::uint16_t ecat_word = drivegate::core::get_u16({data, size}, kEthernetHeaderSize);
   if (ecat_word & 0x0800) return 0;  // reserved bit: the builder writes 0
   for (std::size_t i = 0; i < n; ++i) {
     // C bit and the reserved bits 11-13 of the length word: the builder writes 0 there.

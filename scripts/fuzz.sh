@@ -2,8 +2,7 @@
 # Builds the libFuzzer targets with clang (ASan + UBSan) and runs each for SECONDS (default 60)
 # on a scratch copy of its seed corpus (fuzz/README.md).
 #
-#   scripts/fuzz.sh [SECONDS] [TARGET...]      TARGET: msgpack_frame sdo can_engines eds config
-#                                              ethercat_frame ethercat_mailbox ethercat_sii ethercat_sim
+#   scripts/fuzz.sh [SECONDS] [TARGET...]      TARGET: NAME of a fuzz/fuzz_NAME.cpp (default: all)
 #
 # Environment: BUILD_DIR (default build-fuzz next to the source tree), WORK_DIR (scratch, default
 # a new mktemp -d), JOBS (ninja -j, default 2).
@@ -12,12 +11,17 @@
 # BUILD_DIR/fuzz/fuzz_<target> FILE, or fuzz_replay_<target> FILE in a normal build.
 set -euo pipefail
 
+src=$(cd "$(dirname "$0")/.." && pwd)
+
 seconds=${1:-60}
 shift || true
 targets=("$@")
-[ ${#targets[@]} -eq 0 ] && targets=(msgpack_frame sdo can_engines eds config ethercat_frame ethercat_mailbox ethercat_sii ethercat_sim)
-
-src=$(cd "$(dirname "$0")/.." && pwd)
+if [ ${#targets[@]} -eq 0 ]; then
+  for f in "$src"/fuzz/fuzz_*.cpp; do
+    name=${f##*/fuzz_}
+    targets+=("${name%.cpp}")
+  done
+fi
 build=${BUILD_DIR:-$src/../build-fuzz}
 work=${WORK_DIR:-$(mktemp -d /tmp/drivegate-fuzz.XXXXXX)}
 jobs=${JOBS:-2}

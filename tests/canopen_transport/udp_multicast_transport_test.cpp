@@ -4,17 +4,14 @@
 #include <gtest/gtest.h>
 
 #include <arpa/inet.h>
-#include <fcntl.h>
 #include <poll.h>
-#include <sched.h>
-#include <signal.h>
-#include <spawn.h>
 #include <sys/socket.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
+#include <exception>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -22,8 +19,7 @@
 #include "adapters/canopen/transport/msgpack_frame.hpp"
 #include "adapters/canopen/transport/udp_multicast_transport.hpp"
 #include "tests/support/alloc_counter.hpp"
-
-extern char** environ;
+#include "tests/support/netns.hpp"
 
 namespace drivegate::canopen {
 namespace {
@@ -375,146 +371,61 @@ TEST(UdpMulticast, SendAndReceiveAllocateNothing) {
 
 // --- live interop with python-can -------------------------------------------------------------
 
-// Runs argv to completion, output discarded; returns the exit status (or -1).
-int run(const std::vector<std::string>& argv) {
-  std::vector<char*> args;
-  for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-  args.push_back(nullptr);
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, 2, "/dev/null", O_WRONLY, 0);
-  pid_t pid = 0;
-  const int rc = posix_spawnp(&pid, args[0], &actions, nullptr, args.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  if (rc != 0) return -1;
-  int status = 0;
-  if (::waitpid(pid, &status, 0) != pid || !WIFEXITED(status)) return -1;
-  return WEXITSTATUS(status);
+// A network namespace with only loopback up and the multicast range routed to it (nullptr, with
+// the reason in `why`, when it cannot be made), deleted on every path out of the test.
+std::unique_ptr<test::NetNamespace> multicast_netns(std::string& why) {
+  try {
+    auto ns = std::make_unique<test::NetNamespace>();
+    const test::RunResult route = ns->ip({"route", "add", "224.0.0.0/4", "dev", "lo"});
+    if (!route.ok()) {
+      why = "ip route add 224.0.0.0/4 failed: " + route.output;
+      return nullptr;
+    }
+    return ns;
+  } catch (const std::exception& e) {
+    why = e.what();
+    return nullptr;
+  }
 }
 
-// A network namespace with only loopback up and the multicast range routed to it, deleted on
-// every path out of the test.
-class Netns {
- public:
-  explicit Netns(std::string name) : name_(std::move(name)) {
-    if (run({"ip", "netns", "add", name_}) != 0) return;
-    created_ = true;
-    ok_ = run({"ip", "-n", name_, "link", "set", "lo", "up"}) == 0 &&
-          run({"ip", "-n", name_, "route", "add", "224.0.0.0/4", "dev", "lo"}) == 0;
-  }
-  ~Netns() {
-    if (created_) run({"ip", "netns", "del", name_});
-  }
-  Netns(const Netns&) = delete;
-  Netns& operator=(const Netns&) = delete;
-  [[nodiscard]] bool ok() const { return ok_; }
-  [[nodiscard]] const std::string& name() const { return name_; }
-
- private:
-  std::string name_;
-  bool created_ = false;
-  bool ok_ = false;
-};
-
-// Switches this thread into a namespace and back: sockets keep the namespace they were made in.
-class InNetns {
- public:
-  explicit InNetns(const std::string& name)
-      : home_(::open("/proc/self/ns/net", O_RDONLY | O_CLOEXEC)),
-        target_(::open(("/run/netns/" + name).c_str(), O_RDONLY | O_CLOEXEC)) {
-    entered_ = home_ >= 0 && target_ >= 0 && ::setns(target_, CLONE_NEWNET) == 0;
-  }
-  ~InNetns() {
-    if (entered_) ::setns(home_, CLONE_NEWNET);
-    if (home_ >= 0) ::close(home_);
-    if (target_ >= 0) ::close(target_);
-  }
-  InNetns(const InNetns&) = delete;
-  InNetns& operator=(const InNetns&) = delete;
-  [[nodiscard]] bool entered() const { return entered_; }
-
- private:
-  int home_;
-  int target_;
-  bool entered_ = false;
-};
-
-// A child process whose stdout and stderr we read; killed and reaped if the test ends early.
+// A program run in `ns` whose stdout and stderr we read line by line; killed and reaped if the
+// test ends early.
 class Child {
  public:
-  explicit Child(const std::vector<std::string>& argv) {
-    int fds[2];
-    if (::pipe2(fds, O_CLOEXEC) != 0) return;
-    std::vector<char*> args;
-    for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-    args.push_back(nullptr);
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_adddup2(&actions, fds[1], 1);
-    posix_spawn_file_actions_adddup2(&actions, fds[1], 2);
-    if (posix_spawnp(&pid_, args[0], &actions, nullptr, args.data(), environ) != 0) pid_ = -1;
-    posix_spawn_file_actions_destroy(&actions);
-    ::close(fds[1]);
-    out_ = fds[0];
-  }
-  ~Child() {
-    if (pid_ > 0) {
-      ::kill(pid_, SIGKILL);
-      ::waitpid(pid_, nullptr, 0);
-    }
-    if (out_ >= 0) ::close(out_);
-  }
-  Child(const Child&) = delete;
-  Child& operator=(const Child&) = delete;
+  Child(const test::NetNamespace& ns, std::vector<std::string> argv)
+      : argv_(std::move(argv)), child_(&ns, [this](int out) {
+          std::vector<char*> args;
+          for (auto& a : argv_) args.push_back(a.data());
+          args.push_back(nullptr);
+          ::dup2(out, STDOUT_FILENO);
+          ::dup2(out, STDERR_FILENO);
+          ::execvp(args[0], args.data());
+          return 127;
+        }) {}
 
-  [[nodiscard]] bool started() const { return pid_ > 0; }
-  // Reads output until it contains `line` + newline; false on timeout or when the child closes it.
+  // Reads output until a line equal to `line` came; false on timeout or when the child closes it.
   bool wait_for(const std::string& line, std::chrono::seconds timeout) {
     const auto deadline = Clock::now() + timeout;
-    while (output_.find(line + "\n") == std::string::npos) {
-      if (Clock::now() >= deadline || read_some(100) == Read::Closed) return false;
-    }
-    return true;
-  }
-  // The exit status once it ends (within the timeout), else nullopt. Output is kept reading so
-  // that the child never blocks on a full pipe.
-  std::optional<int> exit_status(std::chrono::seconds timeout) {
-    const auto deadline = Clock::now() + timeout;
     while (Clock::now() < deadline) {
-      int status = 0;
-      if (::waitpid(pid_, &status, WNOHANG) == pid_) {
-        pid_ = -1;
-        while (read_some(0) == Read::Data) {
-        }
-        return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-      }
-      if (read_some(100) == Read::Closed) {  // the child is exiting: wait for it
-        if (::waitpid(pid_, &status, 0) == pid_) {
-          pid_ = -1;
-          return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-        }
-      }
+      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
+      const std::optional<std::string> got = child_.read_line(left);
+      if (!got) return false;
+      output_ += *got + "\n";
+      if (*got == line) return true;
     }
-    return std::nullopt;
+    return false;
+  }
+  // The exit status once it ends (within the timeout), else nullopt; then what it printed last.
+  std::optional<int> exit_status(std::chrono::seconds timeout) {
+    const std::optional<int> status = child_.wait(timeout);
+    while (const std::optional<std::string> got = child_.read_line(1s)) output_ += *got + "\n";
+    return status;
   }
   [[nodiscard]] const std::string& output() const { return output_; }
 
  private:
-  enum class Read { Data, Idle, Closed };
-  // Waits up to `ms` for output and appends it.
-  Read read_some(int ms) {
-    pollfd p{out_, POLLIN, 0};
-    if (::poll(&p, 1, ms) <= 0) return Read::Idle;
-    char buf[512];
-    const auto n = ::read(out_, buf, sizeof buf);
-    if (n <= 0) return Read::Closed;
-    output_.append(buf, static_cast<std::size_t>(n));
-    return Read::Data;
-  }
-
-  pid_t pid_ = -1;
-  int out_ = -1;
+  std::vector<std::string> argv_;
+  test::ChildProcess child_;
   std::string output_;
 };
 
@@ -549,21 +460,20 @@ finally:
 )";
 
 TEST(UdpMulticast, LiveInteropWithPythonCan) {
-  if (::geteuid() != 0) GTEST_SKIP() << "needs root to create a network namespace (ip netns add)";
+  if (!test::netns_unavailable().empty()) GTEST_SKIP() << test::netns_unavailable();
   // python-can joins the group on INADDR_ANY, i.e. on the interface of the default route; in a
   // namespace of our own that is loopback, so both peers meet there.
-  Netns ns("dg-udp-" + std::to_string(::getpid()));
-  if (!ns.ok()) GTEST_SKIP() << "ip netns failed: cannot create " << ns.name();
+  std::string why;
+  const auto ns = multicast_netns(why);
+  if (!ns) GTEST_SKIP() << "ip netns failed: " << why;
   const std::uint16_t port = test_port(7);
 
   UdpMulticastTransport us(options(port));
   {
-    InNetns inside(ns.name());
-    ASSERT_TRUE(inside.entered()) << "setns into " << ns.name();
+    test::NetnsScope inside(*ns);
     us.open();
   }
-  Child peer({"ip", "netns", "exec", ns.name(), "/usr/bin/python3", "-c", kPythonPeer, std::to_string(port)});
-  ASSERT_TRUE(peer.started());
+  Child peer(*ns, {"/usr/bin/python3", "-c", kPythonPeer, std::to_string(port)});
   ASSERT_TRUE(peer.wait_for("ready", 20s)) << peer.output();
 
   CanFrame rtr;
@@ -593,22 +503,22 @@ TEST(UdpMulticast, LiveInteropWithPythonCan) {
 }
 
 TEST(UdpMulticast, WithInterfaceAnyOwnEchoesAreDroppedWhileAPeerReceivesThem) {
-  if (::geteuid() != 0) GTEST_SKIP() << "needs root to create a network namespace (ip netns add)";
+  if (!test::netns_unavailable().empty()) GTEST_SKIP() << test::netns_unavailable();
   // With interface 0.0.0.0 (the configuration default) the send socket is bound to 0.0.0.0 and
   // the kernel sends from an address of the interface the group's route leads to. In a namespace
   // of our own that is loopback, given a global address (127.0.0.1 is host scope, never chosen
   // as a multicast source) as a NIC has one. Nothing leaves this host.
-  Netns ns("dg-any-" + std::to_string(::getpid()));
-  if (!ns.ok() || run({"ip", "-n", ns.name(), "addr", "add", "198.51.100.7/32", "dev", "lo"}) != 0) {
-    GTEST_SKIP() << "ip netns failed: cannot set up " << ns.name();
-  }
+  std::string why;
+  const auto ns = multicast_netns(why);
+  if (!ns) GTEST_SKIP() << "ip netns failed: " << why;
+  const test::RunResult address = ns->ip({"addr", "add", "198.51.100.7/32", "dev", "lo"});
+  if (!address.ok()) GTEST_SKIP() << "ip netns failed: cannot set up " << ns->name() << ": " << address.output;
   auto o = options(test_port(9));
   o.interface_address = "0.0.0.0";
   UdpMulticastTransport us(o);
   UdpMulticastTransport peer(o);
   {
-    InNetns inside(ns.name());
-    ASSERT_TRUE(inside.entered()) << "setns into " << ns.name();
+    test::NetnsScope inside(*ns);
     us.open();
     peer.open();
   }

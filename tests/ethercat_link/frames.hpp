@@ -14,7 +14,7 @@ namespace drivegate::ethercat::test {
 // header (ETG.1000.4: length in bits 0-10, type 1 = datagrams in bits 12-15, little-endian) and the
 // bytes tag, tag+1, ...
 inline std::vector<std::uint8_t> make_frame(std::uint8_t tag, std::size_t size = 60,
-                                            std::uint16_t ethertype = kEtherTypeEthercat) {
+                                            std::uint16_t ethertype = kEtherType) {
   std::vector<std::uint8_t> f(size, 0);
   for (std::size_t i = 0; i < 6 && i < size; ++i) f[i] = 0xFF;
   const std::uint8_t source[6] = {0x02, 0x00, 0x00, 0x00, 0x00, 0x01};

@@ -21,7 +21,7 @@ class EchoSink final : public FrameSink {
   explicit EchoSink(MemoryLink& link) : link_(link) {}
   void on_frame(FrameView frame) noexcept override {
     if (record) seen.emplace_back(frame.begin(), frame.end());
-    std::array<std::uint8_t, kMaxFrameBytes> reply{};
+    std::array<std::uint8_t, kMaxFrameSize> reply{};
     std::copy(frame.begin(), frame.end(), reply.begin());
     reply[16] = static_cast<std::uint8_t>(reply[16] + 1);
     link_.deliver({reply.data(), frame.size()});

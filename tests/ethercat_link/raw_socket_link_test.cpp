@@ -141,7 +141,7 @@ TEST_F(RawSocketLinkTest, FrameSentOnOneEndArrivesOnTheOther) {
   EXPECT_EQ(got[0], f);  // byte for byte, no padding, no FCS
 
   // And the other way, with the largest frame there is.
-  const auto big = make_frame(0x07, kMaxFrameBytes);
+  const auto big = make_frame(0x07, kMaxFrameSize);
   EXPECT_EQ(b->send(FrameView(big)).sent, 1U);
   const auto back = receive_frames(*a, 1, 2000ms);
   ASSERT_EQ(back.size(), 1U);
@@ -252,7 +252,7 @@ TEST_F(RawSocketLinkTest, InvalidFramesAreRefusedOnSendAndTheRestGo) {
   auto b = open_b();
   const auto ok = make_frame(1);
   const auto shorty = make_frame(2, 12);
-  const auto longy = make_frame(3, kMaxFrameBytes + 1);
+  const auto longy = make_frame(3, kMaxFrameSize + 1);
   const std::array<FrameView, 4> frames{FrameView(shorty), FrameView(ok), FrameView(longy), FrameView(ok)};
   const SendResult r = a->send(frames);
   EXPECT_EQ(r.sent, 2U);

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "adapters/ethercat/master/coe_sdo_client.hpp"
+#include "profiles/cia402/sdo_abort.hpp"
 #include "tests/ethercat_master/fake_line.hpp"
 #include "tests/support/alloc_counter.hpp"
 
@@ -229,7 +230,7 @@ TEST(EthercatCoeSdo, ServerAbortFailsWithItsCode) {
   const auto r = h.run(id);
   EXPECT_EQ(r.status, CoeSdoStatus::Failed);
   EXPECT_EQ(r.abort_code, 0x06010002U);
-  EXPECT_FALSE(sdo_abort_text(r.abort_code).empty());
+  EXPECT_FALSE(cia402::sdo_abort_text(r.abort_code).empty());
   EXPECT_EQ(h.client.counters().aborts, 1U);
 }
 

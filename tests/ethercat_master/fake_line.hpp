@@ -14,9 +14,15 @@
 #include <vector>
 
 #include "adapters/ethercat/wire/al_status.hpp"
-#include "adapters/ethercat/wire/bytes.hpp"
 #include "adapters/ethercat/wire/frame.hpp"
 #include "adapters/ethercat/wire/registers.hpp"
+#include "core/bytes.hpp"
+
+namespace drivegate::ethercat {
+using core::get_u16;
+using core::get_u32;
+using core::put_u16;
+}  // namespace drivegate::ethercat
 
 namespace drivegate::ethercat::test {
 

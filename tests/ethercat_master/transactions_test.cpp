@@ -8,10 +8,13 @@
 #include <vector>
 
 #include "adapters/ethercat/master/transactions.hpp"
-#include "adapters/ethercat/wire/bytes.hpp"
+#include "core/bytes.hpp"
 #include "tests/support/alloc_counter.hpp"
 
 namespace drivegate::ethercat {
+
+using core::put_u16;
+
 namespace {
 
 using namespace std::chrono_literals;

@@ -14,8 +14,17 @@
 #include "adapters/ethercat/sim/esc_slave.hpp"
 #include "adapters/ethercat/sim/generic_io.hpp"
 #include "adapters/ethercat/sim/sim_line.hpp"
-#include "adapters/ethercat/wire/bytes.hpp"
 #include "adapters/ethercat/wire/frame.hpp"
+#include "core/bytes.hpp"
+
+namespace drivegate::ethercat {
+using core::get_u16;
+using core::get_u32;
+using core::get_u64;
+using core::put_u16;
+using core::put_u32;
+using core::put_u64;
+}  // namespace drivegate::ethercat
 
 namespace drivegate::ethercat::sim::test {
 

@@ -1,15 +1,13 @@
 // Frames the simulator answers dissect cleanly in Debian's tshark (issue 9: "every frame it sends
 // and receives must dissect cleanly, no Malformed, CoE fields filled"): a bring-up with SDO
 // traffic and an emergency is captured (frames sent and returned), written as a classic pcap file
-// (link type 1 = Ethernet) and read with `tshark -V`. Skipped when tshark is not installed.
+// (link type 1 = Ethernet) and read with `tshark -V` (tests/support/pcap.hpp). Skipped when tshark
+// is not installed; KEEP_PCAP=1 keeps the file.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
-#include <cstdio>
-#include <cstdlib>
-#include <filesystem>
-#include <fstream>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "tests/ethercat_sim/coe_line.hpp"
 #include "tests/support/pcap.hpp"
@@ -20,7 +18,6 @@ namespace {
 using Bytes = std::vector<std::uint8_t>;
 
 TEST(EthercatSimTshark, BringUpDissectsCleanly) {
-  if (std::system("command -v tshark >/dev/null 2>&1") != 0) GTEST_SKIP() << "tshark not installed";
   std::vector<Bytes> capture;
   test::CoeLine l;
   l.bus.capture = &capture;
@@ -41,10 +38,9 @@ TEST(EthercatSimTshark, BringUpDissectsCleanly) {
   l.get();
   ASSERT_GT(capture.size(), 20U);
 
-  const auto path = std::filesystem::temp_directory_path() / ("drivegate-ecat-sim-" + std::to_string(::getpid()) + ".pcap");
-  drivegate::test::write_pcap(path, capture, 100);
-  const std::string out = drivegate::test::command_output("tshark -r '" + path.string() + "' -V 2>&1");
-  if (std::getenv("KEEP_PCAP") == nullptr) std::filesystem::remove(path);
+  const std::optional<std::string> dissected = drivegate::test::tshark_dissect(capture, 100);
+  if (!dissected) GTEST_SKIP() << "tshark not installed";
+  const std::string& out = *dissected;
   ASSERT_FALSE(out.empty());
   EXPECT_EQ(out.find("Malformed"), std::string::npos) << out;
   EXPECT_EQ(out.find("Exception"), std::string::npos) << out;

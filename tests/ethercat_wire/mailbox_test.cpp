@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "adapters/ethercat/wire/mailbox.hpp"
+#include "profiles/cia402/sdo_abort.hpp"
 
 namespace drivegate::ethercat {
 namespace {
@@ -133,7 +134,7 @@ TEST(EcatMailbox, DigestTv6Responses) {
   ASSERT_EQ(a.error, MailboxError::None);
   EXPECT_EQ(a.sdo.command, SdoCommand::Abort);
   EXPECT_EQ(a.sdo.abort_code, 0x06070010U);
-  EXPECT_EQ(sdo_abort_text(a.sdo.abort_code), "data type does not match, length of service parameter does not match");
+  EXPECT_EQ(cia402::sdo_abort_text(a.sdo.abort_code), "data type does not match, length of service parameter does not match");
   // Some servers send the abort as service 3; it is still an abort.
   Bytes abort3 = abort;
   abort3[7] = 0x30;
@@ -244,10 +245,10 @@ TEST(EcatMailbox, ExpeditedUploadAndCompleteAccess) {
 // Abort texts come from the one table CANopen also uses; CoE adds 0601000[3-6]h [ETG.1000.6
 // §5.6.2.7.2].
 TEST(EcatMailbox, AbortTexts) {
-  EXPECT_EQ(sdo_abort_text(0x06020000), "object does not exist in the object dictionary");
-  EXPECT_EQ(sdo_abort_text(0x06010004), "complete access not supported for objects of variable length");
-  EXPECT_EQ(sdo_abort_text(0x06010006), "object mapped to an RxPDO, SDO download blocked");
-  EXPECT_EQ(sdo_abort_text(0x12345678), "unknown abort code");
+  EXPECT_EQ(cia402::sdo_abort_text(0x06020000), "object does not exist in the object dictionary");
+  EXPECT_EQ(cia402::sdo_abort_text(0x06010004), "complete access not supported for objects of variable length");
+  EXPECT_EQ(cia402::sdo_abort_text(0x06010006), "object mapped to an RxPDO, SDO download blocked");
+  EXPECT_EQ(cia402::sdo_abort_text(0x12345678), "unknown abort code");
 }
 
 TEST(EcatMailbox, EncodersRefuseBadArguments) {
@@ -416,7 +417,7 @@ TEST(EcatMailbox, SdoInfoDescriptions) {
   const SdoInfoView x = decode_sdo_info(err);
   ASSERT_EQ(x.error, MailboxError::None);
   EXPECT_EQ(x.opcode, SdoInfoOpcode::Error);
-  EXPECT_EQ(sdo_abort_text(x.abort_code), "object does not exist in the object dictionary");
+  EXPECT_EQ(cia402::sdo_abort_text(x.abort_code), "object does not exist in the object dictionary");
 }
 
 TEST(EcatMailbox, SdoInfoMalformed) {

@@ -1,15 +1,11 @@
 // Frames written by the codecs dissect cleanly in Debian's tshark (issue 9: "must dissect cleanly
-// in tshark, no Malformed, CoE fields filled"). The test writes a classic pcap file (global header
-// + one record per frame, link type 1 = Ethernet) and reads `tshark -r FILE -V`. Skipped when
-// tshark is not installed (scripts/install-deps.sh installs it).
+// in tshark, no Malformed, CoE fields filled"). The frames go through a classic pcap file (link
+// type 1 = Ethernet) to `tshark -r FILE -V` (tests/support/pcap.hpp). Skipped when tshark is not
+// installed (scripts/install-deps.sh installs it).
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <array>
-#include <cstdio>
-#include <cstdlib>
-#include <filesystem>
-#include <fstream>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -114,13 +110,10 @@ std::vector<Bytes> frames() {
 }
 
 TEST(EcatTshark, FramesDissectCleanly) {
-  if (std::system("command -v tshark >/dev/null 2>&1") != 0) GTEST_SKIP() << "tshark not installed (scripts/install-deps.sh)";
-  const auto path = std::filesystem::temp_directory_path() /
-                    ("drivegate-ecat-wire-" + std::to_string(::getpid()) + ".pcap");
   const std::vector<Bytes> fs = frames();
-  drivegate::test::write_pcap(path, fs);
-  const std::string out = drivegate::test::command_output("tshark -r '" + path.string() + "' -V 2>&1");
-  std::filesystem::remove(path);
+  const std::optional<std::string> dissected = drivegate::test::tshark_dissect(fs);
+  if (!dissected) GTEST_SKIP() << "tshark not installed (scripts/install-deps.sh)";
+  const std::string& out = *dissected;
   ASSERT_FALSE(out.empty());
   EXPECT_EQ(out.find("Malformed"), std::string::npos) << out;
   EXPECT_EQ(out.find("Exception"), std::string::npos) << out;

@@ -4,19 +4,19 @@
 // authentication retries every second and announcements come every second.
 #include <gtest/gtest.h>
 #include <signal.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "client/client.hpp"
 #include "tests/daemon/daemon_process.hpp"
+#include "tests/support/run_program.hpp"
 
 using namespace drivegate;
 using namespace std::chrono_literals;
@@ -26,21 +26,8 @@ namespace {
 constexpr auto kStartUp = 20s;
 constexpr auto kNothingSeen = 6s;  // > announcement period + handshake retry, with margin
 
-struct ShellRun {
-  int status = -1;
-  std::string output;
-};
-
-ShellRun run(const std::string& command) {
-  ShellRun r;
-  FILE* p = ::popen((command + " 2>&1").c_str(), "r");
-  if (p == nullptr) return r;
-  char buf[512];
-  while (std::fgets(buf, sizeof buf, p) != nullptr) r.output += buf;
-  const int status = ::pclose(p);
-  r.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+using test::run_program;
+using test::RunResult;
 
 class Security : public ::testing::Test {
  protected:
@@ -49,10 +36,10 @@ class Security : public ::testing::Test {
     pki_ = std::filesystem::temp_directory_path() /
            ("drivegate-pki-" + std::to_string(::getpid()) + "-" +
             ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    const ShellRun made = run(std::string(DRIVEGATE_MAKE_PKI) + " " + pki_.string() + " --domain " +
-                         std::to_string(dds_.domain) +
-                         " --client observer:observer --client operator:operator --client engineer:engineer"
-                         " --client old:operator:expired --other-ca rogue:operator");
+    const RunResult made = run_program({DRIVEGATE_MAKE_PKI, pki_.string(), "--domain", std::to_string(dds_.domain),
+                                        "--client", "observer:observer", "--client", "operator:operator",
+                                        "--client", "engineer:engineer", "--client", "old:operator:expired",
+                                        "--other-ca", "rogue:operator"});
     ASSERT_EQ(made.status, 0) << made.output;
     const std::string gateway_dir = (pki_ / "gateway").string();
     config_ = test::write_demo_config("secure", dds_, [&](YAML::Node& root) {
@@ -78,9 +65,11 @@ class Security : public ::testing::Test {
   static bool sees_gateway(client::Client& c, std::chrono::milliseconds timeout) {
     return c.wait_until([&] { return c.state("x").has_value() && !c.gateways().empty(); }, timeout);
   }
-  std::string ctl(const std::string& identity, const std::string& args) const {
-    const ShellRun r = run(std::string(DRIVEGATECTL_PATH) + " --domain " + std::to_string(dds_.domain) + " --namespace " +
-                      dds_.ns + (identity.empty() ? "" : " --identity " + (pki_ / identity).string()) + " " + args);
+  std::string ctl(const std::string& identity, const std::vector<std::string>& args) const {
+    std::vector<std::string> argv{DRIVEGATECTL_PATH, "--domain", std::to_string(dds_.domain), "--namespace", dds_.ns};
+    if (!identity.empty()) argv.insert(argv.end(), {"--identity", (pki_ / identity).string()});
+    argv.insert(argv.end(), args.begin(), args.end());
+    const RunResult r = run_program(argv);
     return std::to_string(r.status) + ":" + r.output;
   }
 
@@ -144,11 +133,11 @@ TEST_F(Security, AnObserverReadsStateButCannotCommand) {
   const auto r = obs.send(request("x", "enable"), true, 5s);
   EXPECT_EQ(r.outcome, client::Outcome::Denied);
   EXPECT_NE(r.reason.find("axis_command"), std::string::npos) << r.reason;
-  const std::string out = ctl("observer", "enable x");
+  const std::string out = ctl("observer", {"enable", "x"});
   EXPECT_EQ(out.rfind("1:", 0), 0u) << out;
   EXPECT_NE(out.find("enable x: denied"), std::string::npos) << out;
   EXPECT_NE(out.find("access control"), std::string::npos) << out;
-  const std::string status = ctl("observer", "status x");
+  const std::string status = ctl("observer", {"status", "x"});
   EXPECT_EQ(status.rfind("0:", 0), 0u) << status;
   EXPECT_NE(status.find("switch_on_disabled"), std::string::npos) << status;
   // The link detail (axis_link) is the observer's to read as well.
@@ -177,7 +166,7 @@ TEST_F(Security, StrangersSeeNothingAndCommandNothing) {
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("not expired"), std::string::npos) << e.what();
   }
-  const std::string out = ctl("old", "status");
+  const std::string out = ctl("old", {"status"});
   EXPECT_EQ(out.rfind("1:", 0), 0u) << out;
 }
 
@@ -185,7 +174,7 @@ TEST_F(Security, StrangersSeeNothingAndCommandNothing) {
 // which starts from it): with certificates where it expects them, it passes --check-config.
 TEST(SecurityConfig, OnInTheProductionExampleOffInTheDemo) {
   const auto pki = std::filesystem::temp_directory_path() / ("drivegate-pki-prod-" + std::to_string(::getpid()));
-  const ShellRun made = run(std::string(DRIVEGATE_MAKE_PKI) + " " + pki.string());
+  const RunResult made = run_program({DRIVEGATE_MAKE_PKI, pki.string()});
   ASSERT_EQ(made.status, 0) << made.output;
   std::ifstream in(DRIVEGATE_PRODUCTION_CONFIG);
   std::stringstream text;
@@ -195,11 +184,11 @@ TEST(SecurityConfig, OnInTheProductionExampleOffInTheDemo) {
   ASSERT_NE(yaml.find("dir: " + installed), std::string::npos);
   yaml.replace(yaml.find(installed), installed.size(), (pki / "gateway").string());
   const std::string file = test::write_config_text("production", yaml);
-  ShellRun r = run(std::string(DRIVEGATED_PATH) + " --check-config " + file);
+  RunResult r = run_program({DRIVEGATED_PATH, "--check-config", file});
   EXPECT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("dds security:    on: certificate " + (pki / "gateway" / "cert.pem").string()), std::string::npos)
       << r.output;
-  r = run(std::string(DRIVEGATED_PATH) + " --check-config " + DRIVEGATE_DEMO_CONFIG);
+  r = run_program({DRIVEGATED_PATH, "--check-config", DRIVEGATE_DEMO_CONFIG});
   EXPECT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("dds security:    off"), std::string::npos) << r.output;
   std::filesystem::remove_all(pki);

@@ -50,8 +50,6 @@ bool has_capability(int cap) {
   return false;
 }
 
-RunResult ip(const std::vector<std::string>& args) { return run_ip(args); }
-
 void must(const RunResult& r, const std::string& what) {
   if (!r.ok()) throw std::runtime_error(what + " failed: " + r.output);
 }
@@ -98,52 +96,6 @@ int open_netns(const std::string& name) {
 
 }  // namespace
 
-RunResult run_program(const std::vector<std::string>& argv) {
-  RunResult result;
-  if (argv.empty() || argv[0].empty()) {
-    result.output = "no program";
-    return result;
-  }
-  int pipefd[2];
-  if (::pipe2(pipefd, O_CLOEXEC) != 0) {
-    result.output = std::string("pipe2: ") + std::strerror(errno);
-    return result;
-  }
-  std::vector<char*> args;
-  for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-  args.push_back(nullptr);
-  const pid_t pid = ::fork();
-  if (pid < 0) {
-    ::close(pipefd[0]);
-    ::close(pipefd[1]);
-    result.output = "fork failed";
-    return result;
-  }
-  if (pid == 0) {
-    ::dup2(pipefd[1], STDOUT_FILENO);
-    ::dup2(pipefd[1], STDERR_FILENO);
-    ::execv(args[0], args.data());
-    ::_exit(127);
-  }
-  ::close(pipefd[1]);
-  char chunk[512];
-  for (;;) {
-    const ssize_t n = ::read(pipefd[0], chunk, sizeof chunk);
-    if (n > 0) {
-      result.output.append(chunk, static_cast<std::size_t>(n));
-      continue;
-    }
-    if (n < 0 && errno == EINTR) continue;
-    break;
-  }
-  ::close(pipefd[0]);
-  int status = 0;
-  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-  }
-  result.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
-}
-
 RunResult run_ip(const std::vector<std::string>& args) {
   std::vector<std::string> argv{ip_path()};
   argv.insert(argv.end(), args.begin(), args.end());
@@ -160,9 +112,9 @@ const std::string& netns_unavailable() {
     if (ip_path().empty()) return "the 'ip' program (iproute2) is missing";
     clean_stale_once();
     const std::string probe = unique_net_name('p');
-    const RunResult add = ip({"netns", "add", probe});
+    const RunResult add = run_ip({"netns", "add", probe});
     if (!add.ok()) return "cannot create a network namespace: " + add.output;
-    ip({"netns", "del", probe});
+    run_ip({"netns", "del", probe});
     return {};
   }();
   return reason;
@@ -179,10 +131,10 @@ std::string unique_net_name(char kind) {
 int remove_stale_net_objects() {
   int removed = 0;
   for (const auto& name : entries("/run/netns")) {
-    if (stale(name) && ip({"netns", "del", name}).ok()) ++removed;
+    if (stale(name) && run_ip({"netns", "del", name}).ok()) ++removed;
   }
   for (const auto& name : entries("/sys/class/net")) {
-    if (stale(name) && ip({"link", "del", name}).ok()) ++removed;
+    if (stale(name) && run_ip({"link", "del", name}).ok()) ++removed;
   }
   return removed;
 }
@@ -191,23 +143,23 @@ NetNamespace::NetNamespace() {
   if (ip_path().empty()) throw std::runtime_error("the 'ip' program (iproute2) is missing");
   clean_stale_once();
   name_ = unique_net_name('n');
-  must(test::ip({"netns", "add", name_}), "ip netns add " + name_);
+  must(run_ip({"netns", "add", name_}), "ip netns add " + name_);
   const RunResult lo = ip({"link", "set", "lo", "up"});
   if (!lo.ok()) {
-    test::ip({"netns", "del", name_});
+    run_ip({"netns", "del", name_});
     throw std::runtime_error("ip -n " + name_ + " link set lo up failed: " + lo.output);
   }
 }
 
 NetNamespace::~NetNamespace() {
   // Interfaces inside go with the namespace once nothing holds it; a VethPair deletes its own first.
-  test::ip({"netns", "del", name_});
+  run_ip({"netns", "del", name_});
 }
 
 RunResult NetNamespace::ip(const std::vector<std::string>& args) const {
   std::vector<std::string> a{"-n", name_};
   a.insert(a.end(), args.begin(), args.end());
-  return test::ip(a);
+  return run_ip(a);
 }
 
 NetnsScope::NetnsScope(const NetNamespace& ns) {
@@ -240,16 +192,16 @@ VethPair::~VethPair() {
 
 RunResult VethPair::ip_in(End e, const std::vector<std::string>& args) const {
   const NetNamespace* ns = e == End::A ? ns_a_ : ns_b_;
-  return ns != nullptr ? ns->ip(args) : ip(args);
+  return ns != nullptr ? ns->ip(args) : run_ip(args);
 }
 
 void VethPair::create() {
   // Both ends are made in this process's namespace and moved at once, so that they are there only
   // for the moment between the two commands (and remove_stale_net_objects() finds them after a crash).
-  must(ip({"link", "add", a_, "type", "veth", "peer", "name", b_}), "ip link add " + a_);
+  must(run_ip({"link", "add", a_, "type", "veth", "peer", "name", b_}), "ip link add " + a_);
   exists_ = true;
-  if (ns_a_ != nullptr) must(ip({"link", "set", a_, "netns", ns_a_->name()}), "ip link set " + a_ + " netns");
-  if (ns_b_ != nullptr) must(ip({"link", "set", b_, "netns", ns_b_->name()}), "ip link set " + b_ + " netns");
+  if (ns_a_ != nullptr) must(run_ip({"link", "set", a_, "netns", ns_a_->name()}), "ip link set " + a_ + " netns");
+  if (ns_b_ != nullptr) must(run_ip({"link", "set", b_, "netns", ns_b_->name()}), "ip link set " + b_ + " netns");
   set_up(End::A, true);
   set_up(End::B, true);
   wait_up();

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "tests/support/pipe_lines.hpp"
+#include "tests/support/run_program.hpp"
 
 namespace drivegate::test {
 
@@ -25,13 +26,6 @@ namespace drivegate::test {
 // root, no CAP_NET_ADMIN / CAP_SYS_ADMIN, `ip` missing, the kernel refused). Probed once.
 const std::string& netns_unavailable();
 
-struct RunResult {
-  int status = -1;  // exit status, or -1 when the program did not end normally
-  std::string output;  // stdout and stderr
-  [[nodiscard]] bool ok() const noexcept { return status == 0; }
-};
-// Runs a program (no shell) and waits for it.
-RunResult run_program(const std::vector<std::string>& argv);
 // Runs `ip ARGS...` (iproute2, found in the sbin and bin directories).
 RunResult run_ip(const std::vector<std::string>& args);
 

@@ -1,25 +1,34 @@
 #pragma once
 // Captures for Wireshark's dissectors as an independent judge of our frames: a classic pcap file
-// (global header, then one record per frame; link type 1 = Ethernet), and a command's output.
+// (global header, then one record per frame; link type 1 = Ethernet), and tshark's dissection of it.
+#include <unistd.h>
+
 #include <array>
+#include <atomic>
 #include <cstdint>
-#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
+
+#include "core/bytes.hpp"
+#include "tests/support/run_program.hpp"
 
 namespace drivegate::test {
 
 namespace pcap_detail {
 inline void put32(std::ofstream& f, std::uint32_t v) {
-  const std::array<char, 4> b{static_cast<char>(v & 0xFF), static_cast<char>((v >> 8) & 0xFF),
-                              static_cast<char>((v >> 16) & 0xFF), static_cast<char>(v >> 24)};
-  f.write(b.data(), 4);
+  std::array<std::uint8_t, 4> b{};
+  core::put_u32(b, 0, v);
+  f.write(reinterpret_cast<const char*>(b.data()), b.size());
 }
 inline void put16(std::ofstream& f, std::uint16_t v) {
-  const std::array<char, 2> b{static_cast<char>(v & 0xFF), static_cast<char>(v >> 8)};
-  f.write(b.data(), 2);
+  std::array<std::uint8_t, 2> b{};
+  core::put_u16(b, 0, v);
+  f.write(reinterpret_cast<const char*>(b.data()), b.size());
 }
 }  // namespace pcap_detail
 
@@ -47,16 +56,19 @@ inline void write_pcap(const std::filesystem::path& path, const std::vector<std:
   }
 }
 
-// What a shell command prints on standard output ("" when it cannot start).
-inline std::string command_output(const std::string& cmd) {
-  std::string out;
-  FILE* p = popen(cmd.c_str(), "r");
-  if (p == nullptr) return out;
-  std::array<char, 4096> buf{};
-  std::size_t n = 0;
-  while ((n = std::fread(buf.data(), 1, buf.size(), p)) > 0) out.append(buf.data(), n);
-  pclose(p);
-  return out;
+// `tshark -r FILE -V` of `frames` written to a temporary pcap file (`step_us` apart): the full
+// dissection, stdout and stderr. nullopt when tshark is not installed. The file is removed
+// afterwards unless KEEP_PCAP is set in the environment.
+inline std::optional<std::string> tshark_dissect(const std::vector<std::vector<std::uint8_t>>& frames,
+                                                 std::uint32_t step_us = 1000) {
+  if (run_program({"tshark", "--version"}).status == 127) return std::nullopt;
+  static std::atomic<unsigned> serial{0};
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("drivegate-tshark-" + std::to_string(::getpid()) + "-" + std::to_string(serial++) + ".pcap");
+  write_pcap(path, frames, step_us);
+  RunResult r = run_program({"tshark", "-r", path.string(), "-V"});
+  if (std::getenv("KEEP_PCAP") == nullptr) std::filesystem::remove(path);
+  return std::move(r.output);
 }
 
 }  // namespace drivegate::test

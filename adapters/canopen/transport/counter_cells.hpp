@@ -1,32 +1,20 @@
 #pragma once
-// TransportCounters as relaxed atomics: the one thread that runs send()/receive() writes them, any
-// thread may read a snapshot (Transport::counters()). A single writer needs no read-modify-write,
-// so an increment is a relaxed load and store, as cheap as a plain increment.
-#include <atomic>
-#include <cstdint>
-
+// TransportCounters as relaxed atomics (core::CounterCell): the one thread that runs
+// send()/receive() writes them, any thread may read a snapshot (Transport::counters()).
 #include "adapters/canopen/transport/transport.hpp"
+#include "core/counter_cell.hpp"
 
 namespace drivegate::canopen {
 
-class CounterCell {
- public:
-  void add(std::uint64_t n = 1) noexcept { v_.store(v_.load(std::memory_order_relaxed) + n, std::memory_order_relaxed); }
-  [[nodiscard]] std::uint64_t get() const noexcept { return v_.load(std::memory_order_relaxed); }
-
- private:
-  std::atomic<std::uint64_t> v_{0};
-};
-
 struct CounterCells {
-  CounterCell rx_frames;
-  CounterCell tx_frames;
-  CounterCell rx_malformed;
-  CounterCell rx_filtered;
-  CounterCell tx_overflows;
-  CounterCell error_frames;
-  CounterCell bus_off;
-  CounterCell restarts;
+  core::CounterCell rx_frames;
+  core::CounterCell tx_frames;
+  core::CounterCell rx_malformed;
+  core::CounterCell rx_filtered;
+  core::CounterCell tx_overflows;
+  core::CounterCell error_frames;
+  core::CounterCell bus_off;
+  core::CounterCell restarts;
 
   [[nodiscard]] TransportCounters snapshot() const noexcept {
     TransportCounters c;

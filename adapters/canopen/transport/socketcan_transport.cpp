@@ -10,10 +10,10 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
-#include <system_error>
 #include <utility>
 
 #include "adapters/canopen/transport/batch_send.hpp"
+#include "core/errno_text.hpp"
 #include "core/fd_guard.hpp"
 
 namespace drivegate::canopen {
@@ -21,7 +21,7 @@ namespace {
 
 constexpr std::int64_t kNsPerSecond = 1'000'000'000;
 
-std::string errno_text(int e) { return std::system_category().message(e); }
+using core::errno_text;
 
 [[noreturn]] void fail(const std::string& what) { throw TransportError("socketcan: " + what); }
 

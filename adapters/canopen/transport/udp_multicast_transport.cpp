@@ -6,10 +6,10 @@
 
 #include <algorithm>
 #include <cerrno>
-#include <system_error>
 #include <utility>
 
 #include "adapters/canopen/transport/batch_send.hpp"
+#include "core/errno_text.hpp"
 #include "core/fd_guard.hpp"
 
 namespace drivegate::canopen {
@@ -19,7 +19,7 @@ namespace {
 // that a flood of them cannot hold the cycle thread for long; the rest waits for the next call.
 constexpr std::size_t kDiscardBudget = 64;
 
-std::string errno_text(int e) { return std::system_category().message(e); }
+using core::errno_text;
 
 [[noreturn]] void fail(const std::string& what) { throw TransportError("udp-multicast: " + what); }
 

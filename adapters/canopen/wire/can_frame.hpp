@@ -1,10 +1,12 @@
 #pragma once
 // One classic CAN frame as every layer of the CANopen adapter sees it: transports fill it from the
 // wire, engines read and produce it. Trivially copyable, fixed size, no allocation.
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <span>
 
+#include "core/bytes.hpp"
 #include "core/clock.hpp"
 
 namespace drivegate::canopen {
@@ -47,12 +49,10 @@ inline CanFrame make_frame(std::uint32_t id, std::initializer_list<std::uint8_t>
 // Little-endian helpers for CANopen payloads [CiA 301 §7.1: all numbers little-endian]: n bytes
 // (at most 4) from / to offset `at`, never past the end of the span.
 inline constexpr std::uint32_t get_le(std::span<const std::uint8_t> b, std::size_t at, std::size_t n) noexcept {
-  std::uint32_t v = 0;
-  for (std::size_t i = 0; i < n && i < 4 && at + i < b.size(); ++i) v |= std::uint32_t{b[at + i]} << (8 * i);
-  return v;
+  return at < b.size() ? static_cast<std::uint32_t>(core::get_le(b.subspan(at, std::min({n, std::size_t{4}, b.size() - at})))) : 0;
 }
 inline constexpr void put_le(std::span<std::uint8_t> b, std::size_t at, std::size_t n, std::uint32_t v) noexcept {
-  for (std::size_t i = 0; i < n && i < 4 && at + i < b.size(); ++i) b[at + i] = static_cast<std::uint8_t>(v >> (8 * i));
+  if (at < b.size()) core::put_le(b.subspan(at, std::min({n, std::size_t{4}, b.size() - at})), v);
 }
 
 }  // namespace drivegate::canopen

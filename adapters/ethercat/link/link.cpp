@@ -1,22 +1,12 @@
 #include "adapters/ethercat/link/link.hpp"
 
+#include "core/bytes.hpp"
+
 namespace drivegate::ethercat {
 
-const char* to_string(FrameCheck c) noexcept {
-  switch (c) {
-    case FrameCheck::Ok: return "ok";
-    case FrameCheck::TooShort: return "too short";
-    case FrameCheck::TooLong: return "too long";
-    case FrameCheck::WrongEtherType: return "wrong EtherType";
-  }
-  return "?";
-}
-
 FrameCheck check_frame(std::span<const std::uint8_t> frame) noexcept {
-  if (frame.size() < kMinFrameBytes) return FrameCheck::TooShort;
-  if (frame.size() > kMaxFrameBytes) return FrameCheck::TooLong;
-  const auto type = static_cast<std::uint16_t>((frame[12] << 8) | frame[13]);
-  return type == kEtherTypeEthercat ? FrameCheck::Ok : FrameCheck::WrongEtherType;
+  if (!sendable(frame)) return frame.size() < kMinFrameBytes ? FrameCheck::TooShort : FrameCheck::TooLong;
+  return core::get_be16(frame, kEtherTypeOffset) == kEtherType ? FrameCheck::Ok : FrameCheck::WrongEtherType;
 }
 
 const char* to_string(LinkState s) noexcept {
@@ -26,15 +16,6 @@ const char* to_string(LinkState s) noexcept {
     case LinkState::AdminDown: return "interface down";
     case LinkState::NoCarrier: return "no carrier";
     case LinkState::Gone: return "interface gone";
-  }
-  return "?";
-}
-
-const char* to_string(SendStatus s) noexcept {
-  switch (s) {
-    case SendStatus::Sent: return "sent";
-    case SendStatus::Busy: return "busy";
-    case SendStatus::Down: return "down";
   }
   return "?";
 }
@@ -63,6 +44,11 @@ void LinkCounterCells::count_drop(FrameCheck c) noexcept {
     case FrameCheck::TooLong: rx_too_long.add(); break;
     case FrameCheck::WrongEtherType: rx_wrong_ethertype.add(); break;
   }
+}
+
+void LinkCounterCells::count_transition(LinkState before, LinkState after) noexcept {
+  if (before == LinkState::Up && after != LinkState::Up) link_downs.add();
+  if (before != LinkState::Up && before != LinkState::Closed && after == LinkState::Up) link_ups.add();
 }
 
 }  // namespace drivegate::ethercat

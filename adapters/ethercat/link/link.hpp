@@ -9,14 +9,15 @@
 // allocation, no lock, no logging. open() may allocate and throws LinkError with one line a person
 // can act on. One thread (the bus thread) uses a link; state() and counters() may be read from any.
 #include <array>
-#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <span>
 #include <stdexcept>
 #include <string>
 
+#include "adapters/ethercat/wire/ethernet.hpp"
 #include "core/clock.hpp"
+#include "core/counter_cell.hpp"
 
 namespace drivegate::ethercat {
 
@@ -26,33 +27,34 @@ class LinkError : public std::runtime_error {
 };
 
 // EtherCAT frames are Ethernet II frames of EtherType 88A4h (ETG.1000.4, frame structure: Ethernet
-// header, then the 2-byte EtherCAT header, then the datagrams).
-inline constexpr std::uint16_t kEtherTypeEthercat = 0x88A4;
-inline constexpr std::size_t kEthernetHeaderBytes = 14;  // destination 6, source 6, EtherType 2 [IEEE 802.3 §3.1.1]
-inline constexpr std::size_t kEthercatHeaderBytes = 2;   // length 11 bits, reserved 1, type 4 (ETG.1000.4)
-// Shorter than an Ethernet header plus the EtherCAT header cannot be an EtherCAT frame. Frames are
-// not padded to the 60-byte Ethernet minimum here: veth does not pad, a NIC pads on its own.
-inline constexpr std::size_t kMinFrameBytes = kEthernetHeaderBytes + kEthercatHeaderBytes;
-// The largest untagged Ethernet frame without FCS: 1500 bytes of payload [IEEE 802.3 §3.2.7].
-inline constexpr std::size_t kMaxFrameBytes = kEthernetHeaderBytes + 1500;
+// header, then the 2-byte EtherCAT header, then the datagrams); the sizes and the EtherType are in
+// wire/ethernet.hpp. Shorter than an Ethernet header plus the EtherCAT header cannot be an EtherCAT
+// frame. Frames are not padded to the 60-byte Ethernet minimum here: veth does not pad, a NIC pads
+// on its own. The longest is kMaxFrameSize (1514, untagged, without FCS).
+inline constexpr std::size_t kMinFrameBytes = kEthernetHeaderSize + kEcatHeaderSize;
+
+// One frame to send: the whole Ethernet frame.
+using FrameView = std::span<const std::uint8_t>;
+
+// Whether a frame's length lets it go on the link: kMinFrameBytes to kMaxFrameSize. send() skips
+// other frames (counted invalid); check_frame() refuses received ones by the same rule.
+constexpr bool sendable(FrameView frame) noexcept {
+  return frame.size() >= kMinFrameBytes && frame.size() <= kMaxFrameSize;
+}
 
 // What a received frame is, by its length and EtherType only.
 enum class FrameCheck : std::uint8_t { Ok, TooShort, TooLong, WrongEtherType };
-const char* to_string(FrameCheck c) noexcept;
 // The EtherType is big-endian at offset 12 [IEEE 802.3 §3.2.6]. A VLAN-tagged frame (8100h) counts
 // as a wrong EtherType: EtherCAT masters send untagged frames.
 [[nodiscard]] FrameCheck check_frame(std::span<const std::uint8_t> frame) noexcept;
 
 // One received frame in memory the caller owns (the socket writes straight into `bytes`).
 struct FrameBuffer {
-  std::array<std::uint8_t, kMaxFrameBytes> bytes{};
+  std::array<std::uint8_t, kMaxFrameSize> bytes{};
   std::size_t size = 0;
 
   [[nodiscard]] std::span<const std::uint8_t> view() const noexcept { return {bytes.data(), size}; }
 };
-
-// One frame to send: the whole Ethernet frame.
-using FrameView = std::span<const std::uint8_t>;
 
 enum class LinkState : std::uint8_t {
   Closed,     // not opened (or closed)
@@ -68,10 +70,9 @@ enum class SendStatus : std::uint8_t {
   Busy,  // the transmit queue was full: that frame and the ones after it were not sent
   Down,  // the link is down or closed: that frame and the ones after it were not sent
 };
-const char* to_string(SendStatus s) noexcept;
 
 // What send() did with its frames, front first: sent + invalid + unsent == frames given. Invalid
-// frames (shorter than kMinFrameBytes or longer than kMaxFrameBytes) are skipped and the rest go on.
+// frames (shorter than kMinFrameBytes or longer than kMaxFrameSize) are skipped and the rest go on.
 struct SendResult {
   std::size_t sent = 0;
   std::size_t invalid = 0;
@@ -86,7 +87,7 @@ struct LinkCounters {
   std::uint64_t tx_down = 0;            // not sent: link down or closed
   std::uint64_t rx_frames = 0;          // delivered by receive()
   std::uint64_t rx_too_short = 0;       // dropped: shorter than kMinFrameBytes
-  std::uint64_t rx_too_long = 0;        // dropped: longer than kMaxFrameBytes
+  std::uint64_t rx_too_long = 0;        // dropped: longer than kMaxFrameSize
   std::uint64_t rx_wrong_ethertype = 0; // dropped: not 88A4h
   std::uint64_t rx_own = 0;             // dropped: an outgoing frame of this host seen back
   std::uint64_t rx_overflow = 0;        // dropped before we saw it: receive queue full
@@ -94,25 +95,19 @@ struct LinkCounters {
   std::uint64_t link_ups = 0;           // recoveries: transitions back to Up
 };
 
-// LinkCounters as relaxed atomics: the bus thread writes them, any thread may read a snapshot. A
-// single writer needs no read-modify-write, so an increment is a relaxed load and store.
-class LinkCounterCell {
- public:
-  void add(std::uint64_t n = 1) noexcept { v_.store(v_.load(std::memory_order_relaxed) + n, std::memory_order_relaxed); }
-  [[nodiscard]] std::uint64_t get() const noexcept { return v_.load(std::memory_order_relaxed); }
-
- private:
-  std::atomic<std::uint64_t> v_{0};
-};
-
+// LinkCounters as relaxed atomics (core::CounterCell): the bus thread writes them, any thread may
+// read a snapshot.
 struct LinkCounterCells {
-  LinkCounterCell tx_frames, tx_invalid, tx_busy, tx_down;
-  LinkCounterCell rx_frames, rx_too_short, rx_too_long, rx_wrong_ethertype, rx_own, rx_overflow;
-  LinkCounterCell link_downs, link_ups;
+  core::CounterCell tx_frames, tx_invalid, tx_busy, tx_down;
+  core::CounterCell rx_frames, rx_too_short, rx_too_long, rx_wrong_ethertype, rx_own, rx_overflow;
+  core::CounterCell link_downs, link_ups;
 
   [[nodiscard]] LinkCounters snapshot() const noexcept;
   // Counts a received frame that check_frame() refused.
   void count_drop(FrameCheck c) noexcept;
+  // Counts a change of the link state: Up to any other state is a link down, back to Up from a
+  // down state a link up (from Closed it is an open, not a recovery).
+  void count_transition(LinkState before, LinkState after) noexcept;
 };
 
 class Link {

@@ -29,31 +29,27 @@ void MemoryLink::set_sink(FrameSink* sink) noexcept {
 }
 
 void MemoryLink::open() {
-  open_ = true;
-  open_flag_.store(true, std::memory_order_relaxed);
+  open_.store(true, std::memory_order_relaxed);
 }
 
 void MemoryLink::close() noexcept {
-  open_ = false;
-  open_flag_.store(false, std::memory_order_relaxed);
+  open_.store(false, std::memory_order_relaxed);
   head_ = 0;
   count_ = 0;
 }
 
 void MemoryLink::set_wire_state(LinkState s) noexcept {
-  const LinkState before = wire_.exchange(s, std::memory_order_relaxed);
-  if (before == LinkState::Up && s != LinkState::Up) counters_.link_downs.add();
-  if (before != LinkState::Up && s == LinkState::Up) counters_.link_ups.add();
+  counters_.count_transition(wire_.exchange(s, std::memory_order_relaxed), s);
 }
 
 LinkState MemoryLink::state() const noexcept {
-  return open_flag_.load(std::memory_order_relaxed) ? wire_.load(std::memory_order_relaxed) : LinkState::Closed;
+  return open_.load(std::memory_order_relaxed) ? wire_.load(std::memory_order_relaxed) : LinkState::Closed;
 }
 
 LinkState MemoryLink::poll_state(core::TimePoint /*now*/) noexcept { return state(); }
 
 bool MemoryLink::deliver(FrameView frame) noexcept {
-  if (!open_ || wire_.load(std::memory_order_relaxed) != LinkState::Up) return false;
+  if (!is_open() || wire_.load(std::memory_order_relaxed) != LinkState::Up) return false;
   if (const FrameCheck c = check_frame(frame); c != FrameCheck::Ok) {
     counters_.count_drop(c);
     return false;
@@ -71,10 +67,10 @@ bool MemoryLink::deliver(FrameView frame) noexcept {
 
 SendResult MemoryLink::send(std::span<const FrameView> frames) noexcept {
   SendResult r;
-  const bool up = open_ && wire_.load(std::memory_order_relaxed) == LinkState::Up;
+  const bool up = is_open() && wire_.load(std::memory_order_relaxed) == LinkState::Up;
   for (std::size_t i = 0; i < frames.size(); ++i) {
     const FrameView f = frames[i];
-    if (f.size() < kMinFrameBytes || f.size() > kMaxFrameBytes) {
+    if (!sendable(f)) {
       ++r.invalid;
       counters_.tx_invalid.add();
       continue;

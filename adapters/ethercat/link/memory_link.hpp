@@ -50,7 +50,7 @@ class MemoryLink final : public Link {
 
   void open() override;
   void close() noexcept override;
-  [[nodiscard]] bool is_open() const noexcept override { return open_; }
+  [[nodiscard]] bool is_open() const noexcept override { return open_.load(std::memory_order_relaxed); }
   using Link::send;
   SendResult send(std::span<const FrameView> frames) noexcept override;
   std::size_t receive(std::span<FrameBuffer> out) noexcept override;
@@ -68,9 +68,8 @@ class MemoryLink final : public Link {
   std::size_t count_ = 0;  // queued frames
   FrameSink* sink_ = nullptr;
   MemoryLink* peer_ = nullptr;
-  bool open_ = false;
   std::atomic<LinkState> wire_{LinkState::Up};
-  std::atomic<bool> open_flag_{false};  // open_ for readers on other threads
+  std::atomic<bool> open_{false};  // atomic for state() readers on other threads
   LinkCounterCells counters_;
 };
 

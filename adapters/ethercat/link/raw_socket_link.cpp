@@ -9,9 +9,9 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
-#include <system_error>
 #include <utility>
 
+#include "core/errno_text.hpp"
 #include "core/fd_guard.hpp"
 
 namespace drivegate::ethercat {
@@ -23,7 +23,7 @@ namespace {
 #define PACKET_IGNORE_OUTGOING 23
 #endif
 
-std::string errno_text(int e) { return std::system_category().message(e); }
+using core::errno_text;
 
 [[noreturn]] void fail(const std::string& what) { throw LinkError("ethercat: " + what); }
 
@@ -57,13 +57,14 @@ ifreq request_for(const std::array<char, IFNAMSIZ>& name) noexcept {
 
 bool is_link_error(int e) noexcept { return e == ENETDOWN || e == ENXIO || e == ENODEV || e == ENETUNREACH; }
 
-}  // namespace
-
+// The reason text of open() failing for lack of CAP_NET_RAW, with the binary's path in the hint.
 std::string no_raw_permission_text(const std::string& interface) {
   return "ethercat: no permission to open a raw Ethernet socket on '" + interface +
          "' (CAP_NET_RAW missing); run as root or give the binary cap_net_raw, e.g. setcap cap_net_raw+ep " +
          own_binary();
 }
+
+}  // namespace
 
 RawSocketLink::RawSocketLink(RawSocketOptions options) : options_(std::move(options)) {
   // The headers point into this object's own arrays for its whole life; receive() sets the iovec
@@ -134,8 +135,6 @@ void RawSocketLink::open() {
   if (::setsockopt(fd.get(), SOL_SOCKET, SO_SNDBUFFORCE, &options_.send_buffer_bytes, sizeof(int)) != 0) {
     ::setsockopt(fd.get(), SOL_SOCKET, SO_SNDBUF, &options_.send_buffer_bytes, sizeof(int));
   }
-  socklen_t len = sizeof rcvbuf_;
-  if (::getsockopt(fd.get(), SOL_SOCKET, SO_RCVBUF, &rcvbuf_, &len) != 0) rcvbuf_ = 0;
 
   fd_ = fd.get();
   if (!bind_to(index)) {
@@ -148,7 +147,7 @@ void RawSocketLink::open() {
   fd_ = fd.release();
   // Reset the kernel's drop count: drops before open are not ours.
   tpacket_stats stats{};
-  len = sizeof stats;
+  socklen_t len = sizeof stats;
   ::getsockopt(fd_, SOL_PACKET, PACKET_STATISTICS, &stats, &len);
 
   state_.store(LinkState::Closed, std::memory_order_relaxed);
@@ -159,7 +158,7 @@ void RawSocketLink::open() {
 bool RawSocketLink::bind_to(int ifindex) noexcept {
   sockaddr_ll address{};
   address.sll_family = AF_PACKET;
-  address.sll_protocol = htons(options_.all_ethertypes ? std::uint16_t{ETH_P_ALL} : kEtherTypeEthercat);
+  address.sll_protocol = htons(options_.all_ethertypes ? std::uint16_t{ETH_P_ALL} : kEtherType);
   address.sll_ifindex = ifindex;
   if (::bind(fd_, reinterpret_cast<const sockaddr*>(&address), sizeof address) != 0) {
     bound_ = false;
@@ -186,9 +185,7 @@ void RawSocketLink::close() noexcept {
 }
 
 void RawSocketLink::set_state(LinkState s) noexcept {
-  const LinkState before = state_.exchange(s, std::memory_order_relaxed);
-  if (before == LinkState::Up && s != LinkState::Up) counters_.link_downs.add();
-  if (before != LinkState::Up && before != LinkState::Closed && s == LinkState::Up) counters_.link_ups.add();
+  counters_.count_transition(state_.exchange(s, std::memory_order_relaxed), s);
 }
 
 void RawSocketLink::note_error(int e) noexcept {
@@ -240,7 +237,6 @@ LinkState RawSocketLink::refresh() noexcept {
 
 SendResult RawSocketLink::send(std::span<const FrameView> frames) noexcept {
   SendResult r;
-  const auto valid = [](FrameView f) { return f.size() >= kMinFrameBytes && f.size() <= kMaxFrameBytes; };
   // What is not sent: the staged frames of the batch from position `staged_from` to `staged_end`
   // (valid ones; the invalid ones among them are counted already) and every frame from `next` on,
   // not looked at yet (each counted invalid or unsent). Every frame is counted once.
@@ -251,7 +247,7 @@ SendResult RawSocketLink::send(std::span<const FrameView> frames) noexcept {
       cell.add();
     }
     for (std::size_t i = next; i < frames.size(); ++i) {
-      if (!valid(frames[i])) {
+      if (!sendable(frames[i])) {
         ++r.invalid;
         counters_.tx_invalid.add();
       } else {
@@ -271,14 +267,13 @@ SendResult RawSocketLink::send(std::span<const FrameView> frames) noexcept {
     std::size_t count = 0;
     for (; next < frames.size() && count < kLinkBatch; ++next) {
       const FrameView f = frames[next];
-      if (!valid(f)) {
+      if (!sendable(f)) {
         ++r.invalid;
         counters_.tx_invalid.add();
         continue;
       }
       // sendmsg does not write through iov_base; iovec has no const variant.
       tx_iov_[count] = iovec{const_cast<std::uint8_t*>(f.data()), f.size()};
-      tx_frame_of_[count] = next;
       ++count;
     }
     for (std::size_t done = 0; done < count;) {

@@ -47,9 +47,6 @@ struct RawSocketOptions {
   bool all_ethertypes = false;
 };
 
-// The reason text of open() failing for lack of CAP_NET_RAW, with the binary's path in the hint.
-std::string no_raw_permission_text(const std::string& interface);
-
 class RawSocketLink final : public Link {
  public:
   explicit RawSocketLink(RawSocketOptions options);
@@ -75,8 +72,6 @@ class RawSocketLink final : public Link {
 
   // Whether the kernel took PACKET_IGNORE_OUTGOING (false: the pkttype fallback drops own frames).
   [[nodiscard]] bool ignores_outgoing() const noexcept { return ignore_outgoing_; }
-  // The buffer sizes the kernel granted (it reports twice the payload size it accounts for).
-  [[nodiscard]] int receive_buffer_bytes() const noexcept { return rcvbuf_; }
 
  private:
   // Reads the interface's index and flags through the socket, binds again when the interface came
@@ -94,7 +89,6 @@ class RawSocketLink final : public Link {
   int ifindex_ = -1;
   bool bound_ = false;
   bool ignore_outgoing_ = false;
-  int rcvbuf_ = 0;
   bool check_now_ = true;
   core::TimePoint next_check_{};
   std::atomic<LinkState> state_{LinkState::Closed};
@@ -102,7 +96,6 @@ class RawSocketLink final : public Link {
 
   std::array<mmsghdr, kLinkBatch> tx_msgs_{};
   std::array<iovec, kLinkBatch> tx_iov_{};
-  std::array<std::size_t, kLinkBatch> tx_frame_of_{};
   std::array<mmsghdr, kLinkBatch> rx_msgs_{};
   std::array<iovec, kLinkBatch> rx_iov_{};
   std::array<sockaddr_ll, kLinkBatch> rx_from_{};

@@ -2,11 +2,14 @@
 
 #include <algorithm>
 
-#include "adapters/ethercat/wire/bytes.hpp"
 #include "adapters/ethercat/wire/registers.hpp"
+#include "core/bytes.hpp"
 #include "profiles/cia402/sdo_abort.hpp"
 
 namespace drivegate::ethercat {
+
+using core::put_u32;
+
 namespace {
 
 // Bytes in front of the data: mailbox header 6 + CoE header 2 + SDO command, index, subindex, size

@@ -11,7 +11,7 @@
 //             repeat bit (080Eh bit 1, FPWR), poll until the slave's repeat acknowledge (080Fh bit 1)
 //             equals it, then read SM1 again: the slave has put the last reply back.
 //   transfers: expedited / normal / segmented upload and download, toggle checked; a server abort
-//             fails the request with its code (sdo_abort_text() for the words).
+//             fails the request with its code (cia402::sdo_abort_text() for the words).
 //   emergencies (CoE service 1) arriving in the mailbox go to the EmergencySink, any time.
 //
 // One request in flight per slave, a FIFO of kQueueDepth. Each request has a timeout from its

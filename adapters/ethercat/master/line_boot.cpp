@@ -4,9 +4,14 @@
 #include <cstdarg>
 
 #include "adapters/ethercat/wire/al_status.hpp"
-#include "adapters/ethercat/wire/bytes.hpp"
+#include "core/bytes.hpp"
 
 namespace drivegate::ethercat {
+
+using core::get_u16;
+using core::put_u16;
+using core::put_u32;
+
 namespace {
 
 // Tag layout: bits 24-31 actor (slave position, or the line), 16-23 item of a group, 0-15 sequence

@@ -4,9 +4,17 @@
 #include <cstring>
 
 #include "adapters/ethercat/wire/al_status.hpp"
-#include "adapters/ethercat/wire/bytes.hpp"
+#include "core/bytes.hpp"
 
 namespace drivegate::ethercat::sim {
+
+using core::get_u16;
+using core::get_u32;
+using core::get_u64;
+using core::put_u16;
+using core::put_u32;
+using core::put_u64;
+
 namespace {
 
 constexpr std::uint32_t kMemorySize = 0x10000;

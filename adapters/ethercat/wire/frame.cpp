@@ -2,9 +2,14 @@
 
 #include <algorithm>
 
-#include "adapters/ethercat/wire/bytes.hpp"
+#include "core/bytes.hpp"
 
 namespace drivegate::ethercat {
+
+using core::get_u16;
+using core::get_u32;
+using core::put_u16;
+using core::put_u32;
 
 namespace {
 
@@ -134,8 +139,7 @@ FrameBuilder::FrameBuilder(std::span<std::uint8_t> buffer, const MacAddress& dst
   }
   std::copy(dst.begin(), dst.end(), buf_.begin());
   std::copy(src.begin(), src.end(), buf_.begin() + 6);
-  buf_[12] = static_cast<std::uint8_t>(kEtherType >> 8);  // EtherType is big-endian
-  buf_[13] = static_cast<std::uint8_t>(kEtherType & 0xFF);
+  core::put_be16(buf_, kEtherTypeOffset, kEtherType);
   put_u16(buf_, kEthernetHeaderSize, 0);
   pos_ = kEthernetHeaderSize + kEcatHeaderSize;
 }
@@ -230,18 +234,17 @@ FrameParser::FrameParser(std::span<const std::uint8_t> frame) noexcept : frame_(
   }
   std::copy(frame_.begin(), frame_.begin() + 6, info_.dst.begin());
   std::copy(frame_.begin() + 6, frame_.begin() + 12, info_.src.begin());
-  std::size_t at = 12;
-  auto be16 = [this](std::size_t i) { return static_cast<std::uint16_t>((frame_[i] << 8) | frame_[i + 1]); };
-  std::uint16_t type = be16(at);
+  std::size_t at = kEtherTypeOffset;
+  std::uint16_t type = core::get_be16(frame_, at);
   if (type == kVlanTpid) {
     if (frame_.size() < kEthernetHeaderSize + kVlanTagSize) {
       fail(FrameError::TruncatedEthernet);
       return;
     }
     info_.vlan = true;
-    info_.vlan_tci = be16(at + 2);
+    info_.vlan_tci = core::get_be16(frame_, at + 2);
     at += kVlanTagSize;
-    type = be16(at);
+    type = core::get_be16(frame_, at);
   }
   if (type != kEtherType) {
     fail(FrameError::WrongEtherType);

@@ -17,20 +17,16 @@
 #include <span>
 #include <string_view>
 
+#include "adapters/ethercat/wire/ethernet.hpp"
+
 namespace drivegate::ethercat {
 
 using MacAddress = std::array<std::uint8_t, 6>;
 
-inline constexpr std::uint16_t kEtherType = 0x88A4;       // ETG.1000.4 §5.3
-inline constexpr std::uint16_t kVlanTpid = 0x8100;        // IEEE 802.1Q
-inline constexpr std::size_t kEthernetHeaderSize = 14;
-inline constexpr std::size_t kVlanTagSize = 4;
-inline constexpr std::size_t kEcatHeaderSize = 2;
+// kEtherType, kVlanTpid, the header sizes and kMin/kMaxFrameSize: wire/ethernet.hpp.
 inline constexpr std::size_t kDatagramHeaderSize = 10;
 inline constexpr std::size_t kWkcSize = 2;
 inline constexpr std::size_t kDatagramOverhead = kDatagramHeaderSize + kWkcSize;
-inline constexpr std::size_t kMinFrameSize = 60;    // Ethernet minimum without FCS
-inline constexpr std::size_t kMaxFrameSize = 1514;  // Ethernet maximum without FCS
 inline constexpr std::uint16_t kMaxEcatLength = 0x7FF;  // 11-bit length field
 // Largest data of one datagram in an untagged frame: 1514 - 14 - 2 - 12.
 inline constexpr std::size_t kMaxDatagramData = kMaxFrameSize - kEthernetHeaderSize - kEcatHeaderSize - kDatagramOverhead;

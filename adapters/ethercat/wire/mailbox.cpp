@@ -2,10 +2,14 @@
 
 #include <algorithm>
 
-#include "adapters/ethercat/wire/bytes.hpp"
-#include "profiles/cia402/sdo_abort.hpp"
+#include "core/bytes.hpp"
 
 namespace drivegate::ethercat {
+
+using core::get_u16;
+using core::get_u32;
+using core::put_u16;
+using core::put_u32;
 
 std::string_view to_string(MailboxType t) noexcept {
   switch (t) {
@@ -424,8 +428,6 @@ std::size_t encode_sdo_upload_segment_response(std::span<std::uint8_t> out, std:
   const auto cmd = static_cast<std::uint8_t>((toggle ? 0x10 : 0) | (last ? 0x01 : 0));  // scs 0
   return put_segment(out, counter, CoeService::SdoResponse, cmd, data);
 }
-
-std::string_view sdo_abort_text(std::uint32_t abort_code) noexcept { return cia402::sdo_abort_text(abort_code); }
 
 // ---- Emergency --------------------------------------------------------------------------------
 

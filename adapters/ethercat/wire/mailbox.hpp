@@ -17,6 +17,8 @@
 #include <span>
 #include <string_view>
 
+#include "core/bytes.hpp"
+
 namespace drivegate::ethercat {
 
 inline constexpr std::size_t kMailboxHeaderSize = 6;
@@ -205,9 +207,8 @@ std::size_t encode_sdo_upload_normal_response(std::span<std::uint8_t> out, std::
 std::size_t encode_sdo_upload_segment_response(std::span<std::uint8_t> out, std::uint8_t counter, bool toggle,
                                                bool last, std::span<const std::uint8_t> data) noexcept;
 
-// CoE shares the CiA 301 abort codes (ETG.1000.6 §5.6.2.7.2); the texts live in one bus-neutral
-// table (profiles/cia402/sdo_abort.hpp).
-std::string_view sdo_abort_text(std::uint32_t abort_code) noexcept;
+// CoE shares the CiA 301 abort codes (ETG.1000.6 §5.6.2.7.2); codes and texts live in one
+// bus-neutral table: cia402::sdo_abort_code and cia402::sdo_abort_text (profiles/cia402/sdo_abort.hpp).
 
 // ---- CoE emergency [ETG.1000.6 §5.6.4] --------------------------------------------------------
 
@@ -312,7 +313,7 @@ struct SdoInfoView {
   std::span<const std::uint8_t> index_bytes{};  // u16 LE each
   std::size_t index_count() const noexcept { return index_bytes.size() / 2; }
   std::uint16_t index_at(std::size_t i) const noexcept {
-    return static_cast<std::uint16_t>(index_bytes[2 * i] | (index_bytes[2 * i + 1] << 8));
+    return core::get_u16(index_bytes, 2 * i);
   }
   // Get Object Description request: object.index; response: all of object.
   SdoInfoObjectDescription object{};

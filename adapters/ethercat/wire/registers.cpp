@@ -1,8 +1,13 @@
 #include "adapters/ethercat/wire/registers.hpp"
 
-#include "adapters/ethercat/wire/bytes.hpp"
+#include "core/bytes.hpp"
 
 namespace drivegate::ethercat {
+
+using core::get_u16;
+using core::get_u32;
+using core::put_u16;
+using core::put_u32;
 
 std::string_view to_string(AlState s) noexcept {
   switch (s) {

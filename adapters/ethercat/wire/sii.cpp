@@ -2,9 +2,13 @@
 
 #include <algorithm>
 
-#include "adapters/ethercat/wire/bytes.hpp"
+#include "core/bytes.hpp"
 
 namespace drivegate::ethercat {
+
+using core::get_u16;
+using core::get_u32;
+using core::put_u16;
 
 std::string_view to_string(SiiCategory c) noexcept {
   switch (c) {
