@@ -28,9 +28,9 @@ std::vector<std::uint8_t> image(std::uint32_t product, std::uint32_t revision, s
       {0x1180, 0, 0x20, 0, 1, sii_sm_type::kInputs},
   }};
   SiiProfile p;
-  p.identity = SiiIdentity{kVendor, product, revision, 1234};
-  p.standard_mailbox = SiiMailbox{0x1000, 128, 0x1080, 128};
-  p.mailbox_protocols = mailbox_protocol::kCoE;
+  p.header.identity = SiiIdentity{kVendor, product, revision, 1234};
+  p.header.standard_mailbox = SiiMailbox{0x1000, 128, 0x1080, 128};
+  p.header.mailbox_protocols = mailbox_protocol::kCoE;
   p.name = name;
   p.group = "Drive";
   p.sync_managers = sms;
@@ -106,7 +106,7 @@ TEST(EthercatLineBoot, ThreeSlavesReachPreOp) {
     EXPECT_EQ(r.station, 0x1001 + i);
     EXPECT_EQ(h.line.slaves[i].station(), 0x1001 + i);       // APWR 0010h = 1001h + position
     EXPECT_EQ(h.line.slaves[i].al_state(), 2);               // the ESC is in PRE-OP
-    EXPECT_EQ(h.boot->sii(i).identity, (SiiIdentity{kVendor, kProduct, 0x00010000, 1234}));
+    EXPECT_EQ(h.boot->sii(i).header.identity, (SiiIdentity{kVendor, kProduct, 0x00010000, 1234}));
     EXPECT_EQ(h.boot->sii(i).string(h.boot->sii(i).general.name_index), "ESR TrioDrive");
     // SM0/SM1 as the SII standard mailbox says, with the SyncM category's control bytes
     // [ETG.1000.4 Table 59: start, length, control, status, activate, PDI control].

@@ -81,7 +81,7 @@ TEST(EthercatSimCommands, AliasAddressingNeedsDlControlBit) {
   // Alias 0042h in SII word 4, loaded into 0012h at power-on [ETG.1000.6 §5.4]; a slave with no
   // application (registers only).
   SiiProfile p;
-  p.station_alias = 0x0042;
+  p.header.station_alias = 0x0042;
   p.name = "bare";
   std::vector<std::uint8_t> image(2048);
   ASSERT_TRUE(build_sii(p, image).ok());

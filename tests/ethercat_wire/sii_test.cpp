@@ -177,13 +177,13 @@ TEST(EcatSii, ParseHandBuiltImage) {
   EXPECT_TRUE(s->ok());
   EXPECT_EQ(s->issue_count, 0U);
   EXPECT_TRUE(s->header_valid);
-  EXPECT_EQ(s->pdi_control, 0x0005);
-  EXPECT_EQ(s->station_alias, 0x1234);
+  EXPECT_EQ(s->header.pdi_control, 0x0005);
+  EXPECT_EQ(s->header.station_alias, 0x1234);
   EXPECT_TRUE(s->checksum_ok());
-  EXPECT_EQ(s->identity, (SiiIdentity{0x0F, 0x1A63, 0x00010002, 0x12345678}));
-  EXPECT_EQ(s->standard_mailbox, (SiiMailbox{0x1000, 128, 0x1080, 128}));
-  EXPECT_FALSE(s->bootstrap_mailbox.present());
-  EXPECT_EQ(s->mailbox_protocols, mailbox_protocol::kCoE);
+  EXPECT_EQ(s->header.identity, (SiiIdentity{0x0F, 0x1A63, 0x00010002, 0x12345678}));
+  EXPECT_EQ(s->header.standard_mailbox, (SiiMailbox{0x1000, 128, 0x1080, 128}));
+  EXPECT_FALSE(s->header.bootstrap_mailbox.present());
+  EXPECT_EQ(s->header.mailbox_protocols, mailbox_protocol::kCoE);
   EXPECT_EQ(s->eeprom_bytes(), 2048U);
   EXPECT_EQ(s->version, 1);
   ASSERT_EQ(s->string_count, 4U);
@@ -227,7 +227,7 @@ TEST(EcatSii, ChecksumMismatchIsAWarning) {
   EXPECT_TRUE(s->ok());  // a warning: the data is still read
   EXPECT_EQ(s->checksum, kCrcCaseB ^ 0x01);
   EXPECT_EQ(s->checksum_computed, kCrcCaseB);
-  EXPECT_EQ(s->identity.vendor_id, 0x0FU);
+  EXPECT_EQ(s->header.identity.vendor_id, 0x0FU);
 }
 
 // Impossible lengths: reported as errors, nothing read outside the image (ASan checks it).
@@ -332,11 +332,11 @@ TEST(EcatSii, BuilderRoundTrip) {
   const std::array<SiiBuildDc, 1> dcs{dc};
 
   SiiProfile p;
-  p.pdi_control = 0x0C08;
-  p.station_alias = 0;
-  p.identity = {0x0000000F, 0x00001A63, 0x00000001, 42};
-  p.standard_mailbox = {0x1000, 128, 0x1080, 128};
-  p.mailbox_protocols = mailbox_protocol::kCoE;
+  p.header.pdi_control = 0x0C08;
+  p.header.station_alias = 0;
+  p.header.identity = {0x0000000F, 0x00001A63, 0x00000001, 42};
+  p.header.standard_mailbox = {0x1000, 128, 0x1080, 128};
+  p.header.mailbox_protocols = mailbox_protocol::kCoE;
   p.group = "Drives";
   p.order = "TrioDrive D/ES";
   p.name = "TrioDrive D/ES";  // the same text: stored once
@@ -356,9 +356,9 @@ TEST(EcatSii, BuilderRoundTrip) {
   EXPECT_TRUE(s->ok());
   EXPECT_EQ(s->issue_count, 0U) << to_string(s->issues[0].problem);
   EXPECT_TRUE(s->checksum_ok());
-  EXPECT_EQ(s->pdi_control, 0x0C08);
-  EXPECT_EQ(s->identity, p.identity);
-  EXPECT_EQ(s->standard_mailbox, p.standard_mailbox);
+  EXPECT_EQ(s->header.pdi_control, 0x0C08);
+  EXPECT_EQ(s->header.identity, p.header.identity);
+  EXPECT_EQ(s->header.standard_mailbox, p.header.standard_mailbox);
   EXPECT_EQ(s->eeprom_size, 15);
   EXPECT_EQ(s->version, 1);
   // Strings: Drives, TrioDrive D/ES, TPDO1, Statusword, Position internal, RPDO1, Controlword,

@@ -352,7 +352,7 @@ void LineBoot::slave_phase(Slave& s) noexcept {
       // SM0 mailbox out (master -> slave), SM1 mailbox in, from the SII standard mailbox
       // [ETG.1000.6 §5.4 words 18h-1Bh]; control bytes from the SyncM category when it lists them,
       // else the usual 26h / 22h [ETG.1000.4 Table 59].
-      const SiiMailbox& mb = s.info.standard_mailbox;
+      const SiiMailbox& mb = s.info.header.standard_mailbox;
       std::uint8_t out_control = sm_control::kMailboxOut;
       std::uint8_t in_control = sm_control::kMailboxIn;
       for (std::size_t i = 0; i < s.info.sync_manager_count; ++i) {
@@ -494,7 +494,7 @@ void LineBoot::sii_chunk(Slave& s, std::span<const std::uint8_t> data) noexcept 
            to_string(first).data());
       return;
     }
-    s.report.found = s.info.identity;
+    s.report.found = s.info.header.identity;
     identify(s);
     return;
   }
@@ -507,7 +507,7 @@ void LineBoot::sii_chunk(Slave& s, std::span<const std::uint8_t> data) noexcept 
 }
 
 void LineBoot::identify(Slave& s) noexcept {
-  const SiiIdentity& f = s.info.identity;
+  const SiiIdentity& f = s.info.header.identity;
   if (s.report.position >= expected_count_) {
     s.phase = Phase::Idle;
     s.report.status = SlaveStatus::Extra;
@@ -527,7 +527,7 @@ void LineBoot::identify(Slave& s) noexcept {
          e.vendor_id, e.product_code, e.revision, f.vendor_id, f.product_code, f.revision);
     return;
   }
-  if (s.info.standard_mailbox.present()) {
+  if (s.info.header.standard_mailbox.present()) {
     s.report.step = BootStep::Mailbox;
     s.phase = Phase::Mailbox;
     slave_phase(s);

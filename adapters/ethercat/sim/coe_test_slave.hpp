@@ -66,9 +66,9 @@ inline std::vector<std::uint8_t> coe_sii() {
       SiiSyncManager{kIn, 2, sm_control::kInputs, 0, 1, sii_sm_type::kInputs},
   };
   SiiProfile p;
-  p.identity = SiiIdentity{0x0000066F, 0x1234, 1, 7};
-  p.standard_mailbox = SiiMailbox{kMbxOut, kMbxSize, kMbxIn, kMbxSize};
-  p.mailbox_protocols = mailbox_protocol::kCoE;
+  p.header.identity = SiiIdentity{0x0000066F, 0x1234, 1, 7};
+  p.header.standard_mailbox = SiiMailbox{kMbxOut, kMbxSize, kMbxIn, kMbxSize};
+  p.header.mailbox_protocols = mailbox_protocol::kCoE;
   p.name = "CoE test slave";
   p.general.coe_details = coe_details::kSdo | coe_details::kSdoInfo;
   p.sync_managers = sms;

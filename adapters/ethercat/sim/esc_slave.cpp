@@ -38,10 +38,10 @@ EscSlave::EscSlave(const EscConfig& config, std::span<const std::uint8_t> sii, S
       outbox_(config.mailbox_queue, 0),
       coe_(app != nullptr ? app->object_dictionary() : nullptr, config.max_object_bytes) {
   parse_sii(sii_, *sii_info_);
-  has_mailbox_ = sii_info_->standard_mailbox.present();
+  has_mailbox_ = sii_info_->header.standard_mailbox.present();
   if (has_mailbox_) {
-    outbox_ = MailboxOutbox(config.mailbox_queue, sii_info_->standard_mailbox.tx_size);
-    last_sent_.assign(sii_info_->standard_mailbox.tx_size, 0);
+    outbox_ = MailboxOutbox(config.mailbox_queue, sii_info_->header.standard_mailbox.tx_size);
+    last_sent_.assign(sii_info_->header.standard_mailbox.tx_size, 0);
   }
   const std::size_t ram = static_cast<std::size_t>(cfg_.ram_kib) * 1024;
   inputs_.assign(ram, 0);
@@ -109,10 +109,10 @@ void EscSlave::power_on() noexcept {
   if (cfg_.dc_supported) features = static_cast<std::uint16_t>(features | 0x0004U | (cfg_.dc_64bit ? 0x0008U : 0U));
   set16(reg::kEscFeatures, features);
   // What the ESC loads from the EEPROM at power-on [ETG.1000.6 §5.4: words 0-4].
-  set16(reg::kStationAlias, sii_info_->station_alias);
-  mem_[reg::kPdiControl] = static_cast<std::uint8_t>(sii_info_->pdi_control & 0xFF);
-  mem_[reg::kEscConfiguration] = static_cast<std::uint8_t>(sii_info_->pdi_control >> 8);
-  set16(reg::kPdiConfiguration, sii_info_->pdi_configuration);
+  set16(reg::kStationAlias, sii_info_->header.station_alias);
+  mem_[reg::kPdiControl] = static_cast<std::uint8_t>(sii_info_->header.pdi_control & 0xFF);
+  mem_[reg::kEscConfiguration] = static_cast<std::uint8_t>(sii_info_->header.pdi_control >> 8);
+  set16(reg::kPdiConfiguration, sii_info_->header.pdi_configuration);
   set32(reg::kDlControl, 0x00000001);  // forwarding rule; loops on auto
   set16(reg::kAlStatus, static_cast<std::uint16_t>(AlState::Init));
   // Watchdog defaults: divider 2498 (100 µs), times 1000 ticks = 100 ms [digest §8.2].
@@ -492,7 +492,7 @@ std::uint16_t EscSlave::check_transition(AlState from, AlState to) noexcept {
   if (from == AlState::Init && to == AlState::PreOp && has_mailbox_) {
     // Mailbox SMs as the SII says: SM0 master -> slave, SM1 slave -> master, both 1-buffer and
     // enabled [ETG.1000.6 §5.3.2 transition IP, code 0016h].
-    const SiiMailbox& mb = sii_info_->standard_mailbox;
+    const SiiMailbox& mb = sii_info_->header.standard_mailbox;
     const SmEntry s0 = sm(0);
     const SmEntry s1 = sm(1);
     const bool ok0 = s0.enabled() && s0.physical_start == mb.rx_offset && s0.length == mb.rx_size &&
@@ -570,7 +570,7 @@ void EscSlave::sii_command() noexcept {
       mem_[reg::kSiiData + i] = at < sii_.size() ? sii_[at] : 0xFF;  // unprogrammed beyond the image
     }
   } else if (cmd == sii_control::kCommandReload) {
-    set16(reg::kStationAlias, sii_info_->station_alias);
+    set16(reg::kStationAlias, sii_info_->header.station_alias);
   } else {
     ctl = static_cast<std::uint16_t>(ctl | sii_control::kCommandError);  // write or invalid: not offered
   }
@@ -599,7 +599,7 @@ void EscSlave::mailbox_received() noexcept {
   }
   last_rx_counter_ = v.header.counter;
   if (v.header.type == static_cast<std::uint8_t>(MailboxType::CoE) &&
-      (sii_info_->mailbox_protocols & mailbox_protocol::kCoE) != 0) {
+      (sii_info_->header.mailbox_protocols & mailbox_protocol::kCoE) != 0) {
     coe_.on_request(box, state_, outbox_);
     return;
   }

@@ -28,7 +28,7 @@ GenericIoSlave::GenericIoSlave(std::size_t inputs, std::size_t outputs, const Si
                      inputs_.empty() ? std::uint8_t{0} : std::uint8_t{1}, sii_sm_type::kInputs},
   };
   SiiProfile p;
-  p.identity = identity;
+  p.header.identity = identity;
   p.group = "IO";
   p.image = "";
   p.order = "SIM-IO";

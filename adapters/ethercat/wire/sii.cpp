@@ -122,23 +122,23 @@ class Parser {
   }
 
   void header() noexcept {
-    out_.pdi_control = word(sii_word::kPdiControl);
-    out_.pdi_configuration = word(sii_word::kPdiConfiguration);
-    out_.sync_impulse_length = word(sii_word::kSyncImpulseLength);
-    out_.pdi_configuration2 = word(sii_word::kPdiConfiguration2);
-    out_.station_alias = word(sii_word::kStationAlias);
+    out_.header.pdi_control = word(sii_word::kPdiControl);
+    out_.header.pdi_configuration = word(sii_word::kPdiConfiguration);
+    out_.header.sync_impulse_length = word(sii_word::kSyncImpulseLength);
+    out_.header.pdi_configuration2 = word(sii_word::kPdiConfiguration2);
+    out_.header.station_alias = word(sii_word::kStationAlias);
     out_.checksum = static_cast<std::uint8_t>(word(sii_word::kChecksum) & 0xFF);
     out_.checksum_computed = sii_crc8(img_.first(14));
     if (!out_.checksum_ok()) issue(SiiProblem::ChecksumMismatch, sii_word::kChecksum);
-    out_.identity.vendor_id = dword(sii_word::kVendorId);
-    out_.identity.product_code = dword(sii_word::kProductCode);
-    out_.identity.revision = dword(sii_word::kRevision);
-    out_.identity.serial = dword(sii_word::kSerial);
-    out_.bootstrap_mailbox = {word(sii_word::kBootstrapRxMailboxOffset), word(sii_word::kBootstrapRxMailboxSize),
+    out_.header.identity.vendor_id = dword(sii_word::kVendorId);
+    out_.header.identity.product_code = dword(sii_word::kProductCode);
+    out_.header.identity.revision = dword(sii_word::kRevision);
+    out_.header.identity.serial = dword(sii_word::kSerial);
+    out_.header.bootstrap_mailbox = {word(sii_word::kBootstrapRxMailboxOffset), word(sii_word::kBootstrapRxMailboxSize),
                               word(sii_word::kBootstrapTxMailboxOffset), word(sii_word::kBootstrapTxMailboxSize)};
-    out_.standard_mailbox = {word(sii_word::kStandardRxMailboxOffset), word(sii_word::kStandardRxMailboxSize),
+    out_.header.standard_mailbox = {word(sii_word::kStandardRxMailboxOffset), word(sii_word::kStandardRxMailboxSize),
                              word(sii_word::kStandardTxMailboxOffset), word(sii_word::kStandardTxMailboxSize)};
-    out_.mailbox_protocols = word(sii_word::kMailboxProtocols);
+    out_.header.mailbox_protocols = word(sii_word::kMailboxProtocols);
     out_.eeprom_size = word(sii_word::kEepromSize);
     out_.version = word(sii_word::kVersion);
     out_.header_valid = true;
@@ -484,26 +484,26 @@ SiiBuildResult build_sii(const SiiProfile& p, std::span<std::uint8_t> out) noexc
   std::fill(img.begin(), img.begin() + kSiiHeaderBytes, std::uint8_t{0});
   Writer w(img);
   // Fixed header [ETG.1000.6 §5.4].
-  w.u16(p.pdi_control);
-  w.u16(p.pdi_configuration);
-  w.u16(p.sync_impulse_length);
-  w.u16(p.pdi_configuration2);
-  w.u16(p.station_alias);
+  w.u16(p.header.pdi_control);
+  w.u16(p.header.pdi_configuration);
+  w.u16(p.header.sync_impulse_length);
+  w.u16(p.header.pdi_configuration2);
+  w.u16(p.header.station_alias);
   w.u16(0);
   w.u16(0);
   w.u16(sii_crc8(img.first(14)));  // checksum word: CRC in the low byte, 0 in the high byte
-  w.u32(p.identity.vendor_id);
-  w.u32(p.identity.product_code);
-  w.u32(p.identity.revision);
-  w.u32(p.identity.serial);
+  w.u32(p.header.identity.vendor_id);
+  w.u32(p.header.identity.product_code);
+  w.u32(p.header.identity.revision);
+  w.u32(p.header.identity.serial);
   for (int i = 0; i < 4; ++i) w.u16(0);  // words 10h-13h reserved
-  for (const SiiMailbox* m : {&p.bootstrap_mailbox, &p.standard_mailbox}) {
+  for (const SiiMailbox* m : {&p.header.bootstrap_mailbox, &p.header.standard_mailbox}) {
     w.u16(m->rx_offset);
     w.u16(m->rx_size);
     w.u16(m->tx_offset);
     w.u16(m->tx_size);
   }
-  w.u16(p.mailbox_protocols);
+  w.u16(p.header.mailbox_protocols);
   while (w.pos() < 2 * sii_word::kEepromSize) w.u16(0);  // words 1Dh-3Dh reserved
   w.u16(static_cast<std::uint16_t>(size / 128 - 1));
   w.u16(1);  // version

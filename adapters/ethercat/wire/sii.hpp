@@ -227,19 +227,26 @@ inline constexpr std::size_t kSiiMaxPdoEntries = 512;
 inline constexpr std::size_t kSiiMaxDcs = 8;
 inline constexpr std::size_t kSiiMaxIssues = 16;
 
-struct SiiInfo {
-  // Fixed header
+// The fixed header's fields a device describes itself with (what parse_sii reads and build_sii
+// writes; the checksum, size and version are the image's own).
+struct SiiHeader {
   std::uint16_t pdi_control = 0;
   std::uint16_t pdi_configuration = 0;
   std::uint16_t sync_impulse_length = 0;
   std::uint16_t pdi_configuration2 = 0;
   std::uint16_t station_alias = 0;
-  std::uint8_t checksum = 0;           // as stored
-  std::uint8_t checksum_computed = 0;  // CRC-8 of words 0-6
   SiiIdentity identity{};
   SiiMailbox bootstrap_mailbox{};
   SiiMailbox standard_mailbox{};
   std::uint16_t mailbox_protocols = 0;
+  bool operator==(const SiiHeader&) const = default;
+};
+
+struct SiiInfo {
+  // Fixed header
+  SiiHeader header{};
+  std::uint8_t checksum = 0;           // as stored
+  std::uint8_t checksum_computed = 0;  // CRC-8 of words 0-6
   std::uint16_t eeprom_size = 0;       // word 3Eh as stored
   std::uint16_t version = 0;
   bool header_valid = false;
@@ -304,15 +311,7 @@ struct SiiBuildDc {
 };
 
 struct SiiProfile {
-  std::uint16_t pdi_control = 0;
-  std::uint16_t pdi_configuration = 0;
-  std::uint16_t sync_impulse_length = 0;
-  std::uint16_t pdi_configuration2 = 0;
-  std::uint16_t station_alias = 0;
-  SiiIdentity identity{};
-  SiiMailbox bootstrap_mailbox{};
-  SiiMailbox standard_mailbox{};
-  std::uint16_t mailbox_protocols = 0;
+  SiiHeader header{};
   std::string_view group{};
   std::string_view image{};
   std::string_view order{};
