@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <condition_variable>
 #include <deque>
@@ -16,6 +17,7 @@
 #include <fastdds/dds/core/status/PublicationMatchedStatus.hpp>
 #include <fastdds/dds/core/status/SubscriptionMatchedStatus.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/DataWriterListener.hpp>
 #include <fastdds/dds/subscriber/DataReader.hpp>
 #include <fastdds/dds/subscriber/DataReaderListener.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
@@ -114,7 +116,18 @@ std::string_view to_string(Outcome o) noexcept {
   return "unknown";
 }
 
-class Client::Impl : public dds::DataReaderListener {
+// A DDS participant's GUID prefix: the gateway's endpoints all carry the prefix of its participant.
+using ParticipantKey = std::array<std::uint8_t, 12>;
+ParticipantKey participant_of(const eprosima::fastrtps::rtps::GUID_t& guid) {
+  ParticipantKey k{};
+  std::copy(std::begin(guid.guidPrefix.value), std::end(guid.guidPrefix.value), k.begin());
+  return k;
+}
+ParticipantKey participant_of(const dds::InstanceHandle_t& handle) {
+  return participant_of(eprosima::fastrtps::rtps::iHandle2GUID(handle));
+}
+
+class Client::Impl : public dds::DataReaderListener, public dds::DataWriterListener {
  public:
   explicit Impl(ClientOptions options) : opt_(std::move(options)) {
     if (opt_.name.empty()) opt_.name = default_name();
@@ -156,9 +169,11 @@ class Client::Impl : public dds::DataReaderListener {
     param_w_ = optional_writer(msg::TopicId::ParamRequest, parameter_refusal_);
     if (param_w_ != nullptr) param_r_ = listened_reader(msg::TopicId::ParamReply, parameter_refusal_);
   }
+  // A reply reader: its matches are followed from creation on (ensure_matched asks whose writers
+  // matched); its data once it is known as reply_r_/param_r_ (replies come only after a request).
   dds::DataReader* listened_reader(msg::TopicId t, std::string& refusal) {
-    dds::DataReader* r = optional_reader(t, refusal);
-    if (r != nullptr) r->set_listener(this, dds::StatusMask::data_available());
+    dds::DataReader* r = optional_reader(t, refusal, this, dds::StatusMask::subscription_matched());
+    if (r != nullptr) r->set_listener(this, dds::StatusMask::data_available() << dds::StatusMask::subscription_matched());
     return r;
   }
   // The readers call back into this object: delete them before anything else goes.
@@ -191,6 +206,29 @@ class Client::Impl : public dds::DataReaderListener {
       ++generation_;
     }
     cv_.notify_all();
+  }
+
+  // Which participants' readers matched our writers and whose writers matched our readers
+  // (per endpoint, by participant: a count, since a participant may have several).
+  void on_publication_matched(dds::DataWriter* writer, const dds::PublicationMatchedStatus& s) override {
+    note_match(writer, participant_of(s.last_subscription_handle), s.current_count_change);
+  }
+  void on_subscription_matched(dds::DataReader* reader, const dds::SubscriptionMatchedStatus& s) override {
+    note_match(reader, participant_of(s.last_publication_handle), s.current_count_change);
+  }
+  void note_match(const void* endpoint, const ParticipantKey& peer, std::int32_t change) {
+    {
+      std::lock_guard lock(mutex_);
+      auto& peers = matches_[endpoint];
+      const int n = (peers[peer] += change);
+      if (n <= 0) peers.erase(peer);
+      ++generation_;
+    }
+    cv_.notify_all();
+  }
+  [[nodiscard]] bool matched_locked(const void* endpoint, const ParticipantKey& peer) const {
+    const auto e = matches_.find(endpoint);
+    return e != matches_.end() && e->second.count(peer) > 0;
   }
 
   bool wait_until(const std::function<bool()>& condition, Millis timeout) const {
@@ -247,7 +285,7 @@ class Client::Impl : public dds::DataReaderListener {
       return result;
     }
     result.gateway = r.gateway;
-    ensure_matched(deadline, *cmd_w_, *reply_r_);
+    ensure_matched(deadline, r.gateway, *cmd_w_, *reply_r_);
 
     msg::AxisCommand out;
     out.gateway(r.gateway);
@@ -353,7 +391,7 @@ class Client::Impl : public dds::DataReaderListener {
       return result;
     }
     result.gateway = r.gateway;
-    ensure_matched(deadline, *param_w_, *param_r_);
+    ensure_matched(deadline, r.gateway, *param_w_, *param_r_);
     msg::ParameterRequest out;
     out.gateway(r.gateway);
     out.axis(req.axis);
@@ -474,16 +512,18 @@ class Client::Impl : public dds::DataReaderListener {
 
   dds::DataWriter* optional_writer(msg::TopicId t, std::string& refusal) {
     try {
-      return &node_->writer(t);
+      // Matches are followed from creation on (ensure_matched asks whose readers matched).
+      return &node_->writer(t, this, dds::StatusMask::publication_matched());
     } catch (const std::runtime_error& e) {
       if (!node_->secure()) throw;  // without access control a refusal is a real failure
       if (refusal.empty()) refusal = std::string(e.what()) + " (client '" + opt_.name + "')";
       return nullptr;
     }
   }
-  dds::DataReader* optional_reader(msg::TopicId t, std::string& refusal) {
+  dds::DataReader* optional_reader(msg::TopicId t, std::string& refusal, dds::DataReaderListener* listener = nullptr,
+                                   dds::StatusMask mask = dds::StatusMask::none()) {
     try {
-      return &node_->reader(t, nullptr, dds::StatusMask::none());
+      return &node_->reader(t, listener, mask);
     } catch (const std::runtime_error& e) {
       if (!node_->secure()) throw;
       if (refusal.empty()) refusal = std::string(e.what()) + " (client '" + opt_.name + "')";
@@ -590,22 +630,19 @@ class Client::Impl : public dds::DataReaderListener {
   }
 
   // A reliable volatile sample written before the gateway's reader matched us would be lost, and so
-  // would a reply written before our reply reader matched. Wait (bounded) until every known gateway
-  // can be reached both ways.
-  void ensure_matched(SteadyClock::time_point deadline, dds::DataWriter& writer, dds::DataReader& reader) const {
+  // would a reply written before our reply reader matched. Wait (bounded) until the gateway's own
+  // participant matched both: another participant's reader of the topic (a monitor, a recorder)
+  // does not count.
+  void ensure_matched(SteadyClock::time_point deadline, const std::string& gateway, const dds::DataWriter& writer,
+                      const dds::DataReader& reader) const {
     wait_until(
         [&] {
-          std::size_t gateways = 0;
-          {
-            std::lock_guard lock(mutex_);
-            gateways = gateways_.size();
-          }
-          dds::PublicationMatchedStatus w{};
-          dds::SubscriptionMatchedStatus r{};
-          writer.get_publication_matched_status(w);
-          reader.get_subscription_matched_status(r);
-          const auto n = static_cast<std::int32_t>(gateways);
-          return w.current_count >= n && r.current_count >= n;
+          std::lock_guard lock(mutex_);
+          const auto g = gateways_.find(gateway);
+          if (g == gateways_.end()) return false;
+          const auto peer = gateway_participants_.find(gateway);
+          return peer != gateway_participants_.end() && matched_locked(&writer, peer->second) &&
+                 matched_locked(&reader, peer->second);
         },
         std::chrono::duration_cast<Millis>(deadline - SteadyClock::now()));
   }
@@ -633,6 +670,7 @@ class Client::Impl : public dds::DataReaderListener {
           const auto it = info_handles_.find(si.instance_handle);
           if (it != info_handles_.end()) {
             gateways_.erase(it->second);
+            gateway_participants_.erase(it->second);
             info_handles_.erase(it);
             last_info_change_ = SteadyClock::now();
           }
@@ -646,6 +684,7 @@ class Client::Impl : public dds::DataReaderListener {
       for (const auto& a : in.axes())
         g.axes.push_back({in.gateway(), a.name(), a.bus(), a.device(), a.unit(), a.modes()});
       info_handles_[si.instance_handle] = g.name;
+      gateway_participants_[g.name] = participant_of(si.sample_identity.writer_guid());
       gateways_[g.name] = std::move(g);
       last_info_change_ = SteadyClock::now();
     }
@@ -771,6 +810,8 @@ class Client::Impl : public dds::DataReaderListener {
   std::uint64_t generation_ = 0;
   std::map<std::string, GatewayInfo> gateways_;
   std::map<dds::InstanceHandle_t, std::string> info_handles_;
+  std::map<std::string, ParticipantKey> gateway_participants_;  // gateway name -> its participant
+  std::map<const void*, std::map<ParticipantKey, int>> matches_;  // endpoint -> matched peers
   SteadyClock::time_point last_info_change_;
   std::map<std::pair<std::string, std::string>, AxisState> states_;
   std::map<std::pair<std::string, std::string>, BusStatus> buses_;

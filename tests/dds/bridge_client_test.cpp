@@ -198,6 +198,7 @@ TEST(DdsBridge, CommandOnlyClientSubscribesToStatesOnFirstRead) {
   bridge.start();
   msg::DdsNode probe(raw_options());
   dds::DataWriter& state_w = probe.writer(msg::TopicId::AxisState);
+  dds::DataReader& command_r = probe.reader(msg::TopicId::AxisCommand);
   const auto matched_state_readers = [&] {
     dds::PublicationMatchedStatus m{};
     state_w.get_publication_matched_status(m);
@@ -210,9 +211,6 @@ TEST(DdsBridge, CommandOnlyClientSubscribesToStatesOnFirstRead) {
   req.kind = "enable";
   ASSERT_EQ(c.send(req, true, kTimeout).outcome, Outcome::Completed);
   EXPECT_EQ(c.stream_setpoint("x", "gw1", 0, 1, 0), "");
-  // Made only now: a command reader of the probe's, matched before the gateway's, would let the
-  // client send before the gateway can hear it (the client counts matched readers, not whose).
-  dds::DataReader& command_r = probe.reader(msg::TopicId::AxisCommand);
   // The probe has discovered the client's endpoints (the command writer, made after the readers the
   // client made at construction) ...
   ASSERT_TRUE(c.wait_until(
@@ -235,6 +233,64 @@ TEST(DdsBridge, CommandOnlyClientSubscribesToStatesOnFirstRead) {
   EXPECT_EQ(c.links().size(), 2U);
   ASSERT_EQ(c.buses().size(), 1U);
   EXPECT_EQ(c.buses()[0].bus, "can0");
+}
+
+// A command is written only once the addressed gateway's own participant matched the client's
+// command writer and reply reader. Another participant's axis_command reader and command_reply
+// writer (a monitor, a recorder) matched early must not count: a command written then would be
+// lost for the gateway, whose reader matches later.
+TEST(DdsBridge, CommandWaitsForTheGatewaysOwnEndpointsNotAnotherParticipants) {
+  msg::DdsNode probe(raw_options());
+  dds::DataReader& probe_commands = probe.reader(msg::TopicId::AxisCommand);
+  probe.writer(msg::TopicId::CommandReply);
+  // The gateway announces itself, but makes its command endpoints only later.
+  msg::DdsNode gateway(raw_options());
+  dds::DataWriter& info_w = gateway.writer(msg::TopicId::GatewayInfo);
+  msg::GatewayInfo info;
+  info.gateway("gw1");
+  info.host("test");
+  info.pid(1);
+  msg::AxisDescription axis;
+  axis.name("x");
+  axis.bus("can0");
+  info.axes().push_back(axis);
+  ASSERT_TRUE(info_w.write(&info));
+
+  Client c(client_options());
+  std::optional<client::CommandResult> result;
+  std::thread sender([&] {
+    CommandRequest req;
+    req.axis = "x";
+    req.kind = "enable";
+    result = c.send(req, true, kTimeout);
+  });
+  const auto probe_got_command = [&] {
+    bool got = false;
+    msg::take_valid<msg::AxisCommand>(probe_commands, [&](const msg::AxisCommand&) { got = true; });
+    return got;
+  };
+  // The probe matched the client's endpoints, yet the client does not write to it alone.
+  EXPECT_FALSE(c.wait_until(probe_got_command, Millis(1500)));
+
+  dds::DataReader& gw_commands = gateway.reader(msg::TopicId::AxisCommand);
+  dds::DataWriter& gw_replies = gateway.writer(msg::TopicId::CommandReply);
+  std::optional<msg::AxisCommand> received;
+  ASSERT_TRUE(c.wait_until(
+      [&] {
+        msg::take_valid<msg::AxisCommand>(gw_commands, [&](const msg::AxisCommand& in) { received = in; });
+        return received.has_value();
+      },
+      kTimeout));
+  msg::CommandReply reply;
+  reply.gateway("gw1");
+  reply.axis("x");
+  reply.client(received->client());
+  reply.id(received->id());
+  reply.status("completed");
+  ASSERT_TRUE(gw_replies.write(&reply));
+  sender.join();
+  ASSERT_TRUE(result.has_value());
+  EXPECT_EQ(result->outcome, Outcome::Completed) << result->reason;
 }
 
 // The first read right after construction, before any gateway was discovered, waits for discovery
