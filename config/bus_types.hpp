@@ -82,6 +82,10 @@ struct BusTypeInfo {
   std::string address_name = "address";  // in messages and the printout ("node-ID")
   bool reused_address_names_axes = false;  // an address given twice names both axes
   std::string device_section;  // the device profile section of this type ("canopen"); empty: none
+  std::vector<std::string> bus_keys;  // keys of the bus entry besides the common ones ("io"), for read_bus
+  // The key under which two axes of one bus may not share an address; empty: the address. (An
+  // EtherCAT slave with several axes carries them at one position, told apart by their section.)
+  std::function<std::string(const AxisPlan& axis)> address_key;
 
   // Each of these may be empty. After the generic reading filled bus.options: checks across
   // options, and the typed options into bus.sections. `bus_map` is the buses[] entry, `options` its

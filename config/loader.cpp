@@ -165,11 +165,12 @@ void read_options(const MapReader& m, const BusTypeInfo& type, BusPlan& bus) {
 }
 
 void read_bus(const MapReader& b, const BusTypeRegistry& registry, BusPlan& bus) {
-  b.check_keys({"name", "type", "cycle_time", "priority", "cpu", "options"});
   bus.name = b.name("name", Need::Required).value_or("");
   std::shared_ptr<const BusTypeInfo> type;
+  std::vector<std::string> keys{"name", "type", "cycle_time", "priority", "cpu", "options"};
   if (const auto t = b.string("type", Need::Required)) {
     type = registry.find(*t);
+    if (type) keys.insert(keys.end(), type->bus_keys.begin(), type->bus_keys.end());
     const auto available = registry.available_names();
     if (!type) {
       b.error("type", "unknown bus type " + in_quotes(*t) + did_you_mean(*t, registry.names()) +
@@ -181,6 +182,7 @@ void read_bus(const MapReader& b, const BusTypeRegistry& registry, BusPlan& bus)
       bus.type = *t;
     }
   }
+  b.check_keys(keys);
   // Each bus type bounds its cycle (canopen: the SYNC period); unknown types get the widest range.
   bus.cycle_time = b.duration("cycle_time", Need::Required, type ? type->min_cycle_time : 100us,
                               type ? type->max_cycle_time : 1s)
@@ -261,8 +263,10 @@ Plan compile(const std::string& text, const std::string& file, const LoadOptions
       if (axis.plan.address != 0) {
         const BusPlan& bus = plan.buses[*axis.bus];
         const bool name_axes = bus.type_info && bus.type_info->reused_address_names_axes;
-        addresses[*axis.bus].check(std::to_string(axis.plan.address), a, "address",
-                                   std::to_string(axis.plan.address) + " on bus \"" + bus.name + "\"",
+        const std::string key = bus.type_info && bus.type_info->address_key ? bus.type_info->address_key(axis.plan)
+                                                                             : std::to_string(axis.plan.address);
+        addresses[*axis.bus].check(key, a, "address",
+                                   key + " on bus \"" + bus.name + "\"",
                                    name_axes ? "axis \"" + axis.plan.spec.name + "\"" : std::string{});
       }
       axes.emplace_back(*axis.bus, std::move(axis.plan));

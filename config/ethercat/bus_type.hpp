@@ -1,7 +1,7 @@
 #pragma once
-// The `ethercat` bus type's configuration. So far the device profiles' `ethercat:` section: a
-// configuration may name the type, and profiles carry their EtherCAT data, but no adapter is linked
-// in yet (no make_bus: a bus of this type is refused with that reason).
+// The `ethercat` bus type's configuration: its options and `io:` list, the axis section, the
+// device profiles' `ethercat:` section and the checks across a bus. The adapter
+// (adapters/ethercat) adds the factory, the scan and the checks that need its process image.
 #include "config/bus_types.hpp"
 
 namespace drivegate::config {

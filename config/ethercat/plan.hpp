@@ -1,13 +1,15 @@
 #pragma once
-// The plan parts of the `ethercat` bus type held in Sections: a device profile's `ethercat:`
-// section (EthercatDeviceSpec; profiles/devices/README.md "EtherCAT"). The bus options and the
-// axis section come with the adapter.
+// The plan parts of the `ethercat` bus type held in Sections: the typed bus options
+// (BusPlan::section<EthercatBusOptions>(), with the bus' I/O slaves), an axis' `ethercat:` section
+// (EthercatAxisSpec) and a device profile's `ethercat:` section (EthercatDeviceSpec;
+// profiles/devices/README.md "EtherCAT"); config/README.md "EtherCAT buses".
 #include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "config/canopen/plan.hpp"  // PdoEntrySpec, StartupWrite: CoE shares CANopen's objects
+#include "core/clock.hpp"
 #include "profiles/cia402/objects.hpp"
 
 namespace drivegate::config {
@@ -53,6 +55,42 @@ struct EthercatDeviceSpec {
   int axes = 1;                      // axes on one slave, objects offset by axis_offset per axis
   std::uint16_t axis_offset = 0x800;  // ETG.6010 multi-axis: 6000h + 800h per axis
   std::string persona = "generic-cia402";  // simulator persona
+};
+
+enum class EthercatTransportKind : std::uint8_t {
+  Raw,        // an Ethernet interface through an AF_PACKET socket (needs CAP_NET_RAW)
+  Simulated,  // an in-process line of simulated slaves made from the axes' device profiles
+};
+
+// A slave that is not a drive: its process data bytes are published on the I/O topic under `name`
+// (`io:` of the bus entry). Identity and sizes, when given, are checked against the slave's SII.
+struct EthercatIoSlave {
+  std::string name;
+  int position = 0;  // 1 = the slave next to the gateway
+  std::optional<std::uint32_t> vendor_id;
+  std::optional<std::uint32_t> product_code;
+  std::optional<int> input_bytes;   // slave -> master
+  std::optional<int> output_bytes;  // master -> slave
+};
+
+struct EthercatBusOptions {
+  EthercatTransportKind transport = EthercatTransportKind::Raw;
+  std::string interface;  // Raw: the Ethernet interface
+  core::Duration sm_watchdog = std::chrono::milliseconds(100);  // 0: off
+  bool distributed_clocks = true;  // SYNC0 for the drives whose profile asks for it
+  core::Duration sync0_shift{0};   // SYNC0 after the cycle's frame start
+  int lost_cycles = 3;             // cycles without a slave's answer before its axes are lost
+  core::Duration transition_timeout = std::chrono::seconds(10);  // PRE-OP -> SAFE-OP -> OP
+  core::Duration sdo_timeout = std::chrono::seconds(1);
+  core::Duration boot_retry = std::chrono::seconds(1);
+  core::Duration boot_retry_max = std::chrono::seconds(10);
+  std::vector<EthercatIoSlave> io;
+};
+
+// The per-axis `ethercat:` section.
+struct EthercatAxisSpec {
+  int slave_axis = 0;  // which axis of a multi-axis slave (objects + slave_axis x axis_offset)
+  std::string esi;     // an ESI file for the slave (absolute path), empty: none
 };
 
 }  // namespace drivegate::config
