@@ -4,6 +4,7 @@
 // checked against ETG.1000.6 §5.6.2 (digest TV-6 for the expedited download layout).
 #include <gtest/gtest.h>
 
+#include <deque>
 #include <map>
 #include <vector>
 
@@ -33,8 +34,37 @@ struct Server {
   std::vector<std::uint8_t> up;     // remaining upload bytes
   std::vector<std::uint8_t> down;   // download bytes so far
   std::size_t down_total = 0;
+  // Replies wait here while SM1 is full (a slave cannot write a full mailbox [ETG.1000.4 §6
+  // SyncManager, 1-buffer mode]) or while held back: `delay_next` holds the next reply that many
+  // harness cycles (a late reply).
+  std::deque<std::vector<std::uint8_t>> outbox;
+  int delay_next = 0;
+  int delay_left = 0;
 
   std::uint8_t next() { return counter = next_mailbox_counter(counter); }
+
+  void send(FakeEsc& esc, std::span<const std::uint8_t> reply) {
+    if (delay_next > 0) {
+      delay_left = delay_next;
+      delay_next = 0;
+    }
+    if (delay_left > 0 || esc.sm1_full || !outbox.empty()) {
+      outbox.emplace_back(reply.begin(), reply.end());
+    } else {
+      esc.reply(reply);
+    }
+  }
+  // Called once per harness cycle: hands a waiting reply to SM1 when it is free.
+  void deliver(FakeEsc& esc) {
+    if (delay_left > 0) {
+      --delay_left;
+      return;
+    }
+    if (!outbox.empty() && !esc.sm1_full) {
+      esc.reply(outbox.front());
+      outbox.pop_front();
+    }
+  }
 
   void handle(FakeEsc& esc, std::span<const std::uint8_t> req) {
     if (ignore > 0) {
@@ -59,7 +89,7 @@ struct Server {
       key = {s.index, s.subindex};
       if (auto a = aborts.find(key); a != aborts.end()) {
         n = encode_sdo_abort(out, next(), s.index, s.subindex, a->second);
-        esc.reply(std::span<const std::uint8_t>(out.data(), n));
+        send(esc, std::span<const std::uint8_t>(out.data(), n));
         return;
       }
     }
@@ -98,7 +128,7 @@ struct Server {
       default:
         FAIL() << "unexpected command";
     }
-    esc.reply(std::span<const std::uint8_t>(out.data(), n));
+    send(esc, std::span<const std::uint8_t>(out.data(), n));
   }
   std::vector<std::uint8_t> pending;
 };
@@ -117,7 +147,8 @@ struct Harness {
   core::TimePoint now{};
   bool drop_next_sm1_read = false;
 
-  explicit Harness(CoeSdoTiming timing = {}) : client(0x1001, kMailbox, timing, &emcy) {
+  explicit Harness(CoeSdoTiming timing = {}, bool sink = true)
+      : client(0x1001, kMailbox, timing, sink ? &emcy : nullptr) {
     FakeEsc esc;
     put_u16(esc.mem, reg::kStationAddress, 0x1001);
     const auto sm0 = encode_sm(SmEntry{0x1000, 64, 0x26, 0, 1, 0});
@@ -144,6 +175,7 @@ struct Harness {
     }
     // An emergency read: now the SDO reply the server held back.
     FakeEsc& esc = line.slaves[0];
+    server.deliver(esc);
     if (!server.pending.empty() && !esc.sm1_full) {
       const auto req = server.pending;
       server.pending.clear();
@@ -250,6 +282,43 @@ TEST(EthercatCoeSdo, SilentServerTimesOutAndTheQueueMovesOn) {
   EXPECT_GE(h.now - t0, 20ms);
   EXPECT_LT(h.now - t0, 30ms);
   EXPECT_EQ(h.run(second).status, CoeSdoStatus::Done);
+}
+
+TEST(EthercatCoeSdo, LateReplyIsNotTakenAsTheAnswerToTheNextRequest) {
+  // The reply to the first upload comes after its timeout and sits in SM1; the next upload of the
+  // same object must get the value the slave has now, not the old reply (ETG.1000.6 §5.6: the
+  // mailbox counter of a slave's reply says nothing about the request it answers).
+  CoeSdoTiming t;
+  t.timeout = 20ms;
+  Harness h(t, false);  // no emergency sink: nothing reads SM1 while idle
+  h.server.od[{0x2100, 0}] = {1, 0, 0, 0};
+  h.server.delay_next = 30;
+  const auto r1 = h.run(h.client.upload_value(0x2100, 0));
+  EXPECT_EQ(r1.status, CoeSdoStatus::Failed);
+  EXPECT_EQ(r1.abort_code, 0x05040000U);
+  h.server.od[{0x2100, 0}] = {2, 0, 0, 0};
+  for (int i = 0; i < 100 && !h.line.slaves[0].sm1_full; ++i) h.cycle();
+  ASSERT_TRUE(h.line.slaves[0].sm1_full);  // the late reply is in SM1 now
+  const auto r2 = h.run(h.client.upload_value(0x2100, 0));
+  ASSERT_EQ(r2.status, CoeSdoStatus::Done);
+  EXPECT_EQ(r2.value, 2U);
+  EXPECT_EQ(h.client.counters().stale_replies, 1U);
+  EXPECT_EQ(h.line.slaves[0].requests.size(), 2U);
+}
+
+TEST(EthercatCoeSdo, EmergencyFoundWhenEmptyingSm1StillGoesToTheSink) {
+  Harness h;
+  h.server.od[{0x1001, 0}] = {0x22};
+  // An emergency already in SM1 when the request starts [digest §8.1: 8100h, error register 11h].
+  std::array<std::uint8_t, 64> emcy{};
+  const std::size_t n = encode_emergency(emcy, 3, CoeEmergency{0x8100, 0x11, {}});
+  h.line.slaves[0].reply(std::span<const std::uint8_t>(emcy.data(), n));
+  const auto r = h.run(h.client.upload_value(0x1001, 0));
+  ASSERT_EQ(r.status, CoeSdoStatus::Done);
+  EXPECT_EQ(r.value, 0x22U);
+  ASSERT_EQ(h.emcy.got.size(), 1U);
+  EXPECT_EQ(h.emcy.got[0].second.error_code, 0x8100);
+  EXPECT_EQ(h.client.counters().stale_replies, 0U);
 }
 
 TEST(EthercatCoeSdo, LostReplyIsFetchedAgainWithTheRepeatBit) {

@@ -137,6 +137,27 @@ void CoeSdoClient::finish(Slot& s, SlotState state, std::uint32_t abort_code) no
   write_due_ = false;
 }
 
+void CoeSdoClient::on_status(const DatagramAnswer& a) noexcept {
+  // SM1 status 080Dh bit 3: mailbox full [ETG.1000.4 Table 59, SM status].
+  const bool full = a.outcome != DatagramOutcome::Lost && a.wkc == 1 && !a.data.empty() &&
+                    (a.data[0] & sm_status::kMailboxFull) != 0;
+  if (full) {
+    phase_ = Phase::DrainRead;
+    return;
+  }
+  if (a.outcome == DatagramOutcome::Lost || a.wkc != 1) {
+    // No answer: an active request asks again (its timeout bounds this); idle, give up the drain.
+    if (active_ == nullptr) {
+      drain_due_ = false;
+      phase_ = Phase::Idle;
+    }
+    return;
+  }
+  // SM1 empty: the request can go.
+  drain_due_ = false;
+  phase_ = active_ != nullptr ? Phase::Write : Phase::Idle;
+}
+
 template <class Encode>
 void CoeSdoClient::prepare(Expect expect, Encode&& encode) noexcept {
   // The whole SM0 mailbox is written (its last byte hands it to the slave): zero what follows the
@@ -192,6 +213,7 @@ void CoeSdoClient::start_next(core::TimePoint now) noexcept {
   next->result.status = CoeSdoStatus::InFlight;
   deadline_ = now + timing_.timeout;
   prepare_initiate(*next);
+  phase_ = Phase::Drain;  // empty SM1 before the request goes out
 }
 
 bool CoeSdoClient::queue(Transactions& tx, Command c, std::uint16_t ado, std::uint16_t length,
@@ -208,14 +230,22 @@ void CoeSdoClient::poll(core::TimePoint now, Transactions& tx) noexcept {
   if (active_ != nullptr && now >= deadline_) {
     ++counters_.timeouts;
     finish(*active_, SlotState::Failed, cia402::sdo_abort_code::kTimeout);
+    drain_due_ = true;  // its reply may still come: emptied before anything else is taken
   }
   if (active_ == nullptr) start_next(now);
   switch (phase_) {
     case Phase::Idle:
-      // Nothing of ours in flight: still look for emergencies now and then.
-      if (emergencies_ != nullptr && now >= next_status_poll_) {
+      // Nothing of ours in flight: still look for emergencies now and then (and empty SM1 after a
+      // timeout); what SM1 holds now is no answer to anything.
+      if ((emergencies_ != nullptr || drain_due_) && now >= next_status_poll_) {
         if (queue(tx, Command::FPRD, reg::sm_status(1), 1)) next_status_poll_ = now + timing_.poll_interval;
       }
+      return;
+    case Phase::Drain:
+      (void)queue(tx, Command::FPRD, reg::sm_status(1), 1);
+      return;
+    case Phase::DrainRead:
+      (void)queue(tx, Command::FPRD, mailbox_.tx_offset, mailbox_.tx_size);
       return;
     case Phase::Write:
       if (write_due_ && out_size_ != 0) {
@@ -255,7 +285,14 @@ void CoeSdoClient::on_result(std::uint32_t tag, const DatagramAnswer& a) noexcep
   const bool lost = a.outcome == DatagramOutcome::Lost;
   switch (phase_) {
     case Phase::Idle:
-      if (!lost && a.wkc == 1 && !a.data.empty() && (a.data[0] & sm_status::kMailboxFull) != 0) phase_ = Phase::Read;
+    case Phase::Drain:
+      on_status(a);
+      return;
+    case Phase::DrainRead:
+      // Whatever came (or was lost with the frame), look at the status again: the slave may have
+      // put the next mailbox in.
+      phase_ = Phase::Drain;
+      if (!lost && a.wkc == 1) on_mailbox(a.data, true);
       return;
     case Phase::Write:
       if (lost || a.wkc != 1) {  // not taken (mailbox still full) or lost: write again, same counter
@@ -281,7 +318,7 @@ void CoeSdoClient::on_result(std::uint32_t tag, const DatagramAnswer& a) noexcep
         return;
       }
       phase_ = active_ != nullptr ? Phase::Wait : Phase::Idle;
-      on_mailbox(a.data);
+      on_mailbox(a.data, false);
       return;
     case Phase::RepeatWrite:
       if (!lost && a.wkc == 1) {
@@ -295,10 +332,22 @@ void CoeSdoClient::on_result(std::uint32_t tag, const DatagramAnswer& a) noexcep
   }
 }
 
-void CoeSdoClient::on_mailbox(std::span<const std::uint8_t> mb) noexcept {
+void CoeSdoClient::on_mailbox(std::span<const std::uint8_t> mb, bool stale) noexcept {
   const MailboxView m = decode_mailbox(mb);
   if (m.error != MailboxError::None) {
     ++counters_.malformed;
+    return;
+  }
+  if (stale) {
+    // Emptied before a request: an emergency is still one, anything else is dropped.
+    last_reply_counter_ = m.header.counter;
+    const EmergencyView e = decode_emergency(mb);
+    if (m.header.type == static_cast<std::uint8_t>(MailboxType::CoE) && e.error == MailboxError::None) {
+      ++counters_.emergencies;
+      if (emergencies_ != nullptr) emergencies_->on_emergency(station_, e.emergency);
+    } else {
+      ++counters_.stale_replies;
+    }
     return;
   }
   // A repeated reply (same counter as the last one taken) is a duplicate [ETG.1000.6 mailbox

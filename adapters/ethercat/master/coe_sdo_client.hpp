@@ -2,6 +2,10 @@
 // CoE SDO client of one slave over its mailbox [ETG.1000.6 §5.6.2 SDO, mailbox header and counter;
 // ETG.1000.4 §6 SyncManager (1-buffer mode, SM status "mailbox full", repeat request/acknowledge)]:
 //
+//   drain:    before a request is written (and once after a timeout), FPRD 080Dh; while SM1 is
+//             "mailbox full", FPRD of SM1 and drop what it held (a late reply of an earlier request,
+//             counted in stale_replies; an emergency there still goes to the EmergencySink), so a
+//             late reply is never taken as the answer to the next request.
 //   request:  FPWR of the whole SM0 buffer (mailbox out); WKC 0 = the slave has not read the last
 //             one yet: written again at the next poll. The counter runs 1..7 per new message; a
 //             write sent again keeps its counter.
@@ -16,7 +20,7 @@
 //
 // One request in flight per slave, a FIFO of kQueueDepth. Each request has a timeout from its
 // start: then it fails with 05040000h (SDO protocol timed out); nothing is sent to the slave (its
-// late reply, if any, is read and dropped as unexpected). Uploads go into the caller's buffer (or
+// late reply, if any, is read and dropped by the drain, counted in stale_replies). Uploads go into the caller's buffer (or
 // the request's 8 inline bytes); a reply longer than the buffer fails with 05040005h (out of
 // memory). Downloads come from the caller's buffer (must stay valid until the result is taken) or
 // 1..4 inline bytes (download_value). Nothing allocates.
@@ -65,6 +69,7 @@ struct CoeSdoCounters {
   std::uint64_t mailbox_writes = 0, mailbox_busy = 0;  // writes, and those the slave refused (WKC 0)
   std::uint64_t repeats = 0;                            // repeat requests after a lost reply
   std::uint64_t emergencies = 0, unexpected = 0, malformed = 0, queue_full = 0;
+  std::uint64_t stale_replies = 0;  // found in SM1 before a request (or while idle) and dropped
 };
 
 class CoeSdoClient final : public DatagramOwner {
@@ -109,7 +114,7 @@ class CoeSdoClient final : public DatagramOwner {
     std::array<std::uint8_t, kInline> inline_bytes{};
     CoeSdoResult result{};
   };
-  enum class Phase : std::uint8_t { Idle, Write, Wait, Read, RepeatWrite, RepeatWait };
+  enum class Phase : std::uint8_t { Idle, Drain, DrainRead, Write, Wait, Read, RepeatWrite, RepeatWait };
   enum class Expect : std::uint8_t { Initiate, Segment };
 
   CoeSdoId submit(bool upload, std::uint16_t index, std::uint8_t subindex, std::uint8_t* into,
@@ -123,7 +128,9 @@ class CoeSdoClient final : public DatagramOwner {
   void prepare_initiate(Slot& s) noexcept;
   void prepare_download_segment(Slot& s) noexcept;
   void prepare_upload_segment() noexcept;
-  void on_mailbox(std::span<const std::uint8_t> mb) noexcept;
+  // `stale`: read by the drain; only emergencies are taken from it.
+  void on_mailbox(std::span<const std::uint8_t> mb, bool stale) noexcept;
+  void on_status(const DatagramAnswer& a) noexcept;  // an SM1 status read while idle or draining
   void on_sdo(Slot& s, const CoeSdo& sdo) noexcept;
   void finish(Slot& s, SlotState state, std::uint32_t abort_code) noexcept;
   bool queue(Transactions& tx, Command c, std::uint16_t ado, std::uint16_t length,
@@ -147,6 +154,7 @@ class CoeSdoClient final : public DatagramOwner {
   std::uint8_t counter_ = 0;    // mailbox counter of the last message written
   std::uint8_t last_reply_counter_ = 0;
   bool repeat_bit_ = false;
+  bool drain_due_ = false;      // empty SM1 once while idle (after a timeout)
   core::TimePoint deadline_{};
   core::TimePoint next_status_poll_{};
   core::TimePoint now_{};
