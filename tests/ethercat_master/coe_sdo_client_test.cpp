@@ -336,6 +336,26 @@ TEST(EthercatCoeSdo, LostReplyIsFetchedAgainWithTheRepeatBit) {
   EXPECT_EQ(h.line.slaves[0].mem[0x080F] & 0x02, 0x02);  // and acknowledged
 }
 
+TEST(EthercatCoeSdo, RepeatRequestInvertsTheBitTheSlaveHas) {
+  // A previous master left SM1's repeat request set (and acknowledged); the activate byte also has
+  // another bit set. The repeat must invert the slave's bit and keep the others
+  // [ETG.1000.4 Table 59: 080Eh activate bit 1 repeat, 080Fh PDI control bit 1 repeat ack].
+  Harness h;
+  h.server.od[{0x1018, 2}] = {0x34, 0x12, 0, 0};
+  FakeEsc& esc = h.line.slaves[0];
+  esc.mem[0x080E] = 0x43;  // enable | repeat | DC event 0 bus
+  esc.mem[0x080F] = 0x02;  // repeat acknowledged
+  h.drop_next_sm1_read = true;
+  const auto r = h.run(h.client.upload_value(0x1018, 2));
+  ASSERT_EQ(r.status, CoeSdoStatus::Done) << std::hex << r.abort_code;
+  EXPECT_EQ(r.value, 0x1234U);
+  EXPECT_EQ(h.client.counters().repeats, 1U);
+  EXPECT_EQ(esc.requests.size(), 1U);
+  EXPECT_EQ(esc.sm1_reads, 2);
+  EXPECT_EQ(esc.mem[0x080E], 0x41);  // repeat inverted, the rest as it was
+  EXPECT_EQ(esc.mem[0x080F], 0x00);  // acknowledged
+}
+
 TEST(EthercatCoeSdo, EmergencyInTheMailboxGoesToTheSink) {
   Harness h;
   h.server.od[{0x1001, 0}] = {0x11};

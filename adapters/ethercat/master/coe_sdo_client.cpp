@@ -264,10 +264,13 @@ void CoeSdoClient::poll(core::TimePoint now, Transactions& tx) noexcept {
     case Phase::Read:
       (void)queue(tx, Command::FPRD, mailbox_.tx_offset, mailbox_.tx_size);
       return;
+    case Phase::RepeatRead:
+      // SM1 activate (080Eh) and PDI control (080Fh) [ETG.1000.4 Table 59].
+      (void)queue(tx, Command::FPRD, reg::sm_activation(1), 2);
+      return;
     case Phase::RepeatWrite: {
-      // Toggle the repeat request in SM1's activate register [ETG.1000.4 §6 SyncManager: repeat].
-      const std::array<std::uint8_t, 1> act{
-          static_cast<std::uint8_t>(sm_activate::kEnable | (repeat_bit_ ? sm_activate::kRepeat : 0))};
+      // The activate byte as read, repeat request inverted [ETG.1000.4 §6 SyncManager: repeat].
+      const std::array<std::uint8_t, 1> act{repeat_activate_};
       (void)queue(tx, Command::FPWR, reg::sm_activation(1), 1, act);
       return;
     }
@@ -309,8 +312,7 @@ void CoeSdoClient::on_result(std::uint32_t tag, const DatagramAnswer& a) noexcep
     case Phase::Read:
       if (lost) {  // the slave may have freed SM1 already: ask it to repeat
         ++counters_.repeats;
-        repeat_bit_ = !repeat_bit_;
-        phase_ = Phase::RepeatWrite;
+        phase_ = Phase::RepeatRead;
         return;
       }
       if (a.wkc != 1) {  // empty after all
@@ -320,6 +322,12 @@ void CoeSdoClient::on_result(std::uint32_t tag, const DatagramAnswer& a) noexcep
       phase_ = active_ != nullptr ? Phase::Wait : Phase::Idle;
       on_mailbox(a.data, false);
       return;
+    case Phase::RepeatRead:
+      if (!lost && a.wkc == 1 && a.data.size() >= 1) {
+        repeat_activate_ = static_cast<std::uint8_t>(a.data[0] ^ sm_activate::kRepeat);
+        phase_ = Phase::RepeatWrite;
+      }
+      return;
     case Phase::RepeatWrite:
       if (!lost && a.wkc == 1) {
         phase_ = Phase::RepeatWait;
@@ -327,7 +335,10 @@ void CoeSdoClient::on_result(std::uint32_t tag, const DatagramAnswer& a) noexcep
       }
       return;
     case Phase::RepeatWait:
-      if (!lost && a.wkc == 1 && !a.data.empty() && ((a.data[0] & sm_pdi_control::kRepeatAck) != 0) == repeat_bit_) phase_ = Phase::Read;
+      if (!lost && a.wkc == 1 && !a.data.empty() &&
+          ((a.data[0] & sm_pdi_control::kRepeatAck) != 0) == ((repeat_activate_ & sm_activate::kRepeat) != 0)) {
+        phase_ = Phase::Read;
+      }
       return;
   }
 }

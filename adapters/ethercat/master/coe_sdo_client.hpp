@@ -11,9 +11,11 @@
 //             write sent again keeps its counter.
 //   reply:    FPRD 080Dh (SM1 status) at most once per poll_interval until "mailbox full" (bit 3),
 //             then FPRD of the whole SM1 buffer (mailbox in).
-//   lost reply: the slave freed SM1 when it was read, but the frame did not come back: toggle the
-//             repeat bit (080Eh bit 1, FPWR), poll until the slave's repeat acknowledge (080Fh bit 1)
-//             equals it, then read SM1 again: the slave has put the last reply back.
+//   lost reply: the slave freed SM1 when it was read, but the frame did not come back: read SM1's
+//             activate and PDI control bytes (080Eh/080Fh), write the activate byte back with the
+//             repeat request (bit 1) inverted, poll until the slave's repeat acknowledge (080Fh
+//             bit 1) equals it, then read SM1 again: the slave has put the last reply back. The bit
+//             is taken from the slave each time (another master or a restart may have left it set).
 //   transfers: expedited / normal / segmented upload and download, toggle checked; a server abort
 //             fails the request with its code (cia402::sdo_abort_text() for the words).
 //   emergencies (CoE service 1) arriving in the mailbox go to the EmergencySink, any time.
@@ -114,7 +116,7 @@ class CoeSdoClient final : public DatagramOwner {
     std::array<std::uint8_t, kInline> inline_bytes{};
     CoeSdoResult result{};
   };
-  enum class Phase : std::uint8_t { Idle, Drain, DrainRead, Write, Wait, Read, RepeatWrite, RepeatWait };
+  enum class Phase : std::uint8_t { Idle, Drain, DrainRead, Write, Wait, Read, RepeatRead, RepeatWrite, RepeatWait };
   enum class Expect : std::uint8_t { Initiate, Segment };
 
   CoeSdoId submit(bool upload, std::uint16_t index, std::uint8_t subindex, std::uint8_t* into,
@@ -153,7 +155,7 @@ class CoeSdoClient final : public DatagramOwner {
   bool write_due_ = false;
   std::uint8_t counter_ = 0;    // mailbox counter of the last message written
   std::uint8_t last_reply_counter_ = 0;
-  bool repeat_bit_ = false;
+  std::uint8_t repeat_activate_ = 0;  // SM1 activate byte written for the repeat request
   bool drain_due_ = false;      // empty SM1 once while idle (after a timeout)
   core::TimePoint deadline_{};
   core::TimePoint next_status_poll_{};
