@@ -147,6 +147,54 @@ TEST(EthercatLineBoot, RefusedSafeOpReportsTheAlStatusCodeAndAcknowledges) {
   EXPECT_EQ(h.line.slaves[2].al_state(), 4);
 }
 
+TEST(EthercatLineBoot, RefusedTransitionCanBeAskedAgain) {
+  // After the refusal was acknowledged the slave can be asked again without a new start().
+  FakeLine line = line_of(3);
+  line.slaves[1].refuse[4] = 0x001D;
+  Harness h(std::move(line), kThree);
+  h.boot->start(h.now);
+  h.run();
+  ASSERT_TRUE(h.boot->ok());
+  ASSERT_TRUE(h.boot->request_state(1, AlState::SafeOp, h.now));
+  h.run();
+  ASSERT_EQ(h.boot->slave(1).status, SlaveStatus::Failed);
+  EXPECT_EQ(h.boot->slave(1).state, AlState::PreOp);
+  EXPECT_EQ(h.boot->slave(1).al_code, 0x001D);  // kept in the report
+  h.line.slaves[1].refuse.clear();              // the cause is mended
+  ASSERT_TRUE(h.boot->request_state(1, AlState::SafeOp, h.now));
+  h.run();
+  const SlaveReport& r = h.boot->slave(1);
+  EXPECT_EQ(r.status, SlaveStatus::Ready) << r.text.view();
+  EXPECT_EQ(r.state, AlState::SafeOp);
+  EXPECT_EQ(r.al_code, 0);
+  EXPECT_TRUE(r.text.empty());
+  EXPECT_EQ(h.line.slaves[1].al_state(), 4);
+}
+
+TEST(EthercatLineBoot, DownwardRequestFromAnErrorStateSucceeds) {
+  // SAFE-OP with the error indication set (e.g. after an SM watchdog, AL status code 001Bh): a
+  // request for INIT acknowledges with INIT | 10h [ETG.1000.6 §5.3.2] and reaches INIT.
+  Harness h(line_of(1), std::span<const ExpectedSlave>(kThree).first(1));
+  h.boot->start(h.now);
+  h.run();
+  ASSERT_TRUE(h.boot->ok());
+  ASSERT_TRUE(h.boot->request_state(0, AlState::SafeOp, h.now));
+  h.run();
+  ASSERT_EQ(h.boot->slave(0).state, AlState::SafeOp);
+  FakeEsc& esc = h.line.slaves[0];
+  put_u16(esc.mem, reg::kAlStatus, 0x0014);      // SAFE-OP + error
+  put_u16(esc.mem, reg::kAlStatusCode, 0x001B);  // sync manager watchdog
+  const std::size_t writes = esc.al_control_writes.size();
+  ASSERT_TRUE(h.boot->request_state(0, AlState::Init, h.now));
+  h.run();
+  const SlaveReport& r = h.boot->slave(0);
+  EXPECT_EQ(r.status, SlaveStatus::Ready) << r.text.view();
+  EXPECT_EQ(r.state, AlState::Init);
+  EXPECT_EQ(esc.mem[reg::kAlStatus], 0x01);  // INIT, error cleared
+  ASSERT_GT(esc.al_control_writes.size(), writes);
+  EXPECT_EQ(esc.al_control_writes[writes], 0x0011);  // INIT + acknowledge
+}
+
 TEST(EthercatLineBoot, IdentityMismatchIsReportedWithBothIdentities) {
   FakeLine line = line_of(3);
   line.slaves[1].sii = image(6745, 0x00020000, "ESR MidiDrive");

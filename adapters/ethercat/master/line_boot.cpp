@@ -186,10 +186,18 @@ void LineBoot::poll(core::TimePoint now, Transactions& tx) noexcept {
         if (s.report.status != SlaveStatus::Busy) continue;
         // Timeouts of the polling phases are checked when an answer comes in and here, so that a
         // slave that keeps answering "busy" cannot hold the step forever.
-        if ((s.phase == Phase::AlPoll || s.phase == Phase::SiiBusy || s.phase == Phase::SiiStatus) &&
+        if ((s.phase == Phase::AlPoll || s.phase == Phase::AlAckPoll || s.phase == Phase::SiiBusy ||
+             s.phase == Phase::SiiStatus) &&
             now >= s.deadline && !s.pending.waiting) {
-          if (s.phase != Phase::AlPoll) {
+          if (s.phase == Phase::SiiBusy || s.phase == Phase::SiiStatus) {
             fail(s, BootStep::Sii, "SII read of word 0x%04X timed out (EEPROM busy)", s.sii_word);
+          } else if (s.phase == Phase::AlAckPoll) {
+            const std::string_view why = al_status_text(s.report.al_code);
+            fail(s, BootStep::Transition,
+                 "%.*s -> %.*s: error indication not cleared by the acknowledge (AL status 0x%04X, code 0x%04X %.*s)",
+                 static_cast<int>(to_string(s.from).size()), to_string(s.from).data(),
+                 static_cast<int>(to_string(s.report.target).size()), to_string(s.report.target).data(),
+                 s.al_status_raw, s.report.al_code, static_cast<int>(why.size()), why.data());
           } else {
             const AlStatus st = decode_al_status(s.al_status_raw);
             fail(s, BootStep::Transition, "%.*s -> %.*s timed out (AL status 0x%04X %.*s)",
@@ -375,16 +383,18 @@ void LineBoot::slave_phase(Slave& s) noexcept {
       s.deadline = now_ + timeout_of(s.from, s.report.target);
       break;
     }
+    case Phase::AlCheck:
     case Phase::AlPoll:
+    case Phase::AlAckPoll:
       set(s.pending, Command::FPRD, physical_address(station, reg::kAlStatus), 2);
       break;
     case Phase::AlCode:
       set(s.pending, Command::FPRD, physical_address(station, reg::kAlStatusCode), 2);
       break;
     case Phase::AlAck: {
-      // Acknowledge the error, staying in the state the slave is in [ETG.1000.6 §5.3.2].
+      // Acknowledge the error [ETG.1000.6 §5.3.2, AL control bit 4].
       std::array<std::uint8_t, 2> ctl{};
-      put_u16(ctl, 0, al_control(decode_al_status(s.al_status_raw).state(), true));
+      put_u16(ctl, 0, s.ack_control);
       set(s.pending, Command::FPWR, physical_address(station, reg::kAlControl), 2, ctl);
       break;
     }
@@ -395,7 +405,7 @@ void LineBoot::slave_phase(Slave& s) noexcept {
 
 BootStep LineBoot::step_of(Phase p) noexcept {
   if (p == Phase::Mailbox) return BootStep::Mailbox;
-  return p >= Phase::AlRequest ? BootStep::Transition : BootStep::Sii;
+  return p >= Phase::AlCheck ? BootStep::Transition : BootStep::Sii;
 }
 
 void LineBoot::slave_answer(Slave& s, const DatagramAnswer& a) noexcept {
@@ -433,6 +443,29 @@ void LineBoot::slave_answer(Slave& s, const DatagramAnswer& a) noexcept {
     case Phase::Mailbox:
       begin_transition(s, AlState::PreOp);
       return;
+    case Phase::AlCheck: {
+      // Where the slave is before anything is requested: an error indication left from before
+      // (e.g. SAFE-OP + error after a watchdog) is acknowledged first, else the request would be
+      // ignored and the old error taken for a refusal [ETG.1000.6 §5.3.2].
+      if (a.data.size() < 2) return;
+      s.al_status_raw = get_u16(a.data, 0);
+      const AlStatus st = decode_al_status(s.al_status_raw);
+      s.report.state = s.from = st.state();
+      if (st.error) {
+        // Going down: acknowledge with the target itself (e.g. INIT | 10h); else stay where it is.
+        const bool down = static_cast<std::uint8_t>(s.report.target) < static_cast<std::uint8_t>(st.state());
+        acknowledge(s, down ? s.report.target : st.state(), false);
+        return;
+      }
+      if (st.state() == s.report.target) {
+        s.phase = Phase::Idle;
+        s.report.status = SlaveStatus::Ready;
+        return;
+      }
+      s.phase = Phase::AlRequest;
+      slave_phase(s);
+      return;
+    }
     case Phase::AlRequest:
       s.phase = Phase::AlPoll;
       slave_phase(s);
@@ -447,7 +480,7 @@ void LineBoot::slave_answer(Slave& s, const DatagramAnswer& a) noexcept {
         slave_phase(s);
         return;
       }
-      if (st.state() == s.report.target) {
+      if (st.state() == s.report.target) {  // the target, no error: done
         s.phase = Phase::Idle;
         s.report.status = SlaveStatus::Ready;
         return;
@@ -458,15 +491,36 @@ void LineBoot::slave_answer(Slave& s, const DatagramAnswer& a) noexcept {
     case Phase::AlCode:
       if (a.data.size() < 2) return;
       s.report.al_code = get_u16(a.data, 0);
-      s.phase = Phase::AlAck;
+      acknowledge(s, decode_al_status(s.al_status_raw).state(), true);
+      return;
+    case Phase::AlAck:
+      s.phase = Phase::AlAckPoll;
       slave_phase(s);
       return;
-    case Phase::AlAck: {
-      const std::string_view from = to_string(s.from);
-      const std::string_view to = to_string(s.report.target);
-      const std::string_view why = al_status_text(s.report.al_code);
-      fail(s, BootStep::Transition, "%.*s -> %.*s refused: 0x%04X %.*s", static_cast<int>(from.size()), from.data(),
-           static_cast<int>(to.size()), to.data(), s.report.al_code, static_cast<int>(why.size()), why.data());
+    case Phase::AlAckPoll: {
+      if (a.data.size() < 2) return;
+      s.al_status_raw = get_u16(a.data, 0);
+      const AlStatus st = decode_al_status(s.al_status_raw);
+      s.report.state = st.state();
+      if (st.error) {
+        slave_phase(s);  // not cleared yet: poll again (timeout in poll())
+        return;
+      }
+      if (s.refused) {
+        fail_refused(s);
+        return;
+      }
+      // An earlier error acknowledged: go on with the transition.
+      if (st.state() == s.report.target) {
+        s.phase = Phase::Idle;
+        s.report.status = SlaveStatus::Ready;
+      } else if ((s.ack_control & 0x0F) == static_cast<std::uint16_t>(s.report.target)) {
+        s.phase = Phase::AlPoll;  // the acknowledge requested the target already (going down)
+        slave_phase(s);
+      } else {
+        s.phase = Phase::AlRequest;
+        slave_phase(s);
+      }
       return;
     }
     case Phase::Idle:
@@ -543,12 +597,33 @@ void LineBoot::begin_transition(Slave& s, AlState target) noexcept {
   s.report.text.assign("");
   s.from = s.report.state;
   s.report.target = target;
-  s.phase = Phase::AlRequest;
+  s.refused = false;
+  s.deadline = now_ + timeout_of(s.from, target);
+  s.phase = Phase::AlCheck;
   slave_phase(s);
 }
 
+void LineBoot::acknowledge(Slave& s, AlState state, bool refused) noexcept {
+  s.refused = refused;
+  s.ack_control = al_control(state, true);
+  s.deadline = now_ + config_.to_lower_state;  // the error bit must clear within this
+  s.phase = Phase::AlAck;
+  slave_phase(s);
+}
+
+void LineBoot::fail_refused(Slave& s) noexcept {
+  const std::string_view from = to_string(s.from);
+  const std::string_view to = to_string(s.report.target);
+  const std::string_view why = al_status_text(s.report.al_code);
+  fail(s, BootStep::Transition, "%.*s -> %.*s refused: 0x%04X %.*s", static_cast<int>(from.size()), from.data(),
+       static_cast<int>(to.size()), to.data(), s.report.al_code, static_cast<int>(why.size()), why.data());
+}
+
 bool LineBoot::request_state(std::size_t position, AlState target, core::TimePoint now) noexcept {
-  if (position >= found_ || slaves_[position].report.status != SlaveStatus::Ready) return false;
+  if (position >= found_) return false;
+  const SlaveReport& r = slaves_[position].report;
+  const bool again = r.status == SlaveStatus::Failed && r.step == BootStep::Transition;  // refused or timed out
+  if (r.status != SlaveStatus::Ready && !again) return false;
   now_ = now;
   begin_transition(slaves_[position], target);
   if (line_ == LinePhase::Done) line_ = LinePhase::Slaves;

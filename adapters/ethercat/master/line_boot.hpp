@@ -17,12 +17,19 @@
 //                0 = any). A difference fails the slave and names both identities; a slave beyond
 //                the configured ones is reported and left in INIT.
 //      mailbox:  SM0/SM1 from the SII standard mailbox (FPWR 0800h, 16 bytes) when it has one.
-//      PRE-OP:   AL control = 2, then AL status read until the state is reached, the error bit is
-//                set (then 0134h is read for the AL status code and the error acknowledged), or the
-//                transition's timeout passes [ETG.1000.6 §5.3.2].
+//      PRE-OP:   a transition [ETG.1000.6 §5.3.2]: AL status read first; when its error bit is set
+//                the error is acknowledged before anything else (AL control = current state | 10h,
+//                or target | 10h when the target is lower, e.g. SAFE-OP + error -> INIT) and the
+//                status polled until the bit clears. Then AL control = target, and AL status read
+//                until the state is the target with no error (done), the error bit is set (refused:
+//                0134h is read for the AL status code, the error acknowledged with current state |
+//                10h and the status polled until the bit clears), or the transition's timeout passes.
 //
 // request_state() runs a later transition (SAFE-OP, OP, back down) on a slave the same way; part 2
-// (PDO mapping, process data) calls it once the SMs/FMMUs are set.
+// (PDO mapping, process data) calls it once the SMs/FMMUs are set. A slave whose transition failed
+// (refused or timed out: status Failed at BootStep::Transition, the code and text kept in its
+// report) can be asked again with request_state(): the error was acknowledged, so no new start()
+// is needed.
 //
 // Each failing slave stops at its step with one sentence, e.g.
 //   "slave 2 (0x1002, ESR TrioDrive): PRE-OP -> SAFE-OP refused: 0x001D invalid output configuration"
@@ -121,7 +128,9 @@ class LineBoot final : public DatagramOwner {
   [[nodiscard]] const SlaveReport& slave(std::size_t position) const noexcept { return slaves_[position].report; }
   [[nodiscard]] const SiiInfo& sii(std::size_t position) const noexcept { return slaves_[position].info; }
 
-  // Starts a transition of a Ready slave (SAFE-OP, OP, or down). False when the slave is not Ready.
+  // Starts a transition of a Ready slave (SAFE-OP, OP, or down), or of a slave whose last
+  // transition failed (Failed at BootStep::Transition). False otherwise (busy, or stopped at an
+  // earlier step).
   bool request_state(std::size_t position, AlState target, core::TimePoint now) noexcept;
 
  private:
@@ -139,7 +148,7 @@ class LineBoot final : public DatagramOwner {
   };
   enum class LinePhase : std::uint8_t { Idle, Count, Reset, Address, Slaves, Done, Failed };
   enum class Phase : std::uint8_t {
-    Idle, SiiStatus, SiiCommand, SiiBusy, SiiData, Mailbox, AlRequest, AlPoll, AlCode, AlAck,
+    Idle, SiiStatus, SiiCommand, SiiBusy, SiiData, Mailbox, AlCheck, AlRequest, AlPoll, AlCode, AlAck, AlAckPoll,
   };
   struct Slave {
     SlaveReport report{};
@@ -148,6 +157,8 @@ class LineBoot final : public DatagramOwner {
     core::TimePoint deadline{};
     AlState from = AlState::Init;
     std::uint16_t al_status_raw = 0;
+    std::uint16_t ack_control = 0;  // AL control written by AlAck
+    bool refused = false;           // AlAck acknowledges a refusal (else an error found before the request)
     bool eight_byte_reads = false;
     std::uint32_t sii_word = 0;  // next word address to read
     std::size_t sii_next_category = 0;  // image offset of the next SII category header to walk
@@ -171,6 +182,8 @@ class LineBoot final : public DatagramOwner {
   void sii_chunk(Slave& s, std::span<const std::uint8_t> data) noexcept;
   void identify(Slave& s) noexcept;
   void begin_transition(Slave& s, AlState target) noexcept;
+  void acknowledge(Slave& s, AlState state, bool refused) noexcept;  // AlAck with state | 10h
+  void fail_refused(Slave& s) noexcept;
   void fail(Slave& s, BootStep step, const char* fmt, ...) noexcept __attribute__((format(printf, 4, 5)));
   void fail_line(const char* fmt, ...) noexcept __attribute__((format(printf, 2, 3)));
   [[nodiscard]] std::string_view name_of(const Slave& s) const noexcept;
