@@ -38,6 +38,8 @@ struct FakeEsc {
   int delay_left = 0;
   std::uint8_t pending_state = 0;
   std::vector<std::uint16_t> al_control_writes;
+  std::vector<std::pair<std::uint16_t, std::uint8_t>> writes;  // every write: address, first byte
+  std::uint8_t state_when_addressed = 0;  // AL state when the station address (0010h) was written
   // Mailbox
   std::function<void(FakeEsc&, std::span<const std::uint8_t>)> on_mailbox;  // request written to SM0
   std::vector<std::vector<std::uint8_t>> requests;
@@ -101,6 +103,8 @@ struct FakeEsc {
     const SmEntry sm0 = sm(0);
     const bool in_sm0 = sm0.enabled() && ado >= sm0.physical_start && ado < sm0.physical_start + sm0.length;
     const std::uint8_t old_activate1 = mem[reg::sm_activation(1)];
+    writes.emplace_back(ado, in.empty() ? std::uint8_t{0} : in[0]);
+    if (ado == reg::kStationAddress) state_when_addressed = al_state();
     std::copy(in.begin(), in.end(), mem.begin() + ado);
     if (ado <= reg::kAlControl && end > reg::kAlControl) al_control(get_u16(mem, reg::kAlControl));
     if (ado <= reg::kSiiControl && end > reg::kSiiControl) sii_command();

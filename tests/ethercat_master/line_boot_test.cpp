@@ -123,6 +123,62 @@ TEST(EthercatLineBoot, ThreeSlavesReachPreOp) {
   EXPECT_EQ(h.tx.counters().datagrams_lost, 0U);
 }
 
+TEST(EthercatLineBoot, ResetClearsSmsAndFmmusBeforeInitAndTakesTheEeprom) {
+  FakeLine line = line_of(1);
+  line.slaves[0].mem[0x0103] = 0x01;  // station alias enabled (DL control bit 24)
+  line.slaves[0].mem[0x0500] = 0x01;  // EEPROM offered to the PDI
+  Harness h(std::move(line), std::span<const ExpectedSlave>(kThree).first(1));
+  h.boot->start(h.now);
+  h.run();
+  ASSERT_TRUE(h.boot->ok()) << h.boot->line_text();
+  const FakeEsc& esc = h.line.slaves[0];
+  // The reset frame's broadcast writes in order [ETG.1000.4 Tables 31, 47, 56, 59; §6 DC
+  // registers; ETG.1000.6 §5.3.2], first byte of each.
+  const std::vector<std::pair<std::uint16_t, std::uint8_t>> reset(esc.writes.begin(), esc.writes.begin() + 12);
+  EXPECT_EQ(reset, (std::vector<std::pair<std::uint16_t, std::uint8_t>>{
+                       {0x0600, 0x00}, {0x0800, 0x00}, {0x0981, 0x00}, {0x0910, 0x00}, {0x0920, 0x00},
+                       {0x0928, 0x00}, {0x0930, 0x00}, {0x0934, 0x00}, {0x0103, 0x00}, {0x0120, 0x11},
+                       {0x0500, 0x02}, {0x0500, 0x00}}));
+  EXPECT_EQ(esc.mem[0x0934], 0x00);  // system time difference filter depth (SOEM: u16 0C00h)
+  EXPECT_EQ(esc.mem[0x0935], 0x0C);  // speed counter filter depth
+  EXPECT_EQ(esc.mem[0x0103], 0x00);
+  EXPECT_EQ(esc.mem[0x0500], 0x00);
+}
+
+TEST(EthercatLineBoot, ResetWaitsUntilEverySlaveIsInInit) {
+  // Slave 2 was left in SAFE-OP and takes a few status reads to get to INIT: nothing else may
+  // start before it is there.
+  FakeLine line = line_of(3);
+  put_u16(line.slaves[1].mem, reg::kAlStatus, 0x0004);
+  line.slaves[1].al_delay_reads = 5;
+  Harness h(std::move(line), kThree);
+  h.boot->start(h.now);
+  h.run();
+  ASSERT_EQ(h.boot->status(), LineStatus::Done) << h.boot->line_text();
+  EXPECT_TRUE(h.boot->ok()) << h.boot->slave(1).text.view();
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_EQ(h.line.slaves[i].al_state(), 2);
+  // The station addresses were written after every slave reported INIT.
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_EQ(h.line.slaves[i].state_when_addressed, 1) << i;
+  EXPECT_EQ(h.line.slaves[1].al_control_writes, (std::vector<std::uint16_t>{0x0011, 0x0002}));
+}
+
+TEST(EthercatLineBoot, SlaveNotInInitAfterTheResetFailsTheLine) {
+  FakeLine line = line_of(2);
+  put_u16(line.slaves[1].mem, reg::kAlStatus, 0x0002);
+  line.slaves[1].never_reach = true;
+  LineBootConfig cfg;
+  cfg.to_lower_state = 50ms;
+  Harness h(std::move(line), std::span<const ExpectedSlave>(kThree).first(2), cfg);
+  h.boot->start(h.now);
+  const auto t0 = h.now;
+  h.run();
+  EXPECT_EQ(h.boot->status(), LineStatus::Failed);
+  EXPECT_EQ(h.boot->line_text(),
+            "reset: not every slave in INIT after 50 ms (BRD 0x0130: AL status 0x0003 OR-ed over 2 of 2 slaves)");
+  EXPECT_LT(h.now - t0, 100ms);
+  EXPECT_EQ(h.line.slaves[0].station(), 0);  // no station address written
+}
+
 TEST(EthercatLineBoot, RefusedSafeOpReportsTheAlStatusCodeAndAcknowledges) {
   FakeLine line = line_of(3);
   line.slaves[1].refuse[4] = 0x001D;

@@ -22,8 +22,8 @@ constexpr std::uint32_t make_tag(std::uint32_t actor, std::uint32_t item, std::u
 
 // Reset group items.
 enum ResetItem : std::uint32_t {
-  kResetAlControl, kResetFmmus, kResetSms, kResetDcActivation, kResetDcTime, kResetDcOffset, kResetDcDelay,
-  kResetDcSpeed, kResetDcFilter, kResetEeprom, kResetCount,
+  kResetFmmus, kResetSms, kResetDcActivation, kResetDcTime, kResetDcOffset, kResetDcDelay, kResetDcSpeed,
+  kResetDcFilter, kResetAlias, kResetAlControl, kResetEepromForce, kResetEepromMaster, kResetCount,
 };
 
 constexpr std::size_t kFmmuBlockBytes = 16 * reg::kFmmuSize;  // 16 FMMUs [ETG.1000.4 Table 56]
@@ -114,10 +114,13 @@ void LineBoot::send(Pending& p, std::uint32_t actor, Transactions& tx) noexcept 
 }
 
 void LineBoot::queue_reset(Transactions& tx) noexcept {
-  // Broadcast writes bringing every slave to a known state (the registers SOEM's and EtherCrab's
-  // start-ups reset): AL control INIT + acknowledge [ETG.1000.6 §5.3.2], FMMUs and SMs off
+  // One frame of broadcast writes bringing every slave to a known state (the registers SOEM's and
+  // EtherCrab's start-ups reset), processed by each slave in this order: FMMUs and SMs off
   // [ETG.1000.4 Tables 56, 59], DC off and its filters at their reset values [ETG.1000.4 §6 DC
-  // registers], EEPROM interface to EtherCAT (0500h = 0) [ETG.1000.4 Table 48].
+  // registers], the station alias off (DL control byte 0103h bit 0 [ETG.1000.4 Table 31]), and
+  // only then AL control INIT + acknowledge [ETG.1000.6 §5.3.2], so no SM or FMMU is left active
+  // while the slave goes to INIT. Last the EEPROM interface is taken for EtherCAT: 0500h = 2 forces
+  // the PDI's access off, 0500h = 0 leaves it with EtherCAT [ETG.1000.4 §6.4.2, Table 47].
   ++group_seq_;
   group_left_ = 0;
   group_lost_ = group_bad_ = false;
@@ -129,21 +132,27 @@ void LineBoot::queue_reset(Transactions& tx) noexcept {
       group_lost_ = true;
     }
   };
-  std::array<std::uint8_t, 2> al{};
-  put_u16(al, 0, al_control(AlState::Init, true));
-  bwr(kResetAlControl, reg::kAlControl, al);
+  const auto zeros = [](std::size_t n) { return std::span<const std::uint8_t>(kZeros).first(n); };
   bwr(kResetFmmus, reg::kFmmu0, kZeros);
-  bwr(kResetSms, reg::kSm0, std::span<const std::uint8_t>(kZeros).first(kSmBlockBytes));
-  bwr(kResetDcActivation, reg::kDcActivation, std::span<const std::uint8_t>(kZeros).first(1));
-  bwr(kResetDcTime, reg::kDcSystemTime, std::span<const std::uint8_t>(kZeros).first(8));
-  bwr(kResetDcOffset, reg::kDcSystemTimeOffset, std::span<const std::uint8_t>(kZeros).first(8));
-  bwr(kResetDcDelay, reg::kDcSystemTimeDelay, std::span<const std::uint8_t>(kZeros).first(4));
+  bwr(kResetSms, reg::kSm0, zeros(kSmBlockBytes));
+  bwr(kResetDcActivation, reg::kDcActivation, zeros(1));
+  bwr(kResetDcTime, reg::kDcSystemTime, zeros(8));
+  bwr(kResetDcOffset, reg::kDcSystemTimeOffset, zeros(8));
+  bwr(kResetDcDelay, reg::kDcSystemTimeDelay, zeros(4));
   std::array<std::uint8_t, 2> speed{};
   put_u16(speed, 0, 0x1000);  // speed counter start: the ESC's reset value
   bwr(kResetDcSpeed, reg::kDcSpeedCounterStart, speed);
-  const std::array<std::uint8_t, 2> filter{0x0C, 0x0C};  // time difference / speed counter filter depth
+  // 0934h system time difference filter depth 0, 0935h speed counter filter depth 0Ch: the u16
+  // 0C00h SOEM writes at 0934h.
+  const std::array<std::uint8_t, 2> filter{0x00, 0x0C};
   bwr(kResetDcFilter, reg::kDcTimeDifferenceFilterDepth, filter);
-  bwr(kResetEeprom, reg::kSiiConfig, std::span<const std::uint8_t>(kZeros).first(1));
+  bwr(kResetAlias, static_cast<std::uint16_t>(reg::kDlControl + 3), zeros(1));
+  std::array<std::uint8_t, 2> al{};
+  put_u16(al, 0, al_control(AlState::Init, true));
+  bwr(kResetAlControl, reg::kAlControl, al);
+  const std::array<std::uint8_t, 1> force{0x02};
+  bwr(kResetEepromForce, reg::kSiiConfig, force);
+  bwr(kResetEepromMaster, reg::kSiiConfig, zeros(1));
   group_due_ = false;
   if (group_left_ == 0) line_group_done();
 }
@@ -175,6 +184,16 @@ void LineBoot::poll(core::TimePoint now, Transactions& tx) noexcept {
       break;
     case LinePhase::Reset:
       if (group_due_) queue_reset(tx);
+      break;
+    case LinePhase::ResetWait:
+      if (!line_pending_.waiting && now >= reset_deadline_) {
+        fail_line("reset: not every slave in INIT after %lld ms (BRD 0x0130: AL status 0x%04X OR-ed over %u of %zu "
+                  "slaves)",
+                  static_cast<long long>(std::chrono::duration_cast<std::chrono::milliseconds>(config_.to_lower_state).count()), reset_status_, reset_wkc_,
+                  found_);
+        break;
+      }
+      send(line_pending_, kLineActor, tx);
       break;
     case LinePhase::Address:
       if (group_due_) queue_addresses(tx);
@@ -229,6 +248,12 @@ void LineBoot::on_result(std::uint32_t tag, const DatagramAnswer& a) noexcept {
       if (!line_pending_.waiting || seq != line_pending_.seq) return;
       line_pending_.waiting = false;
       line_answer(a);
+      return;
+    }
+    if (line_ == LinePhase::ResetWait) {
+      if (!line_pending_.waiting || seq != line_pending_.seq) return;
+      line_pending_.waiting = false;
+      reset_wait_answer(a);
       return;
     }
     if ((line_ != LinePhase::Reset && line_ != LinePhase::Address) || seq != group_seq_ || group_left_ == 0) return;
@@ -291,6 +316,19 @@ void LineBoot::line_answer(const DatagramAnswer& a) noexcept {
   group_retries_ = config_.retries;
 }
 
+void LineBoot::reset_wait_answer(const DatagramAnswer& a) noexcept {
+  line_pending_.due = true;  // unless done: read again at the next poll (the deadline bounds it)
+  if (a.outcome == DatagramOutcome::Lost || a.data.size() < 2) return;
+  reset_status_ = get_u16(a.data, 0);
+  reset_wkc_ = a.wkc;
+  // INIT is 1: any other state bit in the OR means some slave is elsewhere [ETG.1000.6 §5.3.2].
+  if (a.wkc == found_ && (reset_status_ & 0x0F) == static_cast<std::uint16_t>(AlState::Init)) {
+    line_pending_.due = false;
+    line_ = LinePhase::Address;
+    group_due_ = true;
+  }
+}
+
 void LineBoot::line_group_done() noexcept {
   const BootStep step = line_ == LinePhase::Reset ? BootStep::Reset : BootStep::Address;
   if (group_bad_) {
@@ -312,8 +350,12 @@ void LineBoot::line_group_done() noexcept {
   }
   group_retries_ = config_.retries;
   if (line_ == LinePhase::Reset) {
-    line_ = LinePhase::Address;
-    group_due_ = true;
+    // Wait until every slave is in INIT (BRD of AL status: the states OR-ed, WKC = slaves read).
+    line_ = LinePhase::ResetWait;
+    reset_deadline_ = now_ + config_.to_lower_state;
+    reset_status_ = 0;
+    reset_wkc_ = 0;
+    set(line_pending_, Command::BRD, physical_address(0, reg::kAlStatus), 2);
     return;
   }
   // Addresses set: every slave starts its own steps.

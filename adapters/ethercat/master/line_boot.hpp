@@ -4,9 +4,12 @@
 // ETG.1000.6 §5.3 ESM, §5.4 SII):
 //
 //   1. count:    BRD 0000h; the working counter is the number of slaves [ETG.1000.4 §5.4 BRD].
-//   2. reset:    one frame of broadcast writes: AL control = INIT with error acknowledge, FMMUs and
-//                SyncManagers cleared, DC activation off, DC system time / offset / delay cleared,
-//                DC speed counter start 1000h and filter depths 0Ch, EEPROM access to EtherCAT.
+//   2. reset:    one frame of broadcast writes, in this order: FMMUs and SyncManagers cleared, DC
+//                activation off, DC system time / offset / delay cleared, DC speed counter start
+//                1000h and filter depths (0934h = 0, 0935h = 0Ch), station alias off (0103h = 0),
+//                then AL control = INIT with error acknowledge, then the EEPROM to EtherCAT (0500h =
+//                2, then 0). Then BRD 0130h until every slave reports INIT (to_lower_state; a slave
+//                not in INIT by then fails the line step).
 //   3. address:  APWR 0010h = first_station + position (0x1001, 0x1002, ...).
 //   4. per slave, all slaves in parallel, one datagram in flight each:
 //      SII:      through the EEPROM interface [ETG.1000.4 Table 48]: FPRD 0502h (busy? 4 or 8 byte
@@ -146,7 +149,7 @@ class LineBoot final : public DatagramOwner {
     std::array<std::uint8_t, 16> data{};
     std::size_t data_size = 0;
   };
-  enum class LinePhase : std::uint8_t { Idle, Count, Reset, Address, Slaves, Done, Failed };
+  enum class LinePhase : std::uint8_t { Idle, Count, Reset, ResetWait, Address, Slaves, Done, Failed };
   enum class Phase : std::uint8_t {
     Idle, SiiStatus, SiiCommand, SiiBusy, SiiData, Mailbox, AlCheck, AlRequest, AlPoll, AlCode, AlAck, AlAckPoll,
   };
@@ -173,6 +176,7 @@ class LineBoot final : public DatagramOwner {
   void send(Pending& p, std::uint32_t actor, Transactions& tx) noexcept;
   void line_answer(const DatagramAnswer& a) noexcept;
   void line_group_done() noexcept;
+  void reset_wait_answer(const DatagramAnswer& a) noexcept;
   void queue_reset(Transactions& tx) noexcept;
   void queue_addresses(Transactions& tx) noexcept;
   void slave_answer(Slave& s, const DatagramAnswer& a) noexcept;
@@ -201,6 +205,9 @@ class LineBoot final : public DatagramOwner {
   bool group_due_ = false;
   std::uint16_t group_seq_ = 0;
   std::size_t found_ = 0;
+  core::TimePoint reset_deadline_{};  // every slave in INIT by then
+  std::uint16_t reset_status_ = 0;    // last BRD 0130h: AL status OR-ed over the slaves
+  std::uint16_t reset_wkc_ = 0;
   core::TimePoint now_{};
   core::FixedString<240> line_text_{};
   std::array<Slave, kMaxSlaves> slaves_{};
