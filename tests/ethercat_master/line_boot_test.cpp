@@ -4,6 +4,7 @@
 // transition timeout and lost frames.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <memory>
 #include <vector>
 
@@ -133,11 +134,11 @@ TEST(EthercatLineBoot, ResetClearsSmsAndFmmusBeforeInitAndTakesTheEeprom) {
   ASSERT_TRUE(h.boot->ok()) << h.boot->line_text();
   const FakeEsc& esc = h.line.slaves[0];
   // The reset frame's broadcast writes in order [ETG.1000.4 Tables 31, 47, 56, 59; §6 DC
-  // registers; ETG.1000.6 §5.3.2], first byte of each.
-  const std::vector<std::pair<std::uint16_t, std::uint8_t>> reset(esc.writes.begin(), esc.writes.begin() + 12);
-  EXPECT_EQ(reset, (std::vector<std::pair<std::uint16_t, std::uint8_t>>{
-                       {0x0600, 0x00}, {0x0800, 0x00}, {0x0981, 0x00}, {0x0910, 0x00}, {0x0920, 0x00},
-                       {0x0928, 0x00}, {0x0930, 0x00}, {0x0934, 0x00}, {0x0103, 0x00}, {0x0120, 0x11},
+  // registers; ETG.1000.6 §5.3.2], first two bytes of each (little-endian).
+  const std::vector<std::pair<std::uint16_t, std::uint16_t>> reset(esc.writes.begin(), esc.writes.begin() + 12);
+  EXPECT_EQ(reset, (std::vector<std::pair<std::uint16_t, std::uint16_t>>{
+                       {0x0600, 0x0000}, {0x0800, 0x0000}, {0x0981, 0x00}, {0x0910, 0x0000}, {0x0920, 0x0000},
+                       {0x0928, 0x0000}, {0x0930, 0x1000}, {0x0934, 0x0C00}, {0x0103, 0x00}, {0x0120, 0x0011},
                        {0x0500, 0x02}, {0x0500, 0x00}}));
   EXPECT_EQ(esc.mem[0x0934], 0x00);  // system time difference filter depth (SOEM: u16 0C00h)
   EXPECT_EQ(esc.mem[0x0935], 0x0C);  // speed counter filter depth
@@ -177,6 +178,28 @@ TEST(EthercatLineBoot, SlaveNotInInitAfterTheResetFailsTheLine) {
             "reset: not every slave in INIT after 50 ms (BRD 0x0130: AL status 0x0003 OR-ed over 2 of 2 slaves)");
   EXPECT_LT(h.now - t0, 100ms);
   EXPECT_EQ(h.line.slaves[0].station(), 0);  // no station address written
+}
+
+TEST(EthercatLineBoot, EepromNackIsClearedAndTheReadGivenAgain) {
+  FakeLine line = line_of(2);
+  line.slaves[0].sii_nacks = 2;  // two reads not acknowledged, the third is
+  line.slaves[1].sii_nacks = 1000;
+  LineBootConfig cfg;
+  Harness h(std::move(line), std::span<const ExpectedSlave>(kThree).first(2), cfg);
+  h.boot->start(h.now);
+  h.run();
+  ASSERT_EQ(h.boot->status(), LineStatus::Done) << h.boot->line_text();
+  EXPECT_EQ(h.boot->slave(0).status, SlaveStatus::Ready) << h.boot->slave(0).text.view();
+  EXPECT_EQ(h.boot->slave(0).state, AlState::PreOp);
+  // Each error cleared with a NOP (0502h = 0000h) before the read command again.
+  const auto& w = h.line.slaves[0].writes;
+  EXPECT_EQ(std::count(w.begin(), w.end(), std::pair<std::uint16_t, std::uint16_t>{0x0502, 0x0000}), 2);
+  const SlaveReport& r = h.boot->slave(1);
+  EXPECT_EQ(r.status, SlaveStatus::Failed);
+  EXPECT_EQ(r.step, BootStep::Sii);
+  EXPECT_EQ(r.text.view(),
+            "slave 2 (0x1002, ESR TrioDrive): SII read of word 0x0000 failed 4 times (control 0x2000: the EEPROM did "
+            "not acknowledge)");
 }
 
 TEST(EthercatLineBoot, RefusedSafeOpReportsTheAlStatusCodeAndAcknowledges) {

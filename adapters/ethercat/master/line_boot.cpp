@@ -371,6 +371,7 @@ void LineBoot::line_group_done() noexcept {
     s.image_size = 0;
     s.sii_word = 0;
     s.sii_next_category = kSiiHeaderBytes;
+    s.sii_tries_left = config_.retries;
     s.phase = Phase::SiiStatus;
     s.deadline = now_ + config_.sii_timeout;
     slave_phase(s);
@@ -392,6 +393,12 @@ void LineBoot::slave_phase(Slave& s) noexcept {
       put_u32(cmd, 2, s.sii_word);
       set(s.pending, Command::FPWR, physical_address(station, reg::kSiiControl), 6, cmd);
       s.deadline = now_ + config_.sii_timeout;
+      break;
+    }
+    case Phase::SiiClear: {
+      // NOP command: clears the error bits [ETG.1000.4 Table 48].
+      const std::array<std::uint8_t, 2> nop{};
+      set(s.pending, Command::FPWR, physical_address(station, reg::kSiiControl), 2, nop);
       break;
     }
     case Phase::SiiData:
@@ -467,7 +474,20 @@ void LineBoot::slave_answer(Slave& s, const DatagramAnswer& a) noexcept {
         slave_phase(s);  // poll again (the timeout is checked in poll())
         return;
       }
-      if (s.phase == Phase::SiiBusy && (ctl & (sii_control::kCommandError | sii_control::kDeviceInfoError)) != 0) {
+      constexpr std::uint16_t kNack = sii_control::kCommandError | sii_control::kWriteError;
+      if (s.phase == Phase::SiiBusy && (ctl & kNack) != 0) {
+        // The EEPROM did not acknowledge (bit 13) or a write-enable error (bit 14) [ETG.1000.4
+        // Table 48]: clear the error bits with a NOP command and give the read again, a few times.
+        if (s.sii_tries_left-- > 0) {
+          s.phase = Phase::SiiClear;
+          slave_phase(s);
+          return;
+        }
+        fail(s, BootStep::Sii, "SII read of word 0x%04X failed %d times (control 0x%04X: the EEPROM did not acknowledge)",
+             s.sii_word, config_.retries + 1, ctl);
+        return;
+      }
+      if (s.phase == Phase::SiiBusy && (ctl & sii_control::kDeviceInfoError) != 0) {
         fail(s, BootStep::Sii, "SII read of word 0x%04X failed (control 0x%04X)", s.sii_word, ctl);
         return;
       }
@@ -477,6 +497,10 @@ void LineBoot::slave_answer(Slave& s, const DatagramAnswer& a) noexcept {
     }
     case Phase::SiiCommand:
       s.phase = Phase::SiiBusy;
+      slave_phase(s);
+      return;
+    case Phase::SiiClear:
+      s.phase = Phase::SiiCommand;
       slave_phase(s);
       return;
     case Phase::SiiData:
@@ -575,6 +599,7 @@ void LineBoot::sii_chunk(Slave& s, std::span<const std::uint8_t> data) noexcept 
   std::copy_n(data.begin(), n, s.image.begin() + static_cast<std::ptrdiff_t>(s.image_size));
   s.image_size += n;
   s.sii_word += static_cast<std::uint32_t>(data.size() / 2);
+  s.sii_tries_left = config_.retries;
   const std::span<const std::uint8_t> image(s.image.data(), s.image_size);
   if (s.image_size >= kSiiHeaderBytes && sii_end_seen(image, s.sii_next_category)) {
     parse_sii(image, s.info);

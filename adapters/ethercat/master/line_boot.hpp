@@ -15,7 +15,9 @@
 //      SII:      through the EEPROM interface [ETG.1000.4 Table 48]: FPRD 0502h (busy? 4 or 8 byte
 //                reads?), FPWR 0502h = read command + word address, FPRD 0502h until not busy,
 //                FPRD 0508h (4 or 8 bytes), until the category list ends (FFFFh) [ETG.1000.6 §5.4];
-//                then parse_sii().
+//                then parse_sii(). An error bit after a command (13: no acknowledge, 14: write
+//                enable) is cleared with a NOP (0502h = 0) and the read given again, `retries`
+//                times, then the slave fails at the SII step.
 //      identity: vendor, product, revision against the expected slave at that position (revision
 //                0 = any). A difference fails the slave and names both identities; a slave beyond
 //                the configured ones is reported and left in INIT.
@@ -151,7 +153,7 @@ class LineBoot final : public DatagramOwner {
   };
   enum class LinePhase : std::uint8_t { Idle, Count, Reset, ResetWait, Address, Slaves, Done, Failed };
   enum class Phase : std::uint8_t {
-    Idle, SiiStatus, SiiCommand, SiiBusy, SiiData, Mailbox, AlCheck, AlRequest, AlPoll, AlCode, AlAck, AlAckPoll,
+    Idle, SiiStatus, SiiCommand, SiiBusy, SiiClear, SiiData, Mailbox, AlCheck, AlRequest, AlPoll, AlCode, AlAck, AlAckPoll,
   };
   struct Slave {
     SlaveReport report{};
@@ -164,6 +166,7 @@ class LineBoot final : public DatagramOwner {
     bool refused = false;           // AlAck acknowledges a refusal (else an error found before the request)
     bool eight_byte_reads = false;
     std::uint32_t sii_word = 0;  // next word address to read
+    int sii_tries_left = 0;      // reads of this word given again after an EEPROM error
     std::size_t sii_next_category = 0;  // image offset of the next SII category header to walk
     std::size_t image_size = 0;
     std::array<std::uint8_t, kMaxSiiBytes> image{};
