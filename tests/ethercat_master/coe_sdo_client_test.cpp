@@ -40,6 +40,8 @@ struct Server {
   std::deque<std::vector<std::uint8_t>> outbox;
   int delay_next = 0;
   int delay_left = 0;
+  std::uint32_t stated_size = 0;  // normal upload responses state this size instead (0: the real one)
+  bool size_unstated = false;     // normal upload responses without the size indicator
 
   std::uint8_t next() { return counter = next_mailbox_counter(counter); }
 
@@ -100,9 +102,14 @@ struct Server {
           n = encode_sdo_upload_expedited_response(out, next(), s.index, s.subindex, value);
         } else {
           const std::size_t first = std::min<std::size_t>(value.size(), 64 - 16);
-          n = encode_sdo_upload_normal_response(out, next(), s.index, s.subindex,
-                                                static_cast<std::uint32_t>(value.size()),
-                                                std::span<const std::uint8_t>(value).first(first));
+          n = encode_sdo_upload_normal_response(
+              out, next(), s.index, s.subindex,
+              stated_size != 0 ? stated_size : static_cast<std::uint32_t>(value.size()),
+              std::span<const std::uint8_t>(value).first(first));
+          if (size_unstated) {  // s = 0, size field 0 [ETG.1000.6 §5.6.2.4, CiA 301 §7.2.4.3.5]
+            out[8] = static_cast<std::uint8_t>(out[8] & ~0x01U);
+            core::put_u32(out, 12, 0);
+          }
           up.assign(value.begin() + static_cast<std::ptrdiff_t>(first), value.end());
         }
         break;
@@ -377,6 +384,53 @@ TEST(EthercatCoeSdo, UploadLongerThanTheBufferFails) {
   const auto r = h.run(h.client.upload(0x1008, 0, small));
   EXPECT_EQ(r.status, CoeSdoStatus::Failed);
   EXPECT_EQ(r.abort_code, 0x05040005U);
+}
+
+TEST(EthercatCoeSdo, UploadShorterThanItsStatedSizeFails) {
+  Harness h;
+  h.server.od[{0x1008, 0}] = std::vector<std::uint8_t>(150, 'y');
+  h.server.stated_size = 200;  // segments end after 150 bytes
+  std::array<std::uint8_t, 256> into{};
+  const auto r = h.run(h.client.upload(0x1008, 0, into));
+  EXPECT_EQ(r.status, CoeSdoStatus::Failed);
+  EXPECT_EQ(r.abort_code, 0x06070013U);  // length of service parameter too low
+}
+
+TEST(EthercatCoeSdo, NormalUploadWithoutStatedSizeFails) {
+  Harness h;
+  h.server.od[{0x1008, 0}] = std::vector<std::uint8_t>(10, 'z');
+  h.server.size_unstated = true;
+  std::array<std::uint8_t, 64> into{};
+  const auto r = h.run(h.client.upload(0x1008, 0, into));
+  EXPECT_EQ(r.status, CoeSdoStatus::Failed);
+  EXPECT_EQ(r.abort_code, 0x05040001U);
+}
+
+TEST(EthercatCoeSdo, ResetFailsQueuedRequestsAndForgetsTheReplyCounter) {
+  Harness h;
+  h.server.od[{0x1000, 0}] = {0x92, 0x01, 0x02, 0x00};
+  const CoeSdoId first = h.client.upload_value(0x1000, 0);
+  ASSERT_EQ(h.run(first).status, CoeSdoStatus::Done);  // the slave's reply carried counter 1
+  const CoeSdoId a = h.client.upload_value(0x1000, 0);
+  const CoeSdoId b = h.client.upload_value(0x1000, 0);
+  h.cycle();
+  EXPECT_EQ(h.client.result(a).status, CoeSdoStatus::InFlight);
+  // The slave is re-initialised: its SMs are cleared and it numbers its replies from 1 again.
+  FakeEsc& esc = h.line.slaves[0];
+  esc.sm1_full = false;
+  esc.last_reply.clear();
+  h.server.outbox.clear();
+  h.server.counter = 0;
+  h.client.reset();
+  EXPECT_TRUE(h.client.idle());
+  EXPECT_EQ(h.client.result(a).status, CoeSdoStatus::Failed);
+  EXPECT_EQ(h.client.result(a).abort_code, 0x08000022U);
+  EXPECT_EQ(h.client.result(b).status, CoeSdoStatus::Failed);
+  EXPECT_EQ(h.client.result(b).abort_code, 0x08000022U);
+  EXPECT_EQ(h.client.result(first).status, CoeSdoStatus::Done);  // finished results stay
+  const auto r = h.run(h.client.upload_value(0x1000, 0));
+  ASSERT_EQ(r.status, CoeSdoStatus::Done) << std::hex << r.abort_code;  // its reply has counter 1 again
+  EXPECT_EQ(r.value, 0x00020192U);
 }
 
 TEST(EthercatCoeSdo, QueueHasAFixedSize) {

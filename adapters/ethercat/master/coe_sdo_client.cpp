@@ -137,6 +137,30 @@ void CoeSdoClient::finish(Slot& s, SlotState state, std::uint32_t abort_code) no
   write_due_ = false;
 }
 
+void CoeSdoClient::reset() noexcept {
+  for (auto& s : slots_) {
+    if (s.state != SlotState::Queued && s.state != SlotState::InFlight) continue;
+    s.state = SlotState::Failed;
+    s.result.status = CoeSdoStatus::Failed;
+    s.result.abort_code = cia402::sdo_abort_code::kDeviceState;
+    ++counters_.failed;
+  }
+  active_ = nullptr;
+  phase_ = Phase::Idle;
+  expect_ = Expect::Initiate;
+  toggle_ = false;
+  waiting_ = false;  // the answer of a datagram in flight no longer matches (seq_ moves on)
+  write_due_ = false;
+  out_size_ = 0;
+  // A re-initialised slave numbers its replies afresh: forget the last one seen [ETG.1000.6 §5.6,
+  // mailbox counter]. Our own counter runs on: a new value is accepted whether or not the slave
+  // forgot the last one it saw.
+  last_reply_counter_ = 0;
+  repeat_activate_ = 0;
+  drain_due_ = false;
+  next_status_poll_ = core::TimePoint{};
+}
+
 void CoeSdoClient::on_status(const DatagramAnswer& a) noexcept {
   // SM1 status 080Dh bit 3: mailbox full [ETG.1000.4 Table 59, SM status].
   const bool full = a.outcome != DatagramOutcome::Lost && a.wkc == 1 && !a.data.empty() &&
@@ -450,11 +474,18 @@ void CoeSdoClient::on_sdo(Slot& s, const CoeSdo& sdo) noexcept {
       finish(s, SlotState::Done, 0);
       return;
     }
-    const std::size_t total = sdo.size;  // the size the server indicated
+    // Normal upload: the response states the complete size [ETG.1000.6 §5.6.2.4]; without it the
+    // end of the data cannot be known.
+    if (!sdo.size_indicated) {
+      finish(s, SlotState::Failed, cia402::sdo_abort_code::kUnknownCommand);
+      return;
+    }
+    const std::size_t total = sdo.size;
     if (total > s.capacity) {
       finish(s, SlotState::Failed, cia402::sdo_abort_code::kOutOfMemory);
       return;
     }
+    s.total = total;
     if (s.done >= total) {
       finish(s, SlotState::Done, 0);
     } else {
@@ -463,8 +494,14 @@ void CoeSdoClient::on_sdo(Slot& s, const CoeSdo& sdo) noexcept {
     return;
   }
   toggle_ = !toggle_;
+  if (s.done > s.total) {  // more than stated
+    finish(s, SlotState::Failed, cia402::sdo_abort_code::kTooLong);
+    return;
+  }
   if (sdo.last) {
-    finish(s, SlotState::Done, 0);
+    // The last segment must complete the stated size: fewer bytes is a truncated object.
+    finish(s, s.done == s.total ? SlotState::Done : SlotState::Failed,
+           s.done == s.total ? 0 : cia402::sdo_abort_code::kTooShort);
   } else {
     prepare_upload_segment();
   }

@@ -24,7 +24,9 @@
 // start: then it fails with 05040000h (SDO protocol timed out); nothing is sent to the slave (its
 // late reply, if any, is read and dropped by the drain, counted in stale_replies). Uploads go into the caller's buffer (or
 // the request's 8 inline bytes); a reply longer than the buffer fails with 05040005h (out of
-// memory). Downloads come from the caller's buffer (must stay valid until the result is taken) or
+// memory). A normal upload whose response does not state the size fails with 05040001h (ETG.1000.6
+// §5.6.2.4 makes the complete size part of it), one whose segments end before (after) the stated
+// size with 06070013h (06070012h). Downloads come from the caller's buffer (must stay valid until the result is taken) or
 // 1..4 inline bytes (download_value). Nothing allocates.
 #include <array>
 #include <cstddef>
@@ -94,6 +96,13 @@ class CoeSdoClient final : public DatagramOwner {
   [[nodiscard]] std::span<const std::uint8_t> data(CoeSdoId id) const noexcept;  // upload bytes
   CoeSdoResult take(CoeSdoId id) noexcept;  // frees a finished request
 
+  // The slave was re-initialised (LineBoot took it through INIT again, or it lost power): every
+  // queued or running request fails with 08000022h (present device state), the mailbox state is
+  // dropped (reply counter memory, repeat bit, a datagram in flight is ignored when it comes).
+  // Finished results stay until taken. Callers that re-run LineBoot (start() or a transition
+  // through INIT) call this for each of the slave's clients.
+  void reset() noexcept;
+
   void poll(core::TimePoint now, Transactions& tx) noexcept;
   void on_result(std::uint32_t tag, const DatagramAnswer& answer) noexcept override;
 
@@ -113,6 +122,7 @@ class CoeSdoClient final : public DatagramOwner {
     const std::uint8_t* from = nullptr;    // download source (caller's or inline)
     std::size_t capacity = 0;              // of into / size of from
     std::size_t done = 0;                  // bytes received / sent
+    std::size_t total = 0;                 // uploads: the size the server stated
     std::array<std::uint8_t, kInline> inline_bytes{};
     CoeSdoResult result{};
   };
