@@ -349,6 +349,32 @@ TEST(EthercatLineBoot, LostFramesAreRetried) {
   EXPECT_GT(h.tx.counters().frames_lost, 0U);
 }
 
+TEST(EthercatLineBoot, RestartIgnoresAnswersOfTheEarlierRun) {
+  // start() while the count of the first run is in flight; its answer (two slaves, the line has
+  // changed since) comes back after the new run queued its own count.
+  Harness h(line_of(3), kThree);
+  h.boot->start(h.now);
+  h.boot->poll(h.now, h.tx);
+  std::vector<std::vector<std::uint8_t>> old;
+  for (const auto& f : h.tx.take_frames(h.now + 10ms)) old.emplace_back(f.begin(), f.end());
+  ASSERT_EQ(old.size(), 1U);
+  h.boot->start(h.now);
+  h.boot->poll(h.now, h.tx);
+  std::vector<std::vector<std::uint8_t>> fresh;
+  for (const auto& f : h.tx.take_frames(h.now + 10ms)) fresh.emplace_back(f.begin(), f.end());
+  ASSERT_EQ(fresh.size(), 1U);
+  FakeLine two = line_of(2);
+  two.process(old[0]);
+  h.line.process(fresh[0]);
+  h.tx.on_frame(old[0]);
+  h.tx.on_frame(fresh[0]);
+  h.now += 1ms;
+  h.run();
+  ASSERT_EQ(h.boot->status(), LineStatus::Done) << h.boot->line_text();
+  EXPECT_EQ(h.boot->slave_count(), 3U);
+  EXPECT_TRUE(h.boot->ok());
+}
+
 TEST(EthercatLineBoot, EmptyLineFailsTheCount) {
   Harness h(line_of(0), kThree);
   h.boot->start(h.now);

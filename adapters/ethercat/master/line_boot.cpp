@@ -14,11 +14,14 @@ using core::put_u32;
 
 namespace {
 
-// Tag layout: bits 24-31 actor (slave position, or the line), 16-23 item of a group, 0-15 sequence
-// number (answers of an abandoned datagram are recognised and ignored).
-constexpr std::uint32_t make_tag(std::uint32_t actor, std::uint32_t item, std::uint16_t seq) noexcept {
-  return (actor << 24) | ((item & 0xFF) << 16) | seq;
+// Tag layout: bits 24-31 actor (slave position, or the line), 16-23 item of a group, 12-15 run
+// generation (start() counts it up: answers of a previous run are ignored), 0-11 sequence number
+// (answers of an abandoned datagram are recognised and ignored).
+constexpr std::uint16_t kSeqMask = 0x0FFF;
+constexpr std::uint32_t make_tag(std::uint32_t actor, std::uint32_t item, std::uint8_t run, std::uint16_t seq) noexcept {
+  return (actor << 24) | ((item & 0xFF) << 16) | (static_cast<std::uint32_t>(run & 0x0F) << 12) | (seq & kSeqMask);
 }
+constexpr std::uint16_t next_seq(std::uint16_t seq) noexcept { return static_cast<std::uint16_t>((seq + 1) & kSeqMask); }
 
 // Reset group items.
 enum ResetItem : std::uint32_t {
@@ -77,6 +80,7 @@ LineBoot::LineBoot(std::span<const ExpectedSlave> expected, LineBootConfig confi
 
 void LineBoot::start(core::TimePoint now) noexcept {
   now_ = now;
+  run_ = static_cast<std::uint8_t>((run_ + 1) & 0x0F);
   line_ = LinePhase::Count;
   line_text_.assign("");
   found_ = 0;
@@ -105,8 +109,8 @@ void LineBoot::set(Pending& p, Command command, std::uint32_t address, std::uint
 
 void LineBoot::send(Pending& p, std::uint32_t actor, Transactions& tx) noexcept {
   if (!p.due || p.waiting) return;
-  ++p.seq;
-  if (tx.queue(this, make_tag(actor, 0, p.seq), p.command, p.address, p.length,
+  p.seq = next_seq(p.seq);
+  if (tx.queue(this, make_tag(actor, 0, run_, p.seq), p.command, p.address, p.length,
                std::span<const std::uint8_t>(p.data.data(), p.data_size))) {
     p.due = false;
     p.waiting = true;
@@ -121,11 +125,11 @@ void LineBoot::queue_reset(Transactions& tx) noexcept {
   // only then AL control INIT + acknowledge [ETG.1000.6 §5.3.2], so no SM or FMMU is left active
   // while the slave goes to INIT. Last the EEPROM interface is taken for EtherCAT: 0500h = 2 forces
   // the PDI's access off, 0500h = 0 leaves it with EtherCAT [ETG.1000.4 §6.4.2, Table 47].
-  ++group_seq_;
+  group_seq_ = next_seq(group_seq_);
   group_left_ = 0;
   group_lost_ = group_bad_ = false;
   const auto bwr = [&](std::uint32_t item, std::uint16_t reg, std::span<const std::uint8_t> data) {
-    if (tx.queue(this, make_tag(kLineActor, item, group_seq_), Command::BWR, physical_address(0, reg),
+    if (tx.queue(this, make_tag(kLineActor, item, run_, group_seq_), Command::BWR, physical_address(0, reg),
                  static_cast<std::uint16_t>(data.size()), data)) {
       ++group_left_;
     } else {
@@ -158,14 +162,14 @@ void LineBoot::queue_reset(Transactions& tx) noexcept {
 }
 
 void LineBoot::queue_addresses(Transactions& tx) noexcept {
-  ++group_seq_;
+  group_seq_ = next_seq(group_seq_);
   group_left_ = 0;
   group_lost_ = group_bad_ = false;
   for (std::size_t pos = 0; pos < found_; ++pos) {
     std::array<std::uint8_t, 2> station{};
     put_u16(station, 0, static_cast<std::uint16_t>(config_.first_station + pos));
     const auto p = static_cast<std::uint16_t>(pos);
-    if (tx.queue(this, make_tag(kLineActor, static_cast<std::uint32_t>(pos), group_seq_), Command::APWR,
+    if (tx.queue(this, make_tag(kLineActor, static_cast<std::uint32_t>(pos), run_, group_seq_), Command::APWR,
                  physical_address(auto_increment_adp(p), reg::kStationAddress), 2, station)) {
       ++group_left_;
     } else {
@@ -242,7 +246,8 @@ void LineBoot::poll(core::TimePoint now, Transactions& tx) noexcept {
 
 void LineBoot::on_result(std::uint32_t tag, const DatagramAnswer& a) noexcept {
   const std::uint32_t actor = tag >> 24;
-  const auto seq = static_cast<std::uint16_t>(tag & 0xFFFF);
+  const auto seq = static_cast<std::uint16_t>(tag & kSeqMask);
+  if (((tag >> 12) & 0x0F) != run_) return;  // queued by an earlier run (start() since)
   if (actor == kLineActor) {
     if (line_ == LinePhase::Count) {
       if (!line_pending_.waiting || seq != line_pending_.seq) return;

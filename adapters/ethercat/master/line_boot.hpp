@@ -114,7 +114,8 @@ class LineBoot final : public DatagramOwner {
   // name views must outlive the boot).
   LineBoot(std::span<const ExpectedSlave> expected, LineBootConfig config) noexcept;
 
-  // (Re)starts the boot from the count.
+  // (Re)starts the boot from the count. Answers to datagrams of an earlier run still in flight
+  // are ignored.
   void start(core::TimePoint now) noexcept;
   // Queues the datagrams that are due and runs timeouts.
   void poll(core::TimePoint now, Transactions& tx) noexcept;
@@ -207,6 +208,7 @@ class LineBoot final : public DatagramOwner {
   int group_retries_ = 0;
   bool group_due_ = false;
   std::uint16_t group_seq_ = 0;
+  std::uint8_t run_ = 0;  // run generation (0..15), counted up by start(), part of every tag
   std::size_t found_ = 0;
   core::TimePoint reset_deadline_{};  // every slave in INIT by then
   std::uint16_t reset_status_ = 0;    // last BRD 0130h: AL status OR-ed over the slaves
