@@ -4,6 +4,7 @@
 // checked against ETG.1000.6 §5.6.2 (digest TV-6 for the expedited download layout).
 #include <gtest/gtest.h>
 
+#include <deque>
 #include <map>
 #include <vector>
 
@@ -33,8 +34,39 @@ struct Server {
   std::vector<std::uint8_t> up;     // remaining upload bytes
   std::vector<std::uint8_t> down;   // download bytes so far
   std::size_t down_total = 0;
+  // Replies wait here while SM1 is full (a slave cannot write a full mailbox [ETG.1000.4 §6
+  // SyncManager, 1-buffer mode]) or while held back: `delay_next` holds the next reply that many
+  // harness cycles (a late reply).
+  std::deque<std::vector<std::uint8_t>> outbox;
+  int delay_next = 0;
+  int delay_left = 0;
+  std::uint32_t stated_size = 0;  // normal upload responses state this size instead (0: the real one)
+  bool size_unstated = false;     // normal upload responses without the size indicator
 
   std::uint8_t next() { return counter = next_mailbox_counter(counter); }
+
+  void send(FakeEsc& esc, std::span<const std::uint8_t> reply) {
+    if (delay_next > 0) {
+      delay_left = delay_next;
+      delay_next = 0;
+    }
+    if (delay_left > 0 || esc.sm1_full || !outbox.empty()) {
+      outbox.emplace_back(reply.begin(), reply.end());
+    } else {
+      esc.reply(reply);
+    }
+  }
+  // Called once per harness cycle: hands a waiting reply to SM1 when it is free.
+  void deliver(FakeEsc& esc) {
+    if (delay_left > 0) {
+      --delay_left;
+      return;
+    }
+    if (!outbox.empty() && !esc.sm1_full) {
+      esc.reply(outbox.front());
+      outbox.pop_front();
+    }
+  }
 
   void handle(FakeEsc& esc, std::span<const std::uint8_t> req) {
     if (ignore > 0) {
@@ -59,7 +91,7 @@ struct Server {
       key = {s.index, s.subindex};
       if (auto a = aborts.find(key); a != aborts.end()) {
         n = encode_sdo_abort(out, next(), s.index, s.subindex, a->second);
-        esc.reply(std::span<const std::uint8_t>(out.data(), n));
+        send(esc, std::span<const std::uint8_t>(out.data(), n));
         return;
       }
     }
@@ -70,9 +102,14 @@ struct Server {
           n = encode_sdo_upload_expedited_response(out, next(), s.index, s.subindex, value);
         } else {
           const std::size_t first = std::min<std::size_t>(value.size(), 64 - 16);
-          n = encode_sdo_upload_normal_response(out, next(), s.index, s.subindex,
-                                                static_cast<std::uint32_t>(value.size()),
-                                                std::span<const std::uint8_t>(value).first(first));
+          n = encode_sdo_upload_normal_response(
+              out, next(), s.index, s.subindex,
+              stated_size != 0 ? stated_size : static_cast<std::uint32_t>(value.size()),
+              std::span<const std::uint8_t>(value).first(first));
+          if (size_unstated) {  // s = 0, size field 0 [ETG.1000.6 §5.6.2.4, CiA 301 §7.2.4.3.5]
+            out[8] = static_cast<std::uint8_t>(out[8] & ~0x01U);
+            core::put_u32(out, 12, 0);
+          }
           up.assign(value.begin() + static_cast<std::ptrdiff_t>(first), value.end());
         }
         break;
@@ -98,7 +135,7 @@ struct Server {
       default:
         FAIL() << "unexpected command";
     }
-    esc.reply(std::span<const std::uint8_t>(out.data(), n));
+    send(esc, std::span<const std::uint8_t>(out.data(), n));
   }
   std::vector<std::uint8_t> pending;
 };
@@ -117,7 +154,8 @@ struct Harness {
   core::TimePoint now{};
   bool drop_next_sm1_read = false;
 
-  explicit Harness(CoeSdoTiming timing = {}) : client(0x1001, kMailbox, timing, &emcy) {
+  explicit Harness(CoeSdoTiming timing = {}, bool sink = true)
+      : client(0x1001, kMailbox, timing, sink ? &emcy : nullptr) {
     FakeEsc esc;
     put_u16(esc.mem, reg::kStationAddress, 0x1001);
     const auto sm0 = encode_sm(SmEntry{0x1000, 64, 0x26, 0, 1, 0});
@@ -144,6 +182,7 @@ struct Harness {
     }
     // An emergency read: now the SDO reply the server held back.
     FakeEsc& esc = line.slaves[0];
+    server.deliver(esc);
     if (!server.pending.empty() && !esc.sm1_full) {
       const auto req = server.pending;
       server.pending.clear();
@@ -252,6 +291,43 @@ TEST(EthercatCoeSdo, SilentServerTimesOutAndTheQueueMovesOn) {
   EXPECT_EQ(h.run(second).status, CoeSdoStatus::Done);
 }
 
+TEST(EthercatCoeSdo, LateReplyIsNotTakenAsTheAnswerToTheNextRequest) {
+  // The reply to the first upload comes after its timeout and sits in SM1; the next upload of the
+  // same object must get the value the slave has now, not the old reply (ETG.1000.6 §5.6: the
+  // mailbox counter of a slave's reply says nothing about the request it answers).
+  CoeSdoTiming t;
+  t.timeout = 20ms;
+  Harness h(t, false);  // no emergency sink: nothing reads SM1 while idle
+  h.server.od[{0x2100, 0}] = {1, 0, 0, 0};
+  h.server.delay_next = 30;
+  const auto r1 = h.run(h.client.upload_value(0x2100, 0));
+  EXPECT_EQ(r1.status, CoeSdoStatus::Failed);
+  EXPECT_EQ(r1.abort_code, 0x05040000U);
+  h.server.od[{0x2100, 0}] = {2, 0, 0, 0};
+  for (int i = 0; i < 100 && !h.line.slaves[0].sm1_full; ++i) h.cycle();
+  ASSERT_TRUE(h.line.slaves[0].sm1_full);  // the late reply is in SM1 now
+  const auto r2 = h.run(h.client.upload_value(0x2100, 0));
+  ASSERT_EQ(r2.status, CoeSdoStatus::Done);
+  EXPECT_EQ(r2.value, 2U);
+  EXPECT_EQ(h.client.counters().stale_replies, 1U);
+  EXPECT_EQ(h.line.slaves[0].requests.size(), 2U);
+}
+
+TEST(EthercatCoeSdo, EmergencyFoundWhenEmptyingSm1StillGoesToTheSink) {
+  Harness h;
+  h.server.od[{0x1001, 0}] = {0x22};
+  // An emergency already in SM1 when the request starts [digest §8.1: 8100h, error register 11h].
+  std::array<std::uint8_t, 64> emcy{};
+  const std::size_t n = encode_emergency(emcy, 3, CoeEmergency{0x8100, 0x11, {}});
+  h.line.slaves[0].reply(std::span<const std::uint8_t>(emcy.data(), n));
+  const auto r = h.run(h.client.upload_value(0x1001, 0));
+  ASSERT_EQ(r.status, CoeSdoStatus::Done);
+  EXPECT_EQ(r.value, 0x22U);
+  ASSERT_EQ(h.emcy.got.size(), 1U);
+  EXPECT_EQ(h.emcy.got[0].second.error_code, 0x8100);
+  EXPECT_EQ(h.client.counters().stale_replies, 0U);
+}
+
 TEST(EthercatCoeSdo, LostReplyIsFetchedAgainWithTheRepeatBit) {
   Harness h;
   h.server.od[{0x1018, 1}] = {0x0F, 0, 0, 0};
@@ -265,6 +341,26 @@ TEST(EthercatCoeSdo, LostReplyIsFetchedAgainWithTheRepeatBit) {
   EXPECT_EQ(h.line.slaves[0].sm1_reads, 2);
   EXPECT_EQ(h.line.slaves[0].mem[0x080E] & 0x02, 0x02);  // repeat request toggled
   EXPECT_EQ(h.line.slaves[0].mem[0x080F] & 0x02, 0x02);  // and acknowledged
+}
+
+TEST(EthercatCoeSdo, RepeatRequestInvertsTheBitTheSlaveHas) {
+  // A previous master left SM1's repeat request set (and acknowledged); the activate byte also has
+  // another bit set. The repeat must invert the slave's bit and keep the others
+  // [ETG.1000.4 Table 59: 080Eh activate bit 1 repeat, 080Fh PDI control bit 1 repeat ack].
+  Harness h;
+  h.server.od[{0x1018, 2}] = {0x34, 0x12, 0, 0};
+  FakeEsc& esc = h.line.slaves[0];
+  esc.mem[0x080E] = 0x43;  // enable | repeat | DC event 0 bus
+  esc.mem[0x080F] = 0x02;  // repeat acknowledged
+  h.drop_next_sm1_read = true;
+  const auto r = h.run(h.client.upload_value(0x1018, 2));
+  ASSERT_EQ(r.status, CoeSdoStatus::Done) << std::hex << r.abort_code;
+  EXPECT_EQ(r.value, 0x1234U);
+  EXPECT_EQ(h.client.counters().repeats, 1U);
+  EXPECT_EQ(esc.requests.size(), 1U);
+  EXPECT_EQ(esc.sm1_reads, 2);
+  EXPECT_EQ(esc.mem[0x080E], 0x41);  // repeat inverted, the rest as it was
+  EXPECT_EQ(esc.mem[0x080F], 0x00);  // acknowledged
 }
 
 TEST(EthercatCoeSdo, EmergencyInTheMailboxGoesToTheSink) {
@@ -288,6 +384,53 @@ TEST(EthercatCoeSdo, UploadLongerThanTheBufferFails) {
   const auto r = h.run(h.client.upload(0x1008, 0, small));
   EXPECT_EQ(r.status, CoeSdoStatus::Failed);
   EXPECT_EQ(r.abort_code, 0x05040005U);
+}
+
+TEST(EthercatCoeSdo, UploadShorterThanItsStatedSizeFails) {
+  Harness h;
+  h.server.od[{0x1008, 0}] = std::vector<std::uint8_t>(150, 'y');
+  h.server.stated_size = 200;  // segments end after 150 bytes
+  std::array<std::uint8_t, 256> into{};
+  const auto r = h.run(h.client.upload(0x1008, 0, into));
+  EXPECT_EQ(r.status, CoeSdoStatus::Failed);
+  EXPECT_EQ(r.abort_code, 0x06070013U);  // length of service parameter too low
+}
+
+TEST(EthercatCoeSdo, NormalUploadWithoutStatedSizeFails) {
+  Harness h;
+  h.server.od[{0x1008, 0}] = std::vector<std::uint8_t>(10, 'z');
+  h.server.size_unstated = true;
+  std::array<std::uint8_t, 64> into{};
+  const auto r = h.run(h.client.upload(0x1008, 0, into));
+  EXPECT_EQ(r.status, CoeSdoStatus::Failed);
+  EXPECT_EQ(r.abort_code, 0x05040001U);
+}
+
+TEST(EthercatCoeSdo, ResetFailsQueuedRequestsAndForgetsTheReplyCounter) {
+  Harness h;
+  h.server.od[{0x1000, 0}] = {0x92, 0x01, 0x02, 0x00};
+  const CoeSdoId first = h.client.upload_value(0x1000, 0);
+  ASSERT_EQ(h.run(first).status, CoeSdoStatus::Done);  // the slave's reply carried counter 1
+  const CoeSdoId a = h.client.upload_value(0x1000, 0);
+  const CoeSdoId b = h.client.upload_value(0x1000, 0);
+  h.cycle();
+  EXPECT_EQ(h.client.result(a).status, CoeSdoStatus::InFlight);
+  // The slave is re-initialised: its SMs are cleared and it numbers its replies from 1 again.
+  FakeEsc& esc = h.line.slaves[0];
+  esc.sm1_full = false;
+  esc.last_reply.clear();
+  h.server.outbox.clear();
+  h.server.counter = 0;
+  h.client.reset();
+  EXPECT_TRUE(h.client.idle());
+  EXPECT_EQ(h.client.result(a).status, CoeSdoStatus::Failed);
+  EXPECT_EQ(h.client.result(a).abort_code, 0x08000022U);
+  EXPECT_EQ(h.client.result(b).status, CoeSdoStatus::Failed);
+  EXPECT_EQ(h.client.result(b).abort_code, 0x08000022U);
+  EXPECT_EQ(h.client.result(first).status, CoeSdoStatus::Done);  // finished results stay
+  const auto r = h.run(h.client.upload_value(0x1000, 0));
+  ASSERT_EQ(r.status, CoeSdoStatus::Done) << std::hex << r.abort_code;  // its reply has counter 1 again
+  EXPECT_EQ(r.value, 0x00020192U);
 }
 
 TEST(EthercatCoeSdo, QueueHasAFixedSize) {

@@ -31,6 +31,7 @@ struct FakeEsc {
   std::vector<std::uint8_t> sii;      // EEPROM image
   bool sii_eight_bytes = false;       // 0502h bit 6
   int sii_busy_reads = 0;             // reads of 0502h that report busy after each command
+  int sii_nacks = 0;                  // read commands answered with the "no acknowledge" bit 13
   int busy_left = 0;
   std::map<std::uint8_t, std::uint16_t> refuse;  // requested state -> AL status code
   bool never_reach = false;           // accept requests but stay in the current state
@@ -38,6 +39,9 @@ struct FakeEsc {
   int delay_left = 0;
   std::uint8_t pending_state = 0;
   std::vector<std::uint16_t> al_control_writes;
+  // Every write: address, and its first two bytes little-endian (one byte: that byte).
+  std::vector<std::pair<std::uint16_t, std::uint16_t>> writes;
+  std::uint8_t state_when_addressed = 0;  // AL state when the station address (0010h) was written
   // Mailbox
   std::function<void(FakeEsc&, std::span<const std::uint8_t>)> on_mailbox;  // request written to SM0
   std::vector<std::vector<std::uint8_t>> requests;
@@ -101,6 +105,8 @@ struct FakeEsc {
     const SmEntry sm0 = sm(0);
     const bool in_sm0 = sm0.enabled() && ado >= sm0.physical_start && ado < sm0.physical_start + sm0.length;
     const std::uint8_t old_activate1 = mem[reg::sm_activation(1)];
+    writes.emplace_back(ado, in.size() >= 2 ? get_u16(in, 0) : (in.empty() ? std::uint16_t{0} : in[0]));
+    if (ado == reg::kStationAddress) state_when_addressed = al_state();
     std::copy(in.begin(), in.end(), mem.begin() + ado);
     if (ado <= reg::kAlControl && end > reg::kAlControl) al_control(get_u16(mem, reg::kAlControl));
     if (ado <= reg::kSiiControl && end > reg::kSiiControl) sii_command();
@@ -159,6 +165,13 @@ struct FakeEsc {
   void sii_command() {
     const std::uint16_t ctl = get_u16(mem, reg::kSiiControl);
     if ((ctl & sii_control::kCommandMask) != sii_control::kCommandRead) return;
+    if (sii_nacks > 0) {  // the EEPROM did not acknowledge: error bit 13, no data [ETG.1000.4 Table 48]
+      --sii_nacks;
+      put_u16(mem, reg::kSiiControl,
+              static_cast<std::uint16_t>((ctl & ~sii_control::kCommandMask) | sii_control::kCommandError));
+      busy_left = sii_busy_reads;
+      return;
+    }
     const std::uint32_t word = get_u32(mem, reg::kSiiAddress);
     const std::size_t n = sii_eight_bytes ? 8 : 4;
     for (std::size_t i = 0; i < n; ++i) {

@@ -4,6 +4,7 @@
 // transition timeout and lost frames.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <memory>
 #include <vector>
 
@@ -123,6 +124,84 @@ TEST(EthercatLineBoot, ThreeSlavesReachPreOp) {
   EXPECT_EQ(h.tx.counters().datagrams_lost, 0U);
 }
 
+TEST(EthercatLineBoot, ResetClearsSmsAndFmmusBeforeInitAndTakesTheEeprom) {
+  FakeLine line = line_of(1);
+  line.slaves[0].mem[0x0103] = 0x01;  // station alias enabled (DL control bit 24)
+  line.slaves[0].mem[0x0500] = 0x01;  // EEPROM offered to the PDI
+  Harness h(std::move(line), std::span<const ExpectedSlave>(kThree).first(1));
+  h.boot->start(h.now);
+  h.run();
+  ASSERT_TRUE(h.boot->ok()) << h.boot->line_text();
+  const FakeEsc& esc = h.line.slaves[0];
+  // The reset frame's broadcast writes in order [ETG.1000.4 Tables 31, 47, 56, 59; §6 DC
+  // registers; ETG.1000.6 §5.3.2], first two bytes of each (little-endian).
+  const std::vector<std::pair<std::uint16_t, std::uint16_t>> reset(esc.writes.begin(), esc.writes.begin() + 12);
+  EXPECT_EQ(reset, (std::vector<std::pair<std::uint16_t, std::uint16_t>>{
+                       {0x0600, 0x0000}, {0x0800, 0x0000}, {0x0981, 0x00}, {0x0910, 0x0000}, {0x0920, 0x0000},
+                       {0x0928, 0x0000}, {0x0930, 0x1000}, {0x0934, 0x0C00}, {0x0103, 0x00}, {0x0120, 0x0011},
+                       {0x0500, 0x02}, {0x0500, 0x00}}));
+  EXPECT_EQ(esc.mem[0x0934], 0x00);  // system time difference filter depth (SOEM: u16 0C00h)
+  EXPECT_EQ(esc.mem[0x0935], 0x0C);  // speed counter filter depth
+  EXPECT_EQ(esc.mem[0x0103], 0x00);
+  EXPECT_EQ(esc.mem[0x0500], 0x00);
+}
+
+TEST(EthercatLineBoot, ResetWaitsUntilEverySlaveIsInInit) {
+  // Slave 2 was left in SAFE-OP and takes a few status reads to get to INIT: nothing else may
+  // start before it is there.
+  FakeLine line = line_of(3);
+  put_u16(line.slaves[1].mem, reg::kAlStatus, 0x0004);
+  line.slaves[1].al_delay_reads = 5;
+  Harness h(std::move(line), kThree);
+  h.boot->start(h.now);
+  h.run();
+  ASSERT_EQ(h.boot->status(), LineStatus::Done) << h.boot->line_text();
+  EXPECT_TRUE(h.boot->ok()) << h.boot->slave(1).text.view();
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_EQ(h.line.slaves[i].al_state(), 2);
+  // The station addresses were written after every slave reported INIT.
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_EQ(h.line.slaves[i].state_when_addressed, 1) << i;
+  EXPECT_EQ(h.line.slaves[1].al_control_writes, (std::vector<std::uint16_t>{0x0011, 0x0002}));
+}
+
+TEST(EthercatLineBoot, SlaveNotInInitAfterTheResetFailsTheLine) {
+  FakeLine line = line_of(2);
+  put_u16(line.slaves[1].mem, reg::kAlStatus, 0x0002);
+  line.slaves[1].never_reach = true;
+  LineBootConfig cfg;
+  cfg.to_lower_state = 50ms;
+  Harness h(std::move(line), std::span<const ExpectedSlave>(kThree).first(2), cfg);
+  h.boot->start(h.now);
+  const auto t0 = h.now;
+  h.run();
+  EXPECT_EQ(h.boot->status(), LineStatus::Failed);
+  EXPECT_EQ(h.boot->line_text(),
+            "reset: not every slave in INIT after 50 ms (BRD 0x0130: AL status 0x0003 OR-ed over 2 of 2 slaves)");
+  EXPECT_LT(h.now - t0, 100ms);
+  EXPECT_EQ(h.line.slaves[0].station(), 0);  // no station address written
+}
+
+TEST(EthercatLineBoot, EepromNackIsClearedAndTheReadGivenAgain) {
+  FakeLine line = line_of(2);
+  line.slaves[0].sii_nacks = 2;  // two reads not acknowledged, the third is
+  line.slaves[1].sii_nacks = 1000;
+  LineBootConfig cfg;
+  Harness h(std::move(line), std::span<const ExpectedSlave>(kThree).first(2), cfg);
+  h.boot->start(h.now);
+  h.run();
+  ASSERT_EQ(h.boot->status(), LineStatus::Done) << h.boot->line_text();
+  EXPECT_EQ(h.boot->slave(0).status, SlaveStatus::Ready) << h.boot->slave(0).text.view();
+  EXPECT_EQ(h.boot->slave(0).state, AlState::PreOp);
+  // Each error cleared with a NOP (0502h = 0000h) before the read command again.
+  const auto& w = h.line.slaves[0].writes;
+  EXPECT_EQ(std::count(w.begin(), w.end(), std::pair<std::uint16_t, std::uint16_t>{0x0502, 0x0000}), 2);
+  const SlaveReport& r = h.boot->slave(1);
+  EXPECT_EQ(r.status, SlaveStatus::Failed);
+  EXPECT_EQ(r.step, BootStep::Sii);
+  EXPECT_EQ(r.text.view(),
+            "slave 2 (0x1002, ESR TrioDrive): SII read of word 0x0000 failed 4 times (control 0x2000: the EEPROM did "
+            "not acknowledge)");
+}
+
 TEST(EthercatLineBoot, RefusedSafeOpReportsTheAlStatusCodeAndAcknowledges) {
   FakeLine line = line_of(3);
   line.slaves[1].refuse[4] = 0x001D;
@@ -145,6 +224,54 @@ TEST(EthercatLineBoot, RefusedSafeOpReportsTheAlStatusCodeAndAcknowledges) {
   EXPECT_EQ(h.boot->slave(2).status, SlaveStatus::Ready);
   EXPECT_EQ(h.boot->slave(2).state, AlState::SafeOp);
   EXPECT_EQ(h.line.slaves[2].al_state(), 4);
+}
+
+TEST(EthercatLineBoot, RefusedTransitionCanBeAskedAgain) {
+  // After the refusal was acknowledged the slave can be asked again without a new start().
+  FakeLine line = line_of(3);
+  line.slaves[1].refuse[4] = 0x001D;
+  Harness h(std::move(line), kThree);
+  h.boot->start(h.now);
+  h.run();
+  ASSERT_TRUE(h.boot->ok());
+  ASSERT_TRUE(h.boot->request_state(1, AlState::SafeOp, h.now));
+  h.run();
+  ASSERT_EQ(h.boot->slave(1).status, SlaveStatus::Failed);
+  EXPECT_EQ(h.boot->slave(1).state, AlState::PreOp);
+  EXPECT_EQ(h.boot->slave(1).al_code, 0x001D);  // kept in the report
+  h.line.slaves[1].refuse.clear();              // the cause is mended
+  ASSERT_TRUE(h.boot->request_state(1, AlState::SafeOp, h.now));
+  h.run();
+  const SlaveReport& r = h.boot->slave(1);
+  EXPECT_EQ(r.status, SlaveStatus::Ready) << r.text.view();
+  EXPECT_EQ(r.state, AlState::SafeOp);
+  EXPECT_EQ(r.al_code, 0);
+  EXPECT_TRUE(r.text.empty());
+  EXPECT_EQ(h.line.slaves[1].al_state(), 4);
+}
+
+TEST(EthercatLineBoot, DownwardRequestFromAnErrorStateSucceeds) {
+  // SAFE-OP with the error indication set (e.g. after an SM watchdog, AL status code 001Bh): a
+  // request for INIT acknowledges with INIT | 10h [ETG.1000.6 §5.3.2] and reaches INIT.
+  Harness h(line_of(1), std::span<const ExpectedSlave>(kThree).first(1));
+  h.boot->start(h.now);
+  h.run();
+  ASSERT_TRUE(h.boot->ok());
+  ASSERT_TRUE(h.boot->request_state(0, AlState::SafeOp, h.now));
+  h.run();
+  ASSERT_EQ(h.boot->slave(0).state, AlState::SafeOp);
+  FakeEsc& esc = h.line.slaves[0];
+  put_u16(esc.mem, reg::kAlStatus, 0x0014);      // SAFE-OP + error
+  put_u16(esc.mem, reg::kAlStatusCode, 0x001B);  // sync manager watchdog
+  const std::size_t writes = esc.al_control_writes.size();
+  ASSERT_TRUE(h.boot->request_state(0, AlState::Init, h.now));
+  h.run();
+  const SlaveReport& r = h.boot->slave(0);
+  EXPECT_EQ(r.status, SlaveStatus::Ready) << r.text.view();
+  EXPECT_EQ(r.state, AlState::Init);
+  EXPECT_EQ(esc.mem[reg::kAlStatus], 0x01);  // INIT, error cleared
+  ASSERT_GT(esc.al_control_writes.size(), writes);
+  EXPECT_EQ(esc.al_control_writes[writes], 0x0011);  // INIT + acknowledge
 }
 
 TEST(EthercatLineBoot, IdentityMismatchIsReportedWithBothIdentities) {
@@ -220,6 +347,32 @@ TEST(EthercatLineBoot, LostFramesAreRetried) {
   ASSERT_EQ(h.boot->status(), LineStatus::Done) << h.boot->line_text();
   EXPECT_TRUE(h.boot->ok()) << h.boot->slave(0).text.view() << h.boot->slave(1).text.view();
   EXPECT_GT(h.tx.counters().frames_lost, 0U);
+}
+
+TEST(EthercatLineBoot, RestartIgnoresAnswersOfTheEarlierRun) {
+  // start() while the count of the first run is in flight; its answer (two slaves, the line has
+  // changed since) comes back after the new run queued its own count.
+  Harness h(line_of(3), kThree);
+  h.boot->start(h.now);
+  h.boot->poll(h.now, h.tx);
+  std::vector<std::vector<std::uint8_t>> old;
+  for (const auto& f : h.tx.take_frames(h.now + 10ms)) old.emplace_back(f.begin(), f.end());
+  ASSERT_EQ(old.size(), 1U);
+  h.boot->start(h.now);
+  h.boot->poll(h.now, h.tx);
+  std::vector<std::vector<std::uint8_t>> fresh;
+  for (const auto& f : h.tx.take_frames(h.now + 10ms)) fresh.emplace_back(f.begin(), f.end());
+  ASSERT_EQ(fresh.size(), 1U);
+  FakeLine two = line_of(2);
+  two.process(old[0]);
+  h.line.process(fresh[0]);
+  h.tx.on_frame(old[0]);
+  h.tx.on_frame(fresh[0]);
+  h.now += 1ms;
+  h.run();
+  ASSERT_EQ(h.boot->status(), LineStatus::Done) << h.boot->line_text();
+  EXPECT_EQ(h.boot->slave_count(), 3U);
+  EXPECT_TRUE(h.boot->ok());
 }
 
 TEST(EthercatLineBoot, EmptyLineFailsTheCount) {

@@ -103,5 +103,53 @@ TEST(EthercatSimInterop, LineBootReachesPreOpAndSdoClientTalksToTheServer) {
   EXPECT_EQ(t.io_esc->state(), AlState::PreOp);
 }
 
+TEST(EthercatSimInterop, RebootedLineAndResetClientKeepTalking) {
+  // The boot run again (every slave through INIT: the mailboxes are set up afresh), the client
+  // reset() as LineBoot users do after a re-init: requests work as before.
+  Interop t;
+  t.boot = std::make_unique<LineBoot>(kExpected, LineBootConfig{});
+  t.clients.push_back(std::make_unique<CoeSdoClient>(0x1001, SiiMailbox{0x1000, 128, 0x1080, 128}));
+  CoeSdoClient& c = *t.clients.back();
+  for (int run = 0; run < 2; ++run) {
+    t.boot->start(t.now);
+    c.reset();
+    for (int i = 0; i < 20000 && t.boot->status() == LineStatus::Running; ++i) t.cycle();
+    ASSERT_TRUE(t.boot->ok()) << run << ": " << t.boot->line_text() << t.boot->slave(0).text.view();
+    for (int k = 0; k < 3; ++k) {
+      const CoeSdoId id = c.upload_value(0x1000, 0);
+      for (int i = 0; i < 2000 && c.result(id).status < CoeSdoStatus::Done; ++i) t.cycle();
+      const CoeSdoResult r = c.take(id);
+      EXPECT_EQ(r.status, CoeSdoStatus::Done) << run << "/" << k << std::hex << " abort " << r.abort_code;
+      EXPECT_EQ(r.value, 0x00020192U);
+    }
+  }
+  EXPECT_EQ(c.counters().timeouts, 0U);
+}
+
+TEST(EthercatSimInterop, SlaveDroppedWithAnErrorIsTakenDownAndUpAgain) {
+  // A slave in PRE-OP drops to INIT on its own with the error indication set (a local error,
+  // ETG.1000.6 §5.3.2). Asking it for PRE-OP again acknowledges the error first; the same slave
+  // stuck below PRE-OP is refused, acknowledged, and can be asked again once the fault is gone.
+  Interop t;
+  t.boot = std::make_unique<LineBoot>(kExpected, LineBootConfig{});
+  t.boot->start(t.now);
+  for (int i = 0; i < 20000 && t.boot->status() == LineStatus::Running; ++i) t.cycle();
+  ASSERT_TRUE(t.boot->ok()) << t.boot->line_text();
+  const auto settle = [&] {
+    for (int i = 0; i < 2000 && t.boot->slave(0).status == SlaveStatus::Busy; ++i) t.cycle();
+  };
+  t.line.stick(0, AlState::Init, 0x0011);  // drops to INIT + error, refuses PRE-OP
+  ASSERT_TRUE(t.boot->request_state(0, AlState::PreOp, t.now));
+  settle();
+  EXPECT_EQ(t.boot->slave(0).status, SlaveStatus::Failed);
+  EXPECT_EQ(t.boot->slave(0).al_code, 0x0011);
+  EXPECT_EQ(t.escs[0]->state(), AlState::Init);
+  t.line.stick(0, AlState::Op, 0);  // the fault is gone
+  ASSERT_TRUE(t.boot->request_state(0, AlState::PreOp, t.now));
+  settle();
+  EXPECT_EQ(t.boot->slave(0).status, SlaveStatus::Ready) << t.boot->slave(0).text.view();
+  EXPECT_EQ(t.escs[0]->state(), AlState::PreOp);
+}
+
 }  // namespace
 }  // namespace drivegate::ethercat::sim

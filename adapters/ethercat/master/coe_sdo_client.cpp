@@ -137,6 +137,51 @@ void CoeSdoClient::finish(Slot& s, SlotState state, std::uint32_t abort_code) no
   write_due_ = false;
 }
 
+void CoeSdoClient::reset() noexcept {
+  for (auto& s : slots_) {
+    if (s.state != SlotState::Queued && s.state != SlotState::InFlight) continue;
+    s.state = SlotState::Failed;
+    s.result.status = CoeSdoStatus::Failed;
+    s.result.abort_code = cia402::sdo_abort_code::kDeviceState;
+    ++counters_.failed;
+  }
+  active_ = nullptr;
+  phase_ = Phase::Idle;
+  expect_ = Expect::Initiate;
+  toggle_ = false;
+  waiting_ = false;  // the answer of a datagram in flight no longer matches (seq_ moves on)
+  write_due_ = false;
+  out_size_ = 0;
+  // A re-initialised slave numbers its replies afresh: forget the last one seen [ETG.1000.6 §5.6,
+  // mailbox counter]. Our own counter runs on: a new value is accepted whether or not the slave
+  // forgot the last one it saw.
+  last_reply_counter_ = 0;
+  repeat_activate_ = 0;
+  drain_due_ = false;
+  next_status_poll_ = core::TimePoint{};
+}
+
+void CoeSdoClient::on_status(const DatagramAnswer& a) noexcept {
+  // SM1 status 080Dh bit 3: mailbox full [ETG.1000.4 Table 59, SM status].
+  const bool full = a.outcome != DatagramOutcome::Lost && a.wkc == 1 && !a.data.empty() &&
+                    (a.data[0] & sm_status::kMailboxFull) != 0;
+  if (full) {
+    phase_ = Phase::DrainRead;
+    return;
+  }
+  if (a.outcome == DatagramOutcome::Lost || a.wkc != 1) {
+    // No answer: an active request asks again (its timeout bounds this); idle, give up the drain.
+    if (active_ == nullptr) {
+      drain_due_ = false;
+      phase_ = Phase::Idle;
+    }
+    return;
+  }
+  // SM1 empty: the request can go.
+  drain_due_ = false;
+  phase_ = active_ != nullptr ? Phase::Write : Phase::Idle;
+}
+
 template <class Encode>
 void CoeSdoClient::prepare(Expect expect, Encode&& encode) noexcept {
   // The whole SM0 mailbox is written (its last byte hands it to the slave): zero what follows the
@@ -192,6 +237,7 @@ void CoeSdoClient::start_next(core::TimePoint now) noexcept {
   next->result.status = CoeSdoStatus::InFlight;
   deadline_ = now + timing_.timeout;
   prepare_initiate(*next);
+  phase_ = Phase::Drain;  // empty SM1 before the request goes out
 }
 
 bool CoeSdoClient::queue(Transactions& tx, Command c, std::uint16_t ado, std::uint16_t length,
@@ -208,14 +254,22 @@ void CoeSdoClient::poll(core::TimePoint now, Transactions& tx) noexcept {
   if (active_ != nullptr && now >= deadline_) {
     ++counters_.timeouts;
     finish(*active_, SlotState::Failed, cia402::sdo_abort_code::kTimeout);
+    drain_due_ = true;  // its reply may still come: emptied before anything else is taken
   }
   if (active_ == nullptr) start_next(now);
   switch (phase_) {
     case Phase::Idle:
-      // Nothing of ours in flight: still look for emergencies now and then.
-      if (emergencies_ != nullptr && now >= next_status_poll_) {
+      // Nothing of ours in flight: still look for emergencies now and then (and empty SM1 after a
+      // timeout); what SM1 holds now is no answer to anything.
+      if ((emergencies_ != nullptr || drain_due_) && now >= next_status_poll_) {
         if (queue(tx, Command::FPRD, reg::sm_status(1), 1)) next_status_poll_ = now + timing_.poll_interval;
       }
+      return;
+    case Phase::Drain:
+      (void)queue(tx, Command::FPRD, reg::sm_status(1), 1);
+      return;
+    case Phase::DrainRead:
+      (void)queue(tx, Command::FPRD, mailbox_.tx_offset, mailbox_.tx_size);
       return;
     case Phase::Write:
       if (write_due_ && out_size_ != 0) {
@@ -234,10 +288,13 @@ void CoeSdoClient::poll(core::TimePoint now, Transactions& tx) noexcept {
     case Phase::Read:
       (void)queue(tx, Command::FPRD, mailbox_.tx_offset, mailbox_.tx_size);
       return;
+    case Phase::RepeatRead:
+      // SM1 activate (080Eh) and PDI control (080Fh) [ETG.1000.4 Table 59].
+      (void)queue(tx, Command::FPRD, reg::sm_activation(1), 2);
+      return;
     case Phase::RepeatWrite: {
-      // Toggle the repeat request in SM1's activate register [ETG.1000.4 §6 SyncManager: repeat].
-      const std::array<std::uint8_t, 1> act{
-          static_cast<std::uint8_t>(sm_activate::kEnable | (repeat_bit_ ? sm_activate::kRepeat : 0))};
+      // The activate byte as read, repeat request inverted [ETG.1000.4 §6 SyncManager: repeat].
+      const std::array<std::uint8_t, 1> act{repeat_activate_};
       (void)queue(tx, Command::FPWR, reg::sm_activation(1), 1, act);
       return;
     }
@@ -255,7 +312,14 @@ void CoeSdoClient::on_result(std::uint32_t tag, const DatagramAnswer& a) noexcep
   const bool lost = a.outcome == DatagramOutcome::Lost;
   switch (phase_) {
     case Phase::Idle:
-      if (!lost && a.wkc == 1 && !a.data.empty() && (a.data[0] & sm_status::kMailboxFull) != 0) phase_ = Phase::Read;
+    case Phase::Drain:
+      on_status(a);
+      return;
+    case Phase::DrainRead:
+      // Whatever came (or was lost with the frame), look at the status again: the slave may have
+      // put the next mailbox in.
+      phase_ = Phase::Drain;
+      if (!lost && a.wkc == 1) on_mailbox(a.data, true);
       return;
     case Phase::Write:
       if (lost || a.wkc != 1) {  // not taken (mailbox still full) or lost: write again, same counter
@@ -272,8 +336,7 @@ void CoeSdoClient::on_result(std::uint32_t tag, const DatagramAnswer& a) noexcep
     case Phase::Read:
       if (lost) {  // the slave may have freed SM1 already: ask it to repeat
         ++counters_.repeats;
-        repeat_bit_ = !repeat_bit_;
-        phase_ = Phase::RepeatWrite;
+        phase_ = Phase::RepeatRead;
         return;
       }
       if (a.wkc != 1) {  // empty after all
@@ -281,7 +344,13 @@ void CoeSdoClient::on_result(std::uint32_t tag, const DatagramAnswer& a) noexcep
         return;
       }
       phase_ = active_ != nullptr ? Phase::Wait : Phase::Idle;
-      on_mailbox(a.data);
+      on_mailbox(a.data, false);
+      return;
+    case Phase::RepeatRead:
+      if (!lost && a.wkc == 1 && a.data.size() >= 1) {
+        repeat_activate_ = static_cast<std::uint8_t>(a.data[0] ^ sm_activate::kRepeat);
+        phase_ = Phase::RepeatWrite;
+      }
       return;
     case Phase::RepeatWrite:
       if (!lost && a.wkc == 1) {
@@ -290,15 +359,30 @@ void CoeSdoClient::on_result(std::uint32_t tag, const DatagramAnswer& a) noexcep
       }
       return;
     case Phase::RepeatWait:
-      if (!lost && a.wkc == 1 && !a.data.empty() && ((a.data[0] & sm_pdi_control::kRepeatAck) != 0) == repeat_bit_) phase_ = Phase::Read;
+      if (!lost && a.wkc == 1 && !a.data.empty() &&
+          ((a.data[0] & sm_pdi_control::kRepeatAck) != 0) == ((repeat_activate_ & sm_activate::kRepeat) != 0)) {
+        phase_ = Phase::Read;
+      }
       return;
   }
 }
 
-void CoeSdoClient::on_mailbox(std::span<const std::uint8_t> mb) noexcept {
+void CoeSdoClient::on_mailbox(std::span<const std::uint8_t> mb, bool stale) noexcept {
   const MailboxView m = decode_mailbox(mb);
   if (m.error != MailboxError::None) {
     ++counters_.malformed;
+    return;
+  }
+  if (stale) {
+    // Emptied before a request: an emergency is still one, anything else is dropped.
+    last_reply_counter_ = m.header.counter;
+    const EmergencyView e = decode_emergency(mb);
+    if (m.header.type == static_cast<std::uint8_t>(MailboxType::CoE) && e.error == MailboxError::None) {
+      ++counters_.emergencies;
+      if (emergencies_ != nullptr) emergencies_->on_emergency(station_, e.emergency);
+    } else {
+      ++counters_.stale_replies;
+    }
     return;
   }
   // A repeated reply (same counter as the last one taken) is a duplicate [ETG.1000.6 mailbox
@@ -390,11 +474,18 @@ void CoeSdoClient::on_sdo(Slot& s, const CoeSdo& sdo) noexcept {
       finish(s, SlotState::Done, 0);
       return;
     }
-    const std::size_t total = sdo.size;  // the size the server indicated
+    // Normal upload: the response states the complete size [ETG.1000.6 §5.6.2.4]; without it the
+    // end of the data cannot be known.
+    if (!sdo.size_indicated) {
+      finish(s, SlotState::Failed, cia402::sdo_abort_code::kUnknownCommand);
+      return;
+    }
+    const std::size_t total = sdo.size;
     if (total > s.capacity) {
       finish(s, SlotState::Failed, cia402::sdo_abort_code::kOutOfMemory);
       return;
     }
+    s.total = total;
     if (s.done >= total) {
       finish(s, SlotState::Done, 0);
     } else {
@@ -403,8 +494,14 @@ void CoeSdoClient::on_sdo(Slot& s, const CoeSdo& sdo) noexcept {
     return;
   }
   toggle_ = !toggle_;
+  if (s.done > s.total) {  // more than stated
+    finish(s, SlotState::Failed, cia402::sdo_abort_code::kTooLong);
+    return;
+  }
   if (sdo.last) {
-    finish(s, SlotState::Done, 0);
+    // The last segment must complete the stated size: fewer bytes is a truncated object.
+    finish(s, s.done == s.total ? SlotState::Done : SlotState::Failed,
+           s.done == s.total ? 0 : cia402::sdo_abort_code::kTooShort);
   } else {
     prepare_upload_segment();
   }

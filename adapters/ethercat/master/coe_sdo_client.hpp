@@ -2,23 +2,31 @@
 // CoE SDO client of one slave over its mailbox [ETG.1000.6 §5.6.2 SDO, mailbox header and counter;
 // ETG.1000.4 §6 SyncManager (1-buffer mode, SM status "mailbox full", repeat request/acknowledge)]:
 //
+//   drain:    before a request is written (and once after a timeout), FPRD 080Dh; while SM1 is
+//             "mailbox full", FPRD of SM1 and drop what it held (a late reply of an earlier request,
+//             counted in stale_replies; an emergency there still goes to the EmergencySink), so a
+//             late reply is never taken as the answer to the next request.
 //   request:  FPWR of the whole SM0 buffer (mailbox out); WKC 0 = the slave has not read the last
 //             one yet: written again at the next poll. The counter runs 1..7 per new message; a
 //             write sent again keeps its counter.
 //   reply:    FPRD 080Dh (SM1 status) at most once per poll_interval until "mailbox full" (bit 3),
 //             then FPRD of the whole SM1 buffer (mailbox in).
-//   lost reply: the slave freed SM1 when it was read, but the frame did not come back: toggle the
-//             repeat bit (080Eh bit 1, FPWR), poll until the slave's repeat acknowledge (080Fh bit 1)
-//             equals it, then read SM1 again: the slave has put the last reply back.
+//   lost reply: the slave freed SM1 when it was read, but the frame did not come back: read SM1's
+//             activate and PDI control bytes (080Eh/080Fh), write the activate byte back with the
+//             repeat request (bit 1) inverted, poll until the slave's repeat acknowledge (080Fh
+//             bit 1) equals it, then read SM1 again: the slave has put the last reply back. The bit
+//             is taken from the slave each time (another master or a restart may have left it set).
 //   transfers: expedited / normal / segmented upload and download, toggle checked; a server abort
 //             fails the request with its code (cia402::sdo_abort_text() for the words).
 //   emergencies (CoE service 1) arriving in the mailbox go to the EmergencySink, any time.
 //
 // One request in flight per slave, a FIFO of kQueueDepth. Each request has a timeout from its
 // start: then it fails with 05040000h (SDO protocol timed out); nothing is sent to the slave (its
-// late reply, if any, is read and dropped as unexpected). Uploads go into the caller's buffer (or
+// late reply, if any, is read and dropped by the drain, counted in stale_replies). Uploads go into the caller's buffer (or
 // the request's 8 inline bytes); a reply longer than the buffer fails with 05040005h (out of
-// memory). Downloads come from the caller's buffer (must stay valid until the result is taken) or
+// memory). A normal upload whose response does not state the size fails with 05040001h (ETG.1000.6
+// §5.6.2.4 makes the complete size part of it), one whose segments end before (after) the stated
+// size with 06070013h (06070012h). Downloads come from the caller's buffer (must stay valid until the result is taken) or
 // 1..4 inline bytes (download_value). Nothing allocates.
 #include <array>
 #include <cstddef>
@@ -65,6 +73,7 @@ struct CoeSdoCounters {
   std::uint64_t mailbox_writes = 0, mailbox_busy = 0;  // writes, and those the slave refused (WKC 0)
   std::uint64_t repeats = 0;                            // repeat requests after a lost reply
   std::uint64_t emergencies = 0, unexpected = 0, malformed = 0, queue_full = 0;
+  std::uint64_t stale_replies = 0;  // found in SM1 before a request (or while idle) and dropped
 };
 
 class CoeSdoClient final : public DatagramOwner {
@@ -87,6 +96,13 @@ class CoeSdoClient final : public DatagramOwner {
   [[nodiscard]] std::span<const std::uint8_t> data(CoeSdoId id) const noexcept;  // upload bytes
   CoeSdoResult take(CoeSdoId id) noexcept;  // frees a finished request
 
+  // The slave was re-initialised (LineBoot took it through INIT again, or it lost power): every
+  // queued or running request fails with 08000022h (present device state), the mailbox state is
+  // dropped (reply counter memory, repeat bit, a datagram in flight is ignored when it comes).
+  // Finished results stay until taken. Callers that re-run LineBoot (start() or a transition
+  // through INIT) call this for each of the slave's clients.
+  void reset() noexcept;
+
   void poll(core::TimePoint now, Transactions& tx) noexcept;
   void on_result(std::uint32_t tag, const DatagramAnswer& answer) noexcept override;
 
@@ -106,10 +122,11 @@ class CoeSdoClient final : public DatagramOwner {
     const std::uint8_t* from = nullptr;    // download source (caller's or inline)
     std::size_t capacity = 0;              // of into / size of from
     std::size_t done = 0;                  // bytes received / sent
+    std::size_t total = 0;                 // uploads: the size the server stated
     std::array<std::uint8_t, kInline> inline_bytes{};
     CoeSdoResult result{};
   };
-  enum class Phase : std::uint8_t { Idle, Write, Wait, Read, RepeatWrite, RepeatWait };
+  enum class Phase : std::uint8_t { Idle, Drain, DrainRead, Write, Wait, Read, RepeatRead, RepeatWrite, RepeatWait };
   enum class Expect : std::uint8_t { Initiate, Segment };
 
   CoeSdoId submit(bool upload, std::uint16_t index, std::uint8_t subindex, std::uint8_t* into,
@@ -123,7 +140,9 @@ class CoeSdoClient final : public DatagramOwner {
   void prepare_initiate(Slot& s) noexcept;
   void prepare_download_segment(Slot& s) noexcept;
   void prepare_upload_segment() noexcept;
-  void on_mailbox(std::span<const std::uint8_t> mb) noexcept;
+  // `stale`: read by the drain; only emergencies are taken from it.
+  void on_mailbox(std::span<const std::uint8_t> mb, bool stale) noexcept;
+  void on_status(const DatagramAnswer& a) noexcept;  // an SM1 status read while idle or draining
   void on_sdo(Slot& s, const CoeSdo& sdo) noexcept;
   void finish(Slot& s, SlotState state, std::uint32_t abort_code) noexcept;
   bool queue(Transactions& tx, Command c, std::uint16_t ado, std::uint16_t length,
@@ -146,7 +165,8 @@ class CoeSdoClient final : public DatagramOwner {
   bool write_due_ = false;
   std::uint8_t counter_ = 0;    // mailbox counter of the last message written
   std::uint8_t last_reply_counter_ = 0;
-  bool repeat_bit_ = false;
+  std::uint8_t repeat_activate_ = 0;  // SM1 activate byte written for the repeat request
+  bool drain_due_ = false;      // empty SM1 once while idle (after a timeout)
   core::TimePoint deadline_{};
   core::TimePoint next_status_poll_{};
   core::TimePoint now_{};

@@ -14,16 +14,19 @@ using core::put_u32;
 
 namespace {
 
-// Tag layout: bits 24-31 actor (slave position, or the line), 16-23 item of a group, 0-15 sequence
-// number (answers of an abandoned datagram are recognised and ignored).
-constexpr std::uint32_t make_tag(std::uint32_t actor, std::uint32_t item, std::uint16_t seq) noexcept {
-  return (actor << 24) | ((item & 0xFF) << 16) | seq;
+// Tag layout: bits 24-31 actor (slave position, or the line), 16-23 item of a group, 12-15 run
+// generation (start() counts it up: answers of a previous run are ignored), 0-11 sequence number
+// (answers of an abandoned datagram are recognised and ignored).
+constexpr std::uint16_t kSeqMask = 0x0FFF;
+constexpr std::uint32_t make_tag(std::uint32_t actor, std::uint32_t item, std::uint8_t run, std::uint16_t seq) noexcept {
+  return (actor << 24) | ((item & 0xFF) << 16) | (static_cast<std::uint32_t>(run & 0x0F) << 12) | (seq & kSeqMask);
 }
+constexpr std::uint16_t next_seq(std::uint16_t seq) noexcept { return static_cast<std::uint16_t>((seq + 1) & kSeqMask); }
 
 // Reset group items.
 enum ResetItem : std::uint32_t {
-  kResetAlControl, kResetFmmus, kResetSms, kResetDcActivation, kResetDcTime, kResetDcOffset, kResetDcDelay,
-  kResetDcSpeed, kResetDcFilter, kResetEeprom, kResetCount,
+  kResetFmmus, kResetSms, kResetDcActivation, kResetDcTime, kResetDcOffset, kResetDcDelay, kResetDcSpeed,
+  kResetDcFilter, kResetAlias, kResetAlControl, kResetEepromForce, kResetEepromMaster, kResetCount,
 };
 
 constexpr std::size_t kFmmuBlockBytes = 16 * reg::kFmmuSize;  // 16 FMMUs [ETG.1000.4 Table 56]
@@ -77,6 +80,7 @@ LineBoot::LineBoot(std::span<const ExpectedSlave> expected, LineBootConfig confi
 
 void LineBoot::start(core::TimePoint now) noexcept {
   now_ = now;
+  run_ = static_cast<std::uint8_t>((run_ + 1) & 0x0F);
   line_ = LinePhase::Count;
   line_text_.assign("");
   found_ = 0;
@@ -105,8 +109,8 @@ void LineBoot::set(Pending& p, Command command, std::uint32_t address, std::uint
 
 void LineBoot::send(Pending& p, std::uint32_t actor, Transactions& tx) noexcept {
   if (!p.due || p.waiting) return;
-  ++p.seq;
-  if (tx.queue(this, make_tag(actor, 0, p.seq), p.command, p.address, p.length,
+  p.seq = next_seq(p.seq);
+  if (tx.queue(this, make_tag(actor, 0, run_, p.seq), p.command, p.address, p.length,
                std::span<const std::uint8_t>(p.data.data(), p.data_size))) {
     p.due = false;
     p.waiting = true;
@@ -114,49 +118,58 @@ void LineBoot::send(Pending& p, std::uint32_t actor, Transactions& tx) noexcept 
 }
 
 void LineBoot::queue_reset(Transactions& tx) noexcept {
-  // Broadcast writes bringing every slave to a known state (the registers SOEM's and EtherCrab's
-  // start-ups reset): AL control INIT + acknowledge [ETG.1000.6 §5.3.2], FMMUs and SMs off
+  // One frame of broadcast writes bringing every slave to a known state (the registers SOEM's and
+  // EtherCrab's start-ups reset), processed by each slave in this order: FMMUs and SMs off
   // [ETG.1000.4 Tables 56, 59], DC off and its filters at their reset values [ETG.1000.4 §6 DC
-  // registers], EEPROM interface to EtherCAT (0500h = 0) [ETG.1000.4 Table 48].
-  ++group_seq_;
+  // registers], the station alias off (DL control byte 0103h bit 0 [ETG.1000.4 Table 31]), and
+  // only then AL control INIT + acknowledge [ETG.1000.6 §5.3.2], so no SM or FMMU is left active
+  // while the slave goes to INIT. Last the EEPROM interface is taken for EtherCAT: 0500h = 2 forces
+  // the PDI's access off, 0500h = 0 leaves it with EtherCAT [ETG.1000.4 §6.4.2, Table 47].
+  group_seq_ = next_seq(group_seq_);
   group_left_ = 0;
   group_lost_ = group_bad_ = false;
   const auto bwr = [&](std::uint32_t item, std::uint16_t reg, std::span<const std::uint8_t> data) {
-    if (tx.queue(this, make_tag(kLineActor, item, group_seq_), Command::BWR, physical_address(0, reg),
+    if (tx.queue(this, make_tag(kLineActor, item, run_, group_seq_), Command::BWR, physical_address(0, reg),
                  static_cast<std::uint16_t>(data.size()), data)) {
       ++group_left_;
     } else {
       group_lost_ = true;
     }
   };
-  std::array<std::uint8_t, 2> al{};
-  put_u16(al, 0, al_control(AlState::Init, true));
-  bwr(kResetAlControl, reg::kAlControl, al);
+  const auto zeros = [](std::size_t n) { return std::span<const std::uint8_t>(kZeros).first(n); };
   bwr(kResetFmmus, reg::kFmmu0, kZeros);
-  bwr(kResetSms, reg::kSm0, std::span<const std::uint8_t>(kZeros).first(kSmBlockBytes));
-  bwr(kResetDcActivation, reg::kDcActivation, std::span<const std::uint8_t>(kZeros).first(1));
-  bwr(kResetDcTime, reg::kDcSystemTime, std::span<const std::uint8_t>(kZeros).first(8));
-  bwr(kResetDcOffset, reg::kDcSystemTimeOffset, std::span<const std::uint8_t>(kZeros).first(8));
-  bwr(kResetDcDelay, reg::kDcSystemTimeDelay, std::span<const std::uint8_t>(kZeros).first(4));
+  bwr(kResetSms, reg::kSm0, zeros(kSmBlockBytes));
+  bwr(kResetDcActivation, reg::kDcActivation, zeros(1));
+  bwr(kResetDcTime, reg::kDcSystemTime, zeros(8));
+  bwr(kResetDcOffset, reg::kDcSystemTimeOffset, zeros(8));
+  bwr(kResetDcDelay, reg::kDcSystemTimeDelay, zeros(4));
   std::array<std::uint8_t, 2> speed{};
   put_u16(speed, 0, 0x1000);  // speed counter start: the ESC's reset value
   bwr(kResetDcSpeed, reg::kDcSpeedCounterStart, speed);
-  const std::array<std::uint8_t, 2> filter{0x0C, 0x0C};  // time difference / speed counter filter depth
+  // 0934h system time difference filter depth 0, 0935h speed counter filter depth 0Ch: the u16
+  // 0C00h SOEM writes at 0934h.
+  const std::array<std::uint8_t, 2> filter{0x00, 0x0C};
   bwr(kResetDcFilter, reg::kDcTimeDifferenceFilterDepth, filter);
-  bwr(kResetEeprom, reg::kSiiConfig, std::span<const std::uint8_t>(kZeros).first(1));
+  bwr(kResetAlias, static_cast<std::uint16_t>(reg::kDlControl + 3), zeros(1));
+  std::array<std::uint8_t, 2> al{};
+  put_u16(al, 0, al_control(AlState::Init, true));
+  bwr(kResetAlControl, reg::kAlControl, al);
+  const std::array<std::uint8_t, 1> force{0x02};
+  bwr(kResetEepromForce, reg::kSiiConfig, force);
+  bwr(kResetEepromMaster, reg::kSiiConfig, zeros(1));
   group_due_ = false;
   if (group_left_ == 0) line_group_done();
 }
 
 void LineBoot::queue_addresses(Transactions& tx) noexcept {
-  ++group_seq_;
+  group_seq_ = next_seq(group_seq_);
   group_left_ = 0;
   group_lost_ = group_bad_ = false;
   for (std::size_t pos = 0; pos < found_; ++pos) {
     std::array<std::uint8_t, 2> station{};
     put_u16(station, 0, static_cast<std::uint16_t>(config_.first_station + pos));
     const auto p = static_cast<std::uint16_t>(pos);
-    if (tx.queue(this, make_tag(kLineActor, static_cast<std::uint32_t>(pos), group_seq_), Command::APWR,
+    if (tx.queue(this, make_tag(kLineActor, static_cast<std::uint32_t>(pos), run_, group_seq_), Command::APWR,
                  physical_address(auto_increment_adp(p), reg::kStationAddress), 2, station)) {
       ++group_left_;
     } else {
@@ -176,6 +189,16 @@ void LineBoot::poll(core::TimePoint now, Transactions& tx) noexcept {
     case LinePhase::Reset:
       if (group_due_) queue_reset(tx);
       break;
+    case LinePhase::ResetWait:
+      if (!line_pending_.waiting && now >= reset_deadline_) {
+        fail_line("reset: not every slave in INIT after %lld ms (BRD 0x0130: AL status 0x%04X OR-ed over %u of %zu "
+                  "slaves)",
+                  static_cast<long long>(std::chrono::duration_cast<std::chrono::milliseconds>(config_.to_lower_state).count()), reset_status_, reset_wkc_,
+                  found_);
+        break;
+      }
+      send(line_pending_, kLineActor, tx);
+      break;
     case LinePhase::Address:
       if (group_due_) queue_addresses(tx);
       break;
@@ -186,10 +209,18 @@ void LineBoot::poll(core::TimePoint now, Transactions& tx) noexcept {
         if (s.report.status != SlaveStatus::Busy) continue;
         // Timeouts of the polling phases are checked when an answer comes in and here, so that a
         // slave that keeps answering "busy" cannot hold the step forever.
-        if ((s.phase == Phase::AlPoll || s.phase == Phase::SiiBusy || s.phase == Phase::SiiStatus) &&
+        if ((s.phase == Phase::AlPoll || s.phase == Phase::AlAckPoll || s.phase == Phase::SiiBusy ||
+             s.phase == Phase::SiiStatus) &&
             now >= s.deadline && !s.pending.waiting) {
-          if (s.phase != Phase::AlPoll) {
+          if (s.phase == Phase::SiiBusy || s.phase == Phase::SiiStatus) {
             fail(s, BootStep::Sii, "SII read of word 0x%04X timed out (EEPROM busy)", s.sii_word);
+          } else if (s.phase == Phase::AlAckPoll) {
+            const std::string_view why = al_status_text(s.report.al_code);
+            fail(s, BootStep::Transition,
+                 "%.*s -> %.*s: error indication not cleared by the acknowledge (AL status 0x%04X, code 0x%04X %.*s)",
+                 static_cast<int>(to_string(s.from).size()), to_string(s.from).data(),
+                 static_cast<int>(to_string(s.report.target).size()), to_string(s.report.target).data(),
+                 s.al_status_raw, s.report.al_code, static_cast<int>(why.size()), why.data());
           } else {
             const AlStatus st = decode_al_status(s.al_status_raw);
             fail(s, BootStep::Transition, "%.*s -> %.*s timed out (AL status 0x%04X %.*s)",
@@ -215,12 +246,19 @@ void LineBoot::poll(core::TimePoint now, Transactions& tx) noexcept {
 
 void LineBoot::on_result(std::uint32_t tag, const DatagramAnswer& a) noexcept {
   const std::uint32_t actor = tag >> 24;
-  const auto seq = static_cast<std::uint16_t>(tag & 0xFFFF);
+  const auto seq = static_cast<std::uint16_t>(tag & kSeqMask);
+  if (((tag >> 12) & 0x0F) != run_) return;  // queued by an earlier run (start() since)
   if (actor == kLineActor) {
     if (line_ == LinePhase::Count) {
       if (!line_pending_.waiting || seq != line_pending_.seq) return;
       line_pending_.waiting = false;
       line_answer(a);
+      return;
+    }
+    if (line_ == LinePhase::ResetWait) {
+      if (!line_pending_.waiting || seq != line_pending_.seq) return;
+      line_pending_.waiting = false;
+      reset_wait_answer(a);
       return;
     }
     if ((line_ != LinePhase::Reset && line_ != LinePhase::Address) || seq != group_seq_ || group_left_ == 0) return;
@@ -283,6 +321,19 @@ void LineBoot::line_answer(const DatagramAnswer& a) noexcept {
   group_retries_ = config_.retries;
 }
 
+void LineBoot::reset_wait_answer(const DatagramAnswer& a) noexcept {
+  line_pending_.due = true;  // unless done: read again at the next poll (the deadline bounds it)
+  if (a.outcome == DatagramOutcome::Lost || a.data.size() < 2) return;
+  reset_status_ = get_u16(a.data, 0);
+  reset_wkc_ = a.wkc;
+  // INIT is 1: any other state bit in the OR means some slave is elsewhere [ETG.1000.6 §5.3.2].
+  if (a.wkc == found_ && (reset_status_ & 0x0F) == static_cast<std::uint16_t>(AlState::Init)) {
+    line_pending_.due = false;
+    line_ = LinePhase::Address;
+    group_due_ = true;
+  }
+}
+
 void LineBoot::line_group_done() noexcept {
   const BootStep step = line_ == LinePhase::Reset ? BootStep::Reset : BootStep::Address;
   if (group_bad_) {
@@ -304,8 +355,12 @@ void LineBoot::line_group_done() noexcept {
   }
   group_retries_ = config_.retries;
   if (line_ == LinePhase::Reset) {
-    line_ = LinePhase::Address;
-    group_due_ = true;
+    // Wait until every slave is in INIT (BRD of AL status: the states OR-ed, WKC = slaves read).
+    line_ = LinePhase::ResetWait;
+    reset_deadline_ = now_ + config_.to_lower_state;
+    reset_status_ = 0;
+    reset_wkc_ = 0;
+    set(line_pending_, Command::BRD, physical_address(0, reg::kAlStatus), 2);
     return;
   }
   // Addresses set: every slave starts its own steps.
@@ -321,6 +376,7 @@ void LineBoot::line_group_done() noexcept {
     s.image_size = 0;
     s.sii_word = 0;
     s.sii_next_category = kSiiHeaderBytes;
+    s.sii_tries_left = config_.retries;
     s.phase = Phase::SiiStatus;
     s.deadline = now_ + config_.sii_timeout;
     slave_phase(s);
@@ -342,6 +398,12 @@ void LineBoot::slave_phase(Slave& s) noexcept {
       put_u32(cmd, 2, s.sii_word);
       set(s.pending, Command::FPWR, physical_address(station, reg::kSiiControl), 6, cmd);
       s.deadline = now_ + config_.sii_timeout;
+      break;
+    }
+    case Phase::SiiClear: {
+      // NOP command: clears the error bits [ETG.1000.4 Table 48].
+      const std::array<std::uint8_t, 2> nop{};
+      set(s.pending, Command::FPWR, physical_address(station, reg::kSiiControl), 2, nop);
       break;
     }
     case Phase::SiiData:
@@ -375,16 +437,18 @@ void LineBoot::slave_phase(Slave& s) noexcept {
       s.deadline = now_ + timeout_of(s.from, s.report.target);
       break;
     }
+    case Phase::AlCheck:
     case Phase::AlPoll:
+    case Phase::AlAckPoll:
       set(s.pending, Command::FPRD, physical_address(station, reg::kAlStatus), 2);
       break;
     case Phase::AlCode:
       set(s.pending, Command::FPRD, physical_address(station, reg::kAlStatusCode), 2);
       break;
     case Phase::AlAck: {
-      // Acknowledge the error, staying in the state the slave is in [ETG.1000.6 §5.3.2].
+      // Acknowledge the error [ETG.1000.6 §5.3.2, AL control bit 4].
       std::array<std::uint8_t, 2> ctl{};
-      put_u16(ctl, 0, al_control(decode_al_status(s.al_status_raw).state(), true));
+      put_u16(ctl, 0, s.ack_control);
       set(s.pending, Command::FPWR, physical_address(station, reg::kAlControl), 2, ctl);
       break;
     }
@@ -395,7 +459,7 @@ void LineBoot::slave_phase(Slave& s) noexcept {
 
 BootStep LineBoot::step_of(Phase p) noexcept {
   if (p == Phase::Mailbox) return BootStep::Mailbox;
-  return p >= Phase::AlRequest ? BootStep::Transition : BootStep::Sii;
+  return p >= Phase::AlCheck ? BootStep::Transition : BootStep::Sii;
 }
 
 void LineBoot::slave_answer(Slave& s, const DatagramAnswer& a) noexcept {
@@ -415,7 +479,20 @@ void LineBoot::slave_answer(Slave& s, const DatagramAnswer& a) noexcept {
         slave_phase(s);  // poll again (the timeout is checked in poll())
         return;
       }
-      if (s.phase == Phase::SiiBusy && (ctl & (sii_control::kCommandError | sii_control::kDeviceInfoError)) != 0) {
+      constexpr std::uint16_t kNack = sii_control::kCommandError | sii_control::kWriteError;
+      if (s.phase == Phase::SiiBusy && (ctl & kNack) != 0) {
+        // The EEPROM did not acknowledge (bit 13) or a write-enable error (bit 14) [ETG.1000.4
+        // Table 48]: clear the error bits with a NOP command and give the read again, a few times.
+        if (s.sii_tries_left-- > 0) {
+          s.phase = Phase::SiiClear;
+          slave_phase(s);
+          return;
+        }
+        fail(s, BootStep::Sii, "SII read of word 0x%04X failed %d times (control 0x%04X: the EEPROM did not acknowledge)",
+             s.sii_word, config_.retries + 1, ctl);
+        return;
+      }
+      if (s.phase == Phase::SiiBusy && (ctl & sii_control::kDeviceInfoError) != 0) {
         fail(s, BootStep::Sii, "SII read of word 0x%04X failed (control 0x%04X)", s.sii_word, ctl);
         return;
       }
@@ -427,12 +504,39 @@ void LineBoot::slave_answer(Slave& s, const DatagramAnswer& a) noexcept {
       s.phase = Phase::SiiBusy;
       slave_phase(s);
       return;
+    case Phase::SiiClear:
+      s.phase = Phase::SiiCommand;
+      slave_phase(s);
+      return;
     case Phase::SiiData:
       sii_chunk(s, a.data);
       return;
     case Phase::Mailbox:
       begin_transition(s, AlState::PreOp);
       return;
+    case Phase::AlCheck: {
+      // Where the slave is before anything is requested: an error indication left from before
+      // (e.g. SAFE-OP + error after a watchdog) is acknowledged first, else the request would be
+      // ignored and the old error taken for a refusal [ETG.1000.6 §5.3.2].
+      if (a.data.size() < 2) return;
+      s.al_status_raw = get_u16(a.data, 0);
+      const AlStatus st = decode_al_status(s.al_status_raw);
+      s.report.state = s.from = st.state();
+      if (st.error) {
+        // Going down: acknowledge with the target itself (e.g. INIT | 10h); else stay where it is.
+        const bool down = static_cast<std::uint8_t>(s.report.target) < static_cast<std::uint8_t>(st.state());
+        acknowledge(s, down ? s.report.target : st.state(), false);
+        return;
+      }
+      if (st.state() == s.report.target) {
+        s.phase = Phase::Idle;
+        s.report.status = SlaveStatus::Ready;
+        return;
+      }
+      s.phase = Phase::AlRequest;
+      slave_phase(s);
+      return;
+    }
     case Phase::AlRequest:
       s.phase = Phase::AlPoll;
       slave_phase(s);
@@ -447,7 +551,7 @@ void LineBoot::slave_answer(Slave& s, const DatagramAnswer& a) noexcept {
         slave_phase(s);
         return;
       }
-      if (st.state() == s.report.target) {
+      if (st.state() == s.report.target) {  // the target, no error: done
         s.phase = Phase::Idle;
         s.report.status = SlaveStatus::Ready;
         return;
@@ -458,15 +562,36 @@ void LineBoot::slave_answer(Slave& s, const DatagramAnswer& a) noexcept {
     case Phase::AlCode:
       if (a.data.size() < 2) return;
       s.report.al_code = get_u16(a.data, 0);
-      s.phase = Phase::AlAck;
+      acknowledge(s, decode_al_status(s.al_status_raw).state(), true);
+      return;
+    case Phase::AlAck:
+      s.phase = Phase::AlAckPoll;
       slave_phase(s);
       return;
-    case Phase::AlAck: {
-      const std::string_view from = to_string(s.from);
-      const std::string_view to = to_string(s.report.target);
-      const std::string_view why = al_status_text(s.report.al_code);
-      fail(s, BootStep::Transition, "%.*s -> %.*s refused: 0x%04X %.*s", static_cast<int>(from.size()), from.data(),
-           static_cast<int>(to.size()), to.data(), s.report.al_code, static_cast<int>(why.size()), why.data());
+    case Phase::AlAckPoll: {
+      if (a.data.size() < 2) return;
+      s.al_status_raw = get_u16(a.data, 0);
+      const AlStatus st = decode_al_status(s.al_status_raw);
+      s.report.state = st.state();
+      if (st.error) {
+        slave_phase(s);  // not cleared yet: poll again (timeout in poll())
+        return;
+      }
+      if (s.refused) {
+        fail_refused(s);
+        return;
+      }
+      // An earlier error acknowledged: go on with the transition.
+      if (st.state() == s.report.target) {
+        s.phase = Phase::Idle;
+        s.report.status = SlaveStatus::Ready;
+      } else if ((s.ack_control & 0x0F) == static_cast<std::uint16_t>(s.report.target)) {
+        s.phase = Phase::AlPoll;  // the acknowledge requested the target already (going down)
+        slave_phase(s);
+      } else {
+        s.phase = Phase::AlRequest;
+        slave_phase(s);
+      }
       return;
     }
     case Phase::Idle:
@@ -479,6 +604,7 @@ void LineBoot::sii_chunk(Slave& s, std::span<const std::uint8_t> data) noexcept 
   std::copy_n(data.begin(), n, s.image.begin() + static_cast<std::ptrdiff_t>(s.image_size));
   s.image_size += n;
   s.sii_word += static_cast<std::uint32_t>(data.size() / 2);
+  s.sii_tries_left = config_.retries;
   const std::span<const std::uint8_t> image(s.image.data(), s.image_size);
   if (s.image_size >= kSiiHeaderBytes && sii_end_seen(image, s.sii_next_category)) {
     parse_sii(image, s.info);
@@ -543,12 +669,33 @@ void LineBoot::begin_transition(Slave& s, AlState target) noexcept {
   s.report.text.assign("");
   s.from = s.report.state;
   s.report.target = target;
-  s.phase = Phase::AlRequest;
+  s.refused = false;
+  s.deadline = now_ + timeout_of(s.from, target);
+  s.phase = Phase::AlCheck;
   slave_phase(s);
 }
 
+void LineBoot::acknowledge(Slave& s, AlState state, bool refused) noexcept {
+  s.refused = refused;
+  s.ack_control = al_control(state, true);
+  s.deadline = now_ + config_.to_lower_state;  // the error bit must clear within this
+  s.phase = Phase::AlAck;
+  slave_phase(s);
+}
+
+void LineBoot::fail_refused(Slave& s) noexcept {
+  const std::string_view from = to_string(s.from);
+  const std::string_view to = to_string(s.report.target);
+  const std::string_view why = al_status_text(s.report.al_code);
+  fail(s, BootStep::Transition, "%.*s -> %.*s refused: 0x%04X %.*s", static_cast<int>(from.size()), from.data(),
+       static_cast<int>(to.size()), to.data(), s.report.al_code, static_cast<int>(why.size()), why.data());
+}
+
 bool LineBoot::request_state(std::size_t position, AlState target, core::TimePoint now) noexcept {
-  if (position >= found_ || slaves_[position].report.status != SlaveStatus::Ready) return false;
+  if (position >= found_) return false;
+  const SlaveReport& r = slaves_[position].report;
+  const bool again = r.status == SlaveStatus::Failed && r.step == BootStep::Transition;  // refused or timed out
+  if (r.status != SlaveStatus::Ready && !again) return false;
   now_ = now;
   begin_transition(slaves_[position], target);
   if (line_ == LinePhase::Done) line_ = LinePhase::Slaves;

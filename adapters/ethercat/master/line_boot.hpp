@@ -4,25 +4,37 @@
 // ETG.1000.6 §5.3 ESM, §5.4 SII):
 //
 //   1. count:    BRD 0000h; the working counter is the number of slaves [ETG.1000.4 §5.4 BRD].
-//   2. reset:    one frame of broadcast writes: AL control = INIT with error acknowledge, FMMUs and
-//                SyncManagers cleared, DC activation off, DC system time / offset / delay cleared,
-//                DC speed counter start 1000h and filter depths 0Ch, EEPROM access to EtherCAT.
+//   2. reset:    one frame of broadcast writes, in this order: FMMUs and SyncManagers cleared, DC
+//                activation off, DC system time / offset / delay cleared, DC speed counter start
+//                1000h and filter depths (0934h = 0, 0935h = 0Ch), station alias off (0103h = 0),
+//                then AL control = INIT with error acknowledge, then the EEPROM to EtherCAT (0500h =
+//                2, then 0). Then BRD 0130h until every slave reports INIT (to_lower_state; a slave
+//                not in INIT by then fails the line step).
 //   3. address:  APWR 0010h = first_station + position (0x1001, 0x1002, ...).
 //   4. per slave, all slaves in parallel, one datagram in flight each:
 //      SII:      through the EEPROM interface [ETG.1000.4 Table 48]: FPRD 0502h (busy? 4 or 8 byte
 //                reads?), FPWR 0502h = read command + word address, FPRD 0502h until not busy,
 //                FPRD 0508h (4 or 8 bytes), until the category list ends (FFFFh) [ETG.1000.6 §5.4];
-//                then parse_sii().
+//                then parse_sii(). An error bit after a command (13: no acknowledge, 14: write
+//                enable) is cleared with a NOP (0502h = 0) and the read given again, `retries`
+//                times, then the slave fails at the SII step.
 //      identity: vendor, product, revision against the expected slave at that position (revision
 //                0 = any). A difference fails the slave and names both identities; a slave beyond
 //                the configured ones is reported and left in INIT.
 //      mailbox:  SM0/SM1 from the SII standard mailbox (FPWR 0800h, 16 bytes) when it has one.
-//      PRE-OP:   AL control = 2, then AL status read until the state is reached, the error bit is
-//                set (then 0134h is read for the AL status code and the error acknowledged), or the
-//                transition's timeout passes [ETG.1000.6 §5.3.2].
+//      PRE-OP:   a transition [ETG.1000.6 §5.3.2]: AL status read first; when its error bit is set
+//                the error is acknowledged before anything else (AL control = current state | 10h,
+//                or target | 10h when the target is lower, e.g. SAFE-OP + error -> INIT) and the
+//                status polled until the bit clears. Then AL control = target, and AL status read
+//                until the state is the target with no error (done), the error bit is set (refused:
+//                0134h is read for the AL status code, the error acknowledged with current state |
+//                10h and the status polled until the bit clears), or the transition's timeout passes.
 //
 // request_state() runs a later transition (SAFE-OP, OP, back down) on a slave the same way; part 2
-// (PDO mapping, process data) calls it once the SMs/FMMUs are set.
+// (PDO mapping, process data) calls it once the SMs/FMMUs are set. A slave whose transition failed
+// (refused or timed out: status Failed at BootStep::Transition, the code and text kept in its
+// report) can be asked again with request_state(): the error was acknowledged, so no new start()
+// is needed.
 //
 // Each failing slave stops at its step with one sentence, e.g.
 //   "slave 2 (0x1002, ESR TrioDrive): PRE-OP -> SAFE-OP refused: 0x001D invalid output configuration"
@@ -102,7 +114,8 @@ class LineBoot final : public DatagramOwner {
   // name views must outlive the boot).
   LineBoot(std::span<const ExpectedSlave> expected, LineBootConfig config) noexcept;
 
-  // (Re)starts the boot from the count.
+  // (Re)starts the boot from the count. Answers to datagrams of an earlier run still in flight
+  // are ignored.
   void start(core::TimePoint now) noexcept;
   // Queues the datagrams that are due and runs timeouts.
   void poll(core::TimePoint now, Transactions& tx) noexcept;
@@ -121,7 +134,9 @@ class LineBoot final : public DatagramOwner {
   [[nodiscard]] const SlaveReport& slave(std::size_t position) const noexcept { return slaves_[position].report; }
   [[nodiscard]] const SiiInfo& sii(std::size_t position) const noexcept { return slaves_[position].info; }
 
-  // Starts a transition of a Ready slave (SAFE-OP, OP, or down). False when the slave is not Ready.
+  // Starts a transition of a Ready slave (SAFE-OP, OP, or down), or of a slave whose last
+  // transition failed (Failed at BootStep::Transition). False otherwise (busy, or stopped at an
+  // earlier step).
   bool request_state(std::size_t position, AlState target, core::TimePoint now) noexcept;
 
  private:
@@ -137,9 +152,9 @@ class LineBoot final : public DatagramOwner {
     std::array<std::uint8_t, 16> data{};
     std::size_t data_size = 0;
   };
-  enum class LinePhase : std::uint8_t { Idle, Count, Reset, Address, Slaves, Done, Failed };
+  enum class LinePhase : std::uint8_t { Idle, Count, Reset, ResetWait, Address, Slaves, Done, Failed };
   enum class Phase : std::uint8_t {
-    Idle, SiiStatus, SiiCommand, SiiBusy, SiiData, Mailbox, AlRequest, AlPoll, AlCode, AlAck,
+    Idle, SiiStatus, SiiCommand, SiiBusy, SiiClear, SiiData, Mailbox, AlCheck, AlRequest, AlPoll, AlCode, AlAck, AlAckPoll,
   };
   struct Slave {
     SlaveReport report{};
@@ -148,8 +163,11 @@ class LineBoot final : public DatagramOwner {
     core::TimePoint deadline{};
     AlState from = AlState::Init;
     std::uint16_t al_status_raw = 0;
+    std::uint16_t ack_control = 0;  // AL control written by AlAck
+    bool refused = false;           // AlAck acknowledges a refusal (else an error found before the request)
     bool eight_byte_reads = false;
     std::uint32_t sii_word = 0;  // next word address to read
+    int sii_tries_left = 0;      // reads of this word given again after an EEPROM error
     std::size_t sii_next_category = 0;  // image offset of the next SII category header to walk
     std::size_t image_size = 0;
     std::array<std::uint8_t, kMaxSiiBytes> image{};
@@ -162,6 +180,7 @@ class LineBoot final : public DatagramOwner {
   void send(Pending& p, std::uint32_t actor, Transactions& tx) noexcept;
   void line_answer(const DatagramAnswer& a) noexcept;
   void line_group_done() noexcept;
+  void reset_wait_answer(const DatagramAnswer& a) noexcept;
   void queue_reset(Transactions& tx) noexcept;
   void queue_addresses(Transactions& tx) noexcept;
   void slave_answer(Slave& s, const DatagramAnswer& a) noexcept;
@@ -171,6 +190,8 @@ class LineBoot final : public DatagramOwner {
   void sii_chunk(Slave& s, std::span<const std::uint8_t> data) noexcept;
   void identify(Slave& s) noexcept;
   void begin_transition(Slave& s, AlState target) noexcept;
+  void acknowledge(Slave& s, AlState state, bool refused) noexcept;  // AlAck with state | 10h
+  void fail_refused(Slave& s) noexcept;
   void fail(Slave& s, BootStep step, const char* fmt, ...) noexcept __attribute__((format(printf, 4, 5)));
   void fail_line(const char* fmt, ...) noexcept __attribute__((format(printf, 2, 3)));
   [[nodiscard]] std::string_view name_of(const Slave& s) const noexcept;
@@ -187,7 +208,11 @@ class LineBoot final : public DatagramOwner {
   int group_retries_ = 0;
   bool group_due_ = false;
   std::uint16_t group_seq_ = 0;
+  std::uint8_t run_ = 0;  // run generation (0..15), counted up by start(), part of every tag
   std::size_t found_ = 0;
+  core::TimePoint reset_deadline_{};  // every slave in INIT by then
+  std::uint16_t reset_status_ = 0;    // last BRD 0130h: AL status OR-ed over the slaves
+  std::uint16_t reset_wkc_ = 0;
   core::TimePoint now_{};
   core::FixedString<240> line_text_{};
   std::array<Slave, kMaxSlaves> slaves_{};
