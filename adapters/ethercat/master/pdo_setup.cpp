@@ -60,17 +60,17 @@ const char* PdoSetup::area_name(Area a) noexcept {
 }
 
 void PdoSetup::add_op(Area area, std::uint16_t index, std::uint8_t subindex, std::uint32_t value, std::uint8_t size,
-                      std::uint8_t entry_sm) noexcept {
+                      std::uint8_t entry_sm, std::uint32_t final_value) noexcept {
   if (op_count_ >= ops_.size()) return;  // start() checked the capacities
-  ops_[op_count_++] = Op{area, index, subindex, size, value, entry_sm, is_ignored(index, subindex)};
+  ops_[op_count_++] = Op{area, index, subindex, size, value, entry_sm, is_ignored(index, subindex), final_value};
 }
 
 bool PdoSetup::add_direction(std::uint16_t assign_index, std::span<const PdoConfig> pdos, std::uint8_t sm) noexcept {
   // Count 0, the mapping objects, the assignment entries, the count [digest §7.2/§7.4, TV-6].
-  add_op(Area::Assignment, assign_index, 0, 0, 1);
+  add_op(Area::Assignment, assign_index, 0, 0, 1, 0, static_cast<std::uint32_t>(pdos.size()));
   for (const PdoConfig& p : pdos) {
     if (p.entries.size() > 254) return false;  // sub-index 0 is UNSIGNED8, 255 reserved
-    add_op(Area::Mapping, p.index, 0, 0, 1);
+    add_op(Area::Mapping, p.index, 0, 0, 1, 0, static_cast<std::uint32_t>(p.entries.size()));
     for (std::size_t i = 0; i < p.entries.size(); ++i) {
       add_op(Area::Mapping, p.index, static_cast<std::uint8_t>(i + 1), p.entries[i].value(), 4, sm);
     }
@@ -281,7 +281,8 @@ void PdoSetup::finish_op(bool download_ok, std::uint32_t download_abort, const C
   const int w = digits(op.size);
   const char* area = area_name(op.area);
   const bool read_ok = read.status == CoeSdoStatus::Done;
-  const bool same = read_ok && read.value == op.value;
+  const bool same = read_ok && (read.value == op.value || (!download_ok && op.subindex == 0 && op.value == 0 &&
+                                                           op.area != Area::Startup && read.value == op.final_value));
   if (same) {
     if (!download_ok) ++counters_.refused_but_set;  // a fixed mapping: refused, but already so
     if (op.entry_sm == 2 || op.entry_sm == 3) bits_[op.entry_sm - 2U] += read.value & 0xFF;

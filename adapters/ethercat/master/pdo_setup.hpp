@@ -10,7 +10,8 @@
 //      digest gives (§7.2, §7.4, TV-6): 1C1xh:00 := 0; per PDO 16xxh:00 := 0, its entries :01..n
 //      (index << 16 | subindex << 8 | bits, TV-1), :00 := n; then 1C1xh:01..m, 1C1xh:00 := m. Every
 //      write is read back. A write the slave refuses (SDO abort) whose read-back already holds the
-//      wanted value is accepted: a device with a fixed mapping refuses writes it does not need.
+//      wanted value is accepted: a device with a fixed mapping refuses writes it does not need (for
+//      the count cleared first, "wanted" is the count the sequence ends with).
 //      A 1-byte sub-index 0 write aborted with a length/type abort is tried again with 2 bytes
 //      (digest TV-6 note).
 //   3. verify: the entry bits read back per SM, rounded up to bytes, equal the process image's
@@ -134,6 +135,9 @@ class PdoSetup final : public DatagramOwner {
     std::uint32_t value = 0;
     std::uint8_t entry_sm = 0;  // 2/3: a mapping entry whose bits count for that SM
     bool ignored = false;
+    // A count cleared before the entries are written (1C1xh:00 / 16xxh:00 := 0): the count the
+    // sequence ends with. A refused clear that reads this count is a fixed assignment/mapping.
+    std::uint32_t final_value = 0;
   };
   enum class SdoPhase : std::uint8_t { Download, WaitDownload, Upload, WaitUpload };
   struct RegWrite {
@@ -149,7 +153,7 @@ class PdoSetup final : public DatagramOwner {
   static constexpr std::size_t kMaxRegWrites = 6;
 
   void add_op(Area area, std::uint16_t index, std::uint8_t subindex, std::uint32_t value, std::uint8_t size,
-              std::uint8_t entry_sm = 0) noexcept;
+              std::uint8_t entry_sm = 0, std::uint32_t final_value = 0) noexcept;
   bool add_direction(std::uint16_t assign_index, std::span<const PdoConfig> pdos, std::uint8_t sm) noexcept;
   void add_reg(std::uint16_t ado, std::span<const std::uint8_t> data, const char* what) noexcept;
   void step_sdo() noexcept;

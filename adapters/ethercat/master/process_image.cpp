@@ -149,8 +149,10 @@ bool ProcessImage::place_sms(std::size_t k, const ImageSlave& in) noexcept {
                   in.input_bytes > 0 ? sm_activate::kEnable : std::uint8_t{0}, 0};
   s.fmmu_outputs_index = in.fmmu_outputs;
   s.fmmu_inputs_index = in.fmmu_inputs;
-  s.fmmu_outputs = FmmuEntry{};
-  s.fmmu_inputs = FmmuEntry{};
+  // An unused FMMU is written all zero (FmmuEntry{} has stop bit 7): cleared, inactive.
+  constexpr FmmuEntry kCleared{0, 0, 0, 0, 0, 0, 0, false};
+  s.fmmu_outputs = kCleared;
+  s.fmmu_inputs = kCleared;
   if (in.output_bytes > 0) {
     s.fmmu_outputs = FmmuEntry{options_.logical_base + s.output_offset, in.output_bytes, 0, 7, in.sm2.start, 0,
                                fmmu_type::kWrite, true};
