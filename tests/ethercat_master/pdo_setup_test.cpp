@@ -191,6 +191,26 @@ TEST(PdoSetup, APlannedSizeThatDiffersFromTheMappingFails) {
             "slave 1 (0x1001): PDO mapping: SM2 carries 48 bits (6 bytes) after the mapping, the process image plans 4 bytes");
 }
 
+TEST(PdoSetup, ARestartFreesTheRequestItLeftRunning) {
+  PdoLine t(1, 0);
+  t.preop();
+  const ProcessImage img = image_of(t, 1, 48, 48);
+  PdoSetup setup;
+  PdoSetupConfig cfg;
+  cfg.rx_pdos = kRx;
+  cfg.tx_pdos = kTx;
+  ASSERT_TRUE(setup.start(t.clients[0].get(), cfg, img.slave(0), t.now));
+  t.cycle([&](core::TimePoint now) { setup.poll(now, t.tx); });  // a download in flight
+  ASSERT_FALSE(t.clients[0]->idle());
+  run(t, setup, 0, cfg, img.slave(0));
+  ASSERT_EQ(setup.status(), PdoSetupStatus::Done) << setup.text();
+  for (int i = 0; i < 100 && !t.clients[0]->idle(); ++i) t.cycle([&](core::TimePoint now) { setup.poll(now, t.tx); });
+  // Every request slot of the client is free again.
+  std::array<CoeSdoId, CoeSdoClient::kQueueDepth> ids{};
+  for (auto& id : ids) id = t.clients[0]->upload_value(0x6007, 0);
+  EXPECT_TRUE(std::all_of(ids.begin(), ids.end(), [](CoeSdoId id) { return id != 0; }));
+}
+
 TEST(PdoSetup, ConfigurationErrorsAreRefusedAtStart) {
   PdoSetup setup;
   const SlaveImage image{};

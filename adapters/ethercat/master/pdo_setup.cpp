@@ -101,6 +101,10 @@ bool PdoSetup::is_ignored(std::uint16_t index, std::uint8_t subindex) const noex
 
 bool PdoSetup::start(CoeSdoClient* coe, const PdoSetupConfig& config, const SlaveImage& image, core::TimePoint now) noexcept {
   now_ = now;
+  if (coe_ != nullptr && sdo_id_ != 0) {
+    abandoned_client_ = coe_;
+    abandoned_ = sdo_id_;
+  }
   coe_ = coe;
   ++generation_;
   slave_number_ = static_cast<std::uint16_t>(config.position + 1);
@@ -185,6 +189,13 @@ bool PdoSetup::start(CoeSdoClient* coe, const PdoSetupConfig& config, const Slav
 
 void PdoSetup::poll(core::TimePoint now, Transactions& tx) noexcept {
   now_ = now;
+  if (abandoned_ != 0) {
+    const CoeSdoStatus s = abandoned_client_->result(abandoned_).status;
+    if (s != CoeSdoStatus::Queued && s != CoeSdoStatus::InFlight) {
+      abandoned_client_->take(abandoned_);
+      abandoned_ = 0;
+    }
+  }
   if (status_ != PdoSetupStatus::Running) return;
   if (step_ == PdoSetupStep::StartupWrites || step_ == PdoSetupStep::Assignment) step_sdo();
   if (status_ != PdoSetupStatus::Running || step_ != PdoSetupStep::Registers) return;

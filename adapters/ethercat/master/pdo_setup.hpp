@@ -183,6 +183,9 @@ class PdoSetup final : public DatagramOwner {
   bool download_ok_ = false;
   std::uint32_t download_abort_ = 0;
   std::array<std::uint32_t, 2> bits_{};
+  // A request still running when start() was called again: taken (freed) once it ends.
+  CoeSdoClient* abandoned_client_ = nullptr;
+  CoeSdoId abandoned_ = 0;
 
   std::array<RegWrite, kMaxRegWrites> regs_{};
   std::size_t reg_count_ = 0;
