@@ -171,6 +171,14 @@ TEST(PdoLine, PerSlaveDatagramsTellWhichSlaveIsMissing) {
   if (HasFatalFailure()) return;
   b.cycles(cx, 3);
   EXPECT_TRUE(cx.last_cycle_good());
+  // Two frames dropped on the line: two lost cycles, not working counter errors; the inputs stay.
+  const CyclicCounters c0 = cx.counters();
+  b.t.line.drop_next(2);
+  b.cycles(cx, 4);
+  EXPECT_EQ(cx.counters().lost - c0.lost, 2U);
+  EXPECT_EQ(cx.counters().wkc_errors, c0.wkc_errors);
+  EXPECT_EQ(cx.counters().good - c0.good, 2U);
+  EXPECT_TRUE(cx.last_cycle_good());
   b.t.line.power_off(1);  // slave 2 and everything behind it
   b.cycles(cx, 3);
   EXPECT_EQ(cx.answered(0), SlaveAnswer::Answered);
