@@ -15,6 +15,7 @@
 #include "adapters/ethercat/wire/sii.hpp"
 #include "core/clock.hpp"
 #include "tests/ethercat_sim/drive_line.hpp"
+#include "tests/support/alloc_counter.hpp"
 
 namespace drivegate::ethercat::sim {
 namespace {
@@ -487,6 +488,36 @@ TEST(EthercatCia402Slave, GenericRequestedLeaveOfOpRunsAbortOption) {
   l.collect_emergencies();
   ASSERT_GE(l.emcys.size(), 1U);
   expect_emcy(l.emcys[0], 0x8100, 0x11);
+}
+
+TEST(EthercatCia402Slave, NoAllocationWhileFramesPass) {
+  // The cyclic path (outputs -> objects, model steps, inputs), SDO traffic, a fault with its EMCY
+  // and the ESR fine interpolator: nothing allocates once the slave is built.
+  DriveLine l("esr-triodrive");
+  l.preop();
+  ASSERT_EQ(l.download(0x1600, 0, 0, 1), 0U);
+  ASSERT_EQ(l.download(0x1600, 2, 0x60C10120, 4), 0U);
+  ASSERT_EQ(l.download(0x1600, 0, 2, 1), 0U);
+  ASSERT_EQ(l.download(0x6060, 0, 7, 2), 0U);
+  l.pd_sms(6, 2);
+  ASSERT_EQ(l.request(AlState::SafeOp), 0x0004);
+  std::vector<std::uint8_t> out(6, 0);
+  l.cycle(out, 2);
+  ASSERT_EQ(l.request(AlState::Op), 0x0008);
+  l.emcys.reserve(8);
+  const drivegate::test::AllocationScope scope;
+  for (int i = 0; i < 100; ++i) {
+    out[0] = static_cast<std::uint8_t>(i < 10 ? 0x06 : (i < 20 ? 0x07 : (i < 30 ? 0x0F : 0x1F)));
+    put_u32(out, 2, static_cast<std::uint32_t>(i * 10));
+    l.cycle(out, 2);
+  }
+  EXPECT_EQ(l.upload(0x6064, 0).abort, 0U);
+  EXPECT_EQ(l.download(0x6081, 0, 1000, 4), 0U);
+  l.app().inject_fault(0x2310);
+  for (int i = 0; i < 10; ++i) l.cycle(out, 2);
+  l.collect_emergencies();
+  EXPECT_EQ(scope.count(), 0U);
+  EXPECT_EQ(l.emcys.size(), 1U);
 }
 
 // ---- Through the master's engines -----------------------------------------------------------
