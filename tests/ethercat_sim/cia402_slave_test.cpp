@@ -480,7 +480,16 @@ TEST(EthercatCia402Slave, GenericRequestedLeaveOfOpRunsAbortOption) {
   walk(l, out, 15, 0x000F, 0x006F, 0x0027);
   l.collect_emergencies();
   l.emcys.clear();
-  // 6007h = 1 (the default): leaving OP on request faults the drive too.
+  // Disabled first (0007h), then SAFE-OP: no reaction.
+  walk(l, out, 15, 0x0007, 0x006F, 0x0023);
+  EXPECT_EQ(l.request(AlState::SafeOp), 0x0004);
+  for (int i = 0; i < 10; ++i) EXPECT_EQ(l.cycle({}, 15).u16(0) & 0x006F, 0x0023);
+  l.collect_emergencies();
+  EXPECT_TRUE(l.emcys.empty());
+  EXPECT_EQ(l.app().counters().comm_losses, 0U);
+  // Enabled, then SAFE-OP on request: 6007h = 1 (the default) faults the drive.
+  EXPECT_EQ(l.request(AlState::Op), 0x0008);
+  walk(l, out, 15, 0x000F, 0x006F, 0x0027);
   EXPECT_EQ(l.request(AlState::SafeOp), 0x0004);
   std::uint16_t sw = 0;
   for (int i = 0; i < 50 && (sw & 0x004F) != 0x0008; ++i) sw = l.cycle({}, 15).u16(0);

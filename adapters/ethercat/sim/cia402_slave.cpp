@@ -823,7 +823,10 @@ void Cia402Slave::on_state_entered(AlState from, AlState to) noexcept {
   // The ESC clears 0440h bit 0 before it leaves OP for an expired SM watchdog (esc_slave.cpp
   // watchdog_check): that tells the watchdog from a requested transition.
   const bool watchdog = esc_ != nullptr && (esc_->memory()[reg::kWatchdogStatusProcessData] & 0x01U) == 0;
-  if (watchdog || persona_.abort_on_requested_leave_op) comm_loss();
+  // A requested exit counts only while the drive runs: a master that disables the drive first
+  // (digest "What a master must do", step 13) leaves OP without a reaction.
+  const bool running = model_.state() == core::AxisState::OperationEnabled;
+  if (watchdog || (persona_.abort_on_requested_leave_op && running)) comm_loss();
 }
 
 void Cia402Slave::comm_loss() noexcept {

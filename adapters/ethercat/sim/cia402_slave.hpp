@@ -33,7 +33,7 @@
 // (outside OP they are not applied: the drive keeps its last values [dunker §5]); the model steps
 // by the elapsed time in 1 ms steps (at most 1 s per call); the drive's EMCYs go to
 // EscSlave::post_emergency; the inputs are read from the mapped objects. Leaving OP by the SM
-// watchdog (or, per persona, any way) runs the 6007h reaction: 1 = fault comm_loss_code (EMCY),
+// watchdog (or, per persona, on request while Operation enabled) runs the 6007h reaction: 1 = fault comm_loss_code (EMCY),
 // 2 = disable voltage, 3 = quick stop, 0 = nothing. Nothing on this path allocates.
 #include <array>
 #include <cstddef>

@@ -109,8 +109,8 @@ struct EthercatPersona {
   // Behaviour.
   std::int16_t abort_option_default = 0;  // 6007h at power-on
   std::int16_t abort_option_max = 3;      // 6007h values 0..max (CiA 402: 0..3; ESR: 0..1)
-  // true: every way out of OP (a requested one too) runs the 6007h reaction; false: only the SM
-  // watchdog does (ESR §8.2).
+  // true: a requested exit from OP while the drive is Operation enabled runs the 6007h reaction
+  // too; false: only the SM watchdog does (ESR §8.2).
   bool abort_on_requested_leave_op = false;
   std::uint16_t comm_loss_code = 0x8100;  // the fault 6007h = 1 raises (CiA 301 "communication")
   bool controlword_bit6_absolute = false;  // pp: bit 6 = 1 absolute (ESR quirk 14), CiA: relative
