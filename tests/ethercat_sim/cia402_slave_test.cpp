@@ -342,7 +342,7 @@ std::uint16_t walk(DriveLine& l, std::vector<std::uint8_t>& out, std::uint16_t i
   out[0] = static_cast<std::uint8_t>(cw);
   out[1] = static_cast<std::uint8_t>(cw >> 8);
   std::uint16_t sw = 0;
-  for (int i = 0; i < 50; ++i) {
+  for (int i = 0; i < 500; ++i) {
     sw = l.cycle(out, in_len).u16(0);
     if ((sw & mask) == want) return sw;
   }
@@ -413,6 +413,32 @@ TEST(EthercatCia402Slave, GenericEnablesAndFollowsCsp) {
   EXPECT_EQ(in.data[2], 8);
   EXPECT_EQ(in.u16(5), 0);
   EXPECT_LT(std::abs(static_cast<std::int32_t>(in.u32(7)) - 4000), 20);
+}
+
+// pp on the ESR: controlword bit 6 = 1 is an absolute move (quirk 14 [EXT]; CiA 402: relative).
+// Two moves to 607Ah = 5000 with bit 6 set end at 5000, not 10000.
+TEST(EthercatCia402Slave, EsrControlwordBit6MeansAbsolute) {
+  DriveLine l("esr-triodrive");
+  l.preop();
+  ASSERT_EQ(l.download(0x6060, 0, 1, 2), 0U);
+  ASSERT_EQ(l.download(0x607A, 0, 5000, 4), 0U);
+  l.pd_sms(2, 2);
+  ASSERT_EQ(l.request(AlState::SafeOp), 0x0004);
+  std::vector<std::uint8_t> out(2, 0);
+  l.cycle(out, 2);
+  ASSERT_EQ(l.request(AlState::Op), 0x0008);
+  walk(l, out, 2, 0x0006, 0x006F, 0x0021);
+  walk(l, out, 2, 0x0007, 0x006F, 0x0023);
+  walk(l, out, 2, 0x000F, 0x006F, 0x0027);
+  for (int move = 0; move < 2; ++move) {
+    walk(l, out, 2, 0x005F, 0x1000, 0x1000);  // new set-point, absolute: wait for the acknowledge
+    walk(l, out, 2, 0x004F, 0x1400, 0x0400);  // bit 4 back; wait for target reached
+  }
+  const auto pos = l.upload(0x6064, 0);
+  EXPECT_EQ(pos.abort, 0U);
+  EXPECT_LT(std::abs(static_cast<std::int32_t>(pos.value) - 5000), 20);
+  // Read back as the master wrote it, bit 6 included.
+  EXPECT_EQ(l.upload(0x6040, 0).value, 0x004FU);
 }
 
 // ---- SM watchdog and 6007h ------------------------------------------------------------------
