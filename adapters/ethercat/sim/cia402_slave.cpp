@@ -1,0 +1,965 @@
+// Cia402Slave: see cia402_slave.hpp.
+#include "adapters/ethercat/sim/cia402_slave.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+#include "adapters/ethercat/wire/al_status.hpp"
+#include "adapters/ethercat/wire/registers.hpp"
+#include "adapters/ethercat/wire/sii.hpp"
+#include "core/bytes.hpp"
+
+namespace drivegate::ethercat::sim {
+namespace {
+
+namespace abort = cia402::sdo_abort_code;
+using cia402::DataType;
+using cia402::ObjectId;
+using cia402::sim::Access;
+
+constexpr ObjectId kControlword{0x6040, 0};
+constexpr ObjectId kStatusword{0x6041, 0};
+constexpr ObjectId kIpDataRecord{0x60C1, 1};
+
+// Access bits [ETG.1000.6 §5.6.3.6]: read in every state, write in every state / in PRE-OP.
+constexpr std::uint16_t kReadAll = object_access::kReadPreOp | object_access::kReadSafeOp | object_access::kReadOp;
+constexpr std::uint16_t kWriteAll = object_access::kWritePreOp | object_access::kWriteSafeOp | object_access::kWriteOp;
+
+// "save" as 1010h:01 takes it [CiA 301 §7.5.2.13].
+constexpr std::uint32_t kSaveSignature = 0x65766173;
+
+// 1C32h/1C33h [ETG.1020 synchronisation, SM output/input parameter]: sub-index 0 = 32 (20h);
+// 04h sync modes supported: bit 0 free run, bit 1 SM synchronous, bits 2-3 = 01 DC SYNC0.
+constexpr std::uint16_t kSyncModesSupported = 0x0007;
+constexpr std::uint32_t kMinCycleNs = 125000;
+constexpr std::uint16_t kSyncFreeRun = 0;
+constexpr std::uint16_t kSyncSm = 1;
+constexpr std::uint16_t kSyncDc0 = 2;
+constexpr std::uint16_t kSyncSm2ForInputs = 0x22;  // 1C33h: inputs latched with the SM2 event
+
+std::uint16_t coe_type(DataType t) noexcept {  // CoE data type codes [ETG.1000.6 Table 64]
+  switch (t) {
+    case DataType::I8: return data_type::kInteger8;
+    case DataType::U8: return data_type::kUnsigned8;
+    case DataType::I16: return data_type::kInteger16;
+    case DataType::U16: return data_type::kUnsigned16;
+    case DataType::I32: return data_type::kInteger32;
+    case DataType::U32: return data_type::kUnsigned32;
+  }
+  return data_type::kUnsigned32;
+}
+
+std::uint16_t access_bits(Access a) noexcept {
+  switch (a) {
+    case Access::ReadOnly: return kReadAll;
+    case Access::WriteOnly: return kWriteAll;
+    case Access::ReadWrite: return kReadAll | kWriteAll;
+  }
+  return kReadAll;
+}
+
+std::uint32_t to_raw(std::int64_t value, std::uint8_t size) noexcept {
+  const auto bits = static_cast<std::uint32_t>(value);  // two's complement, as on the wire
+  return size >= 4 ? bits : bits & ((1U << (8U * size)) - 1U);
+}
+
+bool faulted(core::AxisState s) noexcept {
+  return s == core::AxisState::Fault || s == core::AxisState::FaultReactionActive;
+}
+
+bool rx_mapping_index(std::uint16_t i) noexcept { return i >= 0x1600 && i <= 0x17FF; }
+bool tx_mapping_index(std::uint16_t i) noexcept { return i >= 0x1A00 && i <= 0x1BFF; }
+
+std::string_view object_name(std::uint16_t index) noexcept {
+  if (rx_mapping_index(index)) return "Receive PDO mapping";
+  if (tx_mapping_index(index)) return "Transmit PDO mapping";
+  switch (index) {
+    case 0x1000: return "Device type";
+    case 0x1001: return "Error register";
+    case 0x1008: return "Manufacturer device name";
+    case 0x1009: return "Manufacturer hardware version";
+    case 0x100A: return "Manufacturer software version";
+    case 0x1010: return "Store parameters";
+    case 0x1018: return "Identity";
+    case 0x1C00: return "Sync manager communication type";
+    case 0x1C12: return "Sync manager 2 PDO assignment";
+    case 0x1C13: return "Sync manager 3 PDO assignment";
+    case 0x1C32: return "Sync manager 2 parameter";
+    case 0x1C33: return "Sync manager 3 parameter";
+    case 0x6007: return "Abort connection option code";
+    case 0x603F: return "Error code";
+    case 0x6040: return "Controlword";
+    case 0x6041: return "Statusword";
+    case 0x6060: return "Modes of operation";
+    case 0x6061: return "Modes of operation display";
+    case 0x6062: return "Position demand value";
+    case 0x6063: return "Position actual internal value";
+    case 0x6064: return "Position actual value";
+    case 0x606C: return "Velocity actual value";
+    case 0x6071: return "Target torque";
+    case 0x6072: return "Max torque";
+    case 0x6073: return "Max current";
+    case 0x6077: return "Torque actual value";
+    case 0x6078: return "Current actual value";
+    case 0x6079: return "DC link voltage";
+    case 0x607A: return "Target position";
+    case 0x6081: return "Profile velocity";
+    case 0x6083: return "Profile acceleration";
+    case 0x6084: return "Profile deceleration";
+    case 0x6086: return "Motion profile type";
+    case 0x6098: return "Homing method";
+    case 0x60B1: return "Velocity offset";
+    case 0x60B2: return "Torque offset";
+    case 0x60C0: return "Interpolation sub mode select";
+    case 0x60C1: return "Interpolation data record";
+    case 0x60C2: return "Interpolation time period";
+    case 0x60C3: return "Interpolation sync definition";
+    case 0x60C4: return "Interpolation data configuration";
+    case 0x60FD: return "Digital inputs";
+    case 0x60FF: return "Target velocity";
+    case 0x6502: return "Supported drive modes";
+    default: return index < 0x6000 ? "Manufacturer object" : "Device profile object";
+  }
+}
+
+cia402::sim::DriveModelConfig model_config(const EthercatPersona& p, const Cia402SlaveOptions& o) {
+  cia402::sim::DriveModelConfig c = o.drive;
+  c.supported_modes.assign(p.modes.begin(), p.modes.end());
+  c.identity = cia402::sim::DriveIdentity{p.vendor_id, p.product_code, p.revision, o.serial};
+  c.device_type = p.device_type;
+  c.initial_mode = p.initial_mode;
+  return c;
+}
+
+[[noreturn]] void refuse(const EthercatPersona& p, const char* what) {
+  throw std::invalid_argument("EtherCAT persona \"" + std::string(p.name) + "\": " + what);
+}
+
+}  // namespace
+
+Cia402Slave::Cia402Slave(const EthercatPersona& persona, Cia402SlaveOptions options)
+    : persona_(persona), model_(model_config(persona, options)), vendor_(persona.vendor_objects.size()) {
+  const auto& p = persona_;
+  for (const auto& v : p.vendor_objects) {
+    if (!vendor_.add(v.def, v.access, v.value)) refuse(p, "manufacturer object table is inconsistent");
+  }
+  if (p.rx_pdos.size() > kMaxPdos || p.tx_pdos.size() > kMaxPdos || p.max_entries > kMaxEntries ||
+      p.assign_slots > kMaxAssign || p.rx_assign.size() > p.assign_slots || p.tx_assign.size() > p.assign_slots ||
+      p.rx_assign_count > p.rx_assign.size() || p.tx_assign_count > p.tx_assign.size()) {
+    refuse(p, "more PDOs, entries or assignment slots than the simulator holds");
+  }
+  for (const auto* list : {&p.rx_pdos, &p.tx_pdos}) {
+    for (const auto& d : *list) {
+      if (d.entries.size() > p.max_entries) refuse(p, "a default mapping longer than the entry limit");
+    }
+  }
+  rx_.resize(p.rx_pdos.size());
+  tx_.resize(p.tx_pdos.size());
+  for (const auto& d : p.application_defaults) {
+    if (put_app(d.id, d.value) != 0) refuse(p, "a power-on value the drive refuses");
+  }
+  restore_defaults();
+  for (const auto* list : {&rx_, &tx_}) {
+    const bool receive = list == &rx_;
+    for (const Pdo& d : *list) {
+      for (std::size_t k = 0; k < d.count; ++k) {
+        if (check_entry(d.entries[k], receive) != 0) refuse(p, "a default mapping entry the drive cannot map");
+      }
+    }
+  }
+  if (assigned_bytes(true) > p.process_data_capacity || assigned_bytes(false) > p.process_data_capacity) {
+    refuse(p, "default process data larger than its capacity");
+  }
+  build_entries();
+  build_sii(options.serial, options.station_alias);
+}
+
+Cia402Slave::~Cia402Slave() = default;
+
+EscConfig Cia402Slave::esc_config() const noexcept {
+  EscConfig c;
+  c.dc_supported = persona_.dc_supported;  // ESR: no DC (quirk 9)
+  return c;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Power-on values
+
+void Cia402Slave::restore_defaults() noexcept {
+  const auto& p = persona_;
+  for (std::size_t i = 0; i < rx_.size(); ++i) {
+    rx_[i] = Pdo{};
+    rx_[i].index = p.rx_pdos[i].index;
+    rx_[i].count = static_cast<std::uint8_t>(p.rx_pdos[i].entries.size());
+    std::copy(p.rx_pdos[i].entries.begin(), p.rx_pdos[i].entries.end(), rx_[i].entries.begin());
+  }
+  for (std::size_t i = 0; i < tx_.size(); ++i) {
+    tx_[i] = Pdo{};
+    tx_[i].index = p.tx_pdos[i].index;
+    tx_[i].count = static_cast<std::uint8_t>(p.tx_pdos[i].entries.size());
+    std::copy(p.tx_pdos[i].entries.begin(), p.tx_pdos[i].entries.end(), tx_[i].entries.begin());
+  }
+  rx_assign_ = Assign{};
+  rx_assign_.count = p.rx_assign_count;
+  std::copy(p.rx_assign.begin(), p.rx_assign.end(), rx_assign_.pdos.begin());
+  tx_assign_ = Assign{};
+  tx_assign_.count = p.tx_assign_count;
+  std::copy(p.tx_assign.begin(), p.tx_assign.end(), tx_assign_.pdos.begin());
+  vendor_.reset_to_defaults();
+  abort_option_ = p.abort_option_default;
+  sm_out_sync_mode_ = kSyncFreeRun;
+  sm_out_cycle_ns_ = 0;
+  sm_in_sync_mode_ = kSyncFreeRun;
+  ip_active_ = false;
+  ip_elapsed_ns_ = 0;
+  for (const auto& d : p.application_defaults) (void)put_app(d.id, d.value);
+}
+
+void Cia402Slave::power_cycle() noexcept {
+  model_.power_cycle();
+  restore_defaults();
+  started_ = false;
+  comm_fault_raised_ = false;
+  al_error_seen_ = false;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Objects
+
+bool Cia402Slave::hidden(ObjectId id) const noexcept {
+  const auto& h = persona_.hidden;
+  return std::find(h.begin(), h.end(), id) != h.end();
+}
+
+bool Cia402Slave::ignored(ObjectId id) const noexcept {
+  const auto& l = persona_.ignored_writes;
+  return std::find(l.begin(), l.end(), id) != l.end();
+}
+
+const EcatVendorObject* Cia402Slave::vendor_object(ObjectId id) const noexcept {
+  for (const auto& v : persona_.vendor_objects) {
+    if (v.def.id == id) return &v;
+  }
+  return nullptr;
+}
+
+std::string_view Cia402Slave::text_of(ObjectId id) const noexcept {
+  switch (id.index) {
+    case 0x1008: return persona_.device_name;
+    case 0x1009: return persona_.hardware_version;
+    case 0x100A: return persona_.software_version;
+    default: return {};
+  }
+}
+
+std::optional<DataType> Cia402Slave::type_of(ObjectId id) const noexcept {
+  if (hidden(id)) return std::nullopt;
+  if (const EcatVendorObject* v = vendor_object(id)) return v->def.type;
+  const auto t = model_.dictionary().type_of(id);
+  if (!t) return std::nullopt;
+  for (const auto& o : persona_.type_overrides) {
+    if (o.id == id) return o.type;
+  }
+  return t;
+}
+
+std::optional<Access> Cia402Slave::access_of(ObjectId id) const noexcept {
+  if (hidden(id)) return std::nullopt;
+  if (const EcatVendorObject* v = vendor_object(id)) return v->access;
+  return model_.dictionary().access_of(id);
+}
+
+std::optional<DataType> Cia402Slave::mappable(ObjectId id, bool receive) const noexcept {
+  const auto& list = receive ? persona_.rx_mappable : persona_.tx_mappable;
+  if (!list.empty()) {
+    if (std::find(list.begin(), list.end(), id) == list.end()) return std::nullopt;  // whitelist (ESR §7.3)
+  } else if (id.index < 0x2000) {
+    return std::nullopt;  // communication objects are not process data
+  }
+  const auto type = type_of(id);
+  const auto access = access_of(id);
+  if (!type || !access) return std::nullopt;
+  if (receive ? *access == Access::ReadOnly : *access == Access::WriteOnly) return std::nullopt;
+  return type;
+}
+
+std::uint32_t Cia402Slave::check_entry(std::uint32_t entry, bool receive) const noexcept {
+  const ObjectId id{static_cast<std::uint16_t>(entry >> 16), static_cast<std::uint8_t>(entry >> 8)};
+  const auto bits = entry & 0xFFU;
+  const auto type = mappable(id, receive);
+  // Whole objects only, with their exact length [CiA 301 §7.5.2.36; dunker §7.2].
+  if (!type || bits != 8U * cia402::size_of(*type)) return abort::kNotMappable;
+  return 0;
+}
+
+Cia402Slave::Pdo* Cia402Slave::pdo(std::uint16_t index, bool* receive) noexcept {
+  for (auto* list : {&rx_, &tx_}) {
+    for (Pdo& p : *list) {
+      if (p.index == index) {
+        if (receive != nullptr) *receive = list == &rx_;
+        return &p;
+      }
+    }
+  }
+  return nullptr;
+}
+const Cia402Slave::Pdo* Cia402Slave::pdo(std::uint16_t index, bool* receive) const noexcept {
+  return const_cast<Cia402Slave*>(this)->pdo(index, receive);
+}
+
+std::size_t Cia402Slave::pdo_bytes(const Pdo& p) const noexcept {
+  std::size_t bits = 0;
+  for (std::size_t k = 0; k < p.count; ++k) bits += p.entries[k] & 0xFFU;
+  return (bits + 7) / 8;
+}
+
+std::size_t Cia402Slave::assigned_bytes(bool receive) const noexcept {
+  const Assign& a = receive ? rx_assign_ : tx_assign_;
+  std::size_t n = 0;
+  for (std::size_t k = 0; k < a.count; ++k) {
+    bool rx = false;
+    const Pdo* p = pdo(a.pdos[k], &rx);
+    if (p != nullptr && rx == receive) n += pdo_bytes(*p);
+  }
+  return n;
+}
+
+std::optional<std::int64_t> Cia402Slave::app_value(ObjectId id) const noexcept {
+  if (const EcatVendorObject* v = vendor_object(id)) {
+    if (v->source == EcatVendorSource::TorqueActual) {
+      return std::clamp<std::int64_t>(std::llround(model_.torque()), cia402::sim::type_min(v->def.type),
+                                      cia402::sim::type_max(v->def.type));
+    }
+    return vendor_.get(id);
+  }
+  return model_.dictionary().get(id);
+}
+
+Cia402Slave::Value Cia402Slave::get(ObjectId id) const noexcept {
+  const auto type = type_of(id);
+  if (!type) {
+    if (hidden(id)) return {abort::kNoObject, 0, 0};
+    const bool vendor_index = std::any_of(persona_.vendor_objects.begin(), persona_.vendor_objects.end(),
+                                          [&](const EcatVendorObject& v) { return v.def.id.index == id.index; });
+    return {vendor_index ? abort::kNoSubIndex : model_.dictionary().missing_code(id), 0, 0};
+  }
+  if (access_of(id) == Access::WriteOnly) return {abort::kWriteOnly, 0, 0};
+  std::int64_t value = app_value(id).value_or(0);
+  if (id == kControlword) value = from_model_controlword(static_cast<std::uint16_t>(value));
+  // ESR: no "ip mode active" bit in ip (quirk 7).
+  if (id == kStatusword && !persona_.ip_status_bit12 && model_.active_mode() == cia402::op_mode::kInterpolatedPosition) {
+    value &= ~std::int64_t{0x1000};
+  }
+  const std::uint8_t size = cia402::size_of(*type);
+  return {0, to_raw(value, size), size};
+}
+
+std::uint32_t Cia402Slave::put_app(ObjectId id, std::int64_t value) noexcept {
+  for (const auto& r : persona_.ranges) {
+    if (r.id == id) {
+      if (value > r.max) return abort::kValueTooHigh;
+      if (value < r.min) return abort::kValueTooLow;
+    }
+  }
+  if (vendor_object(id) != nullptr) return vendor_.set(id, value);
+  const auto model_type = model_.dictionary().type_of(id);
+  if (!model_type || hidden(id)) return abort::kNoObject;
+  // A wider type on the wire than in the model (ESR 6060h as INTEGER16): values the model's type
+  // cannot hold are out of range.
+  if (value < cia402::sim::type_min(*model_type) || value > cia402::sim::type_max(*model_type)) {
+    return abort::kValueRange;
+  }
+  if (id == kControlword) value = to_model_controlword(static_cast<std::uint16_t>(value));
+  if (id == kIpDataRecord && persona_.fine_interpolation) {
+    // ESR fine interpolator [dunker §12]: a new set-point is reached over one 60C2h period in
+    // 1 ms steps (advance()).
+    if (!ip_active_ || value != ip_target_) {
+      ip_start_ = static_cast<std::int32_t>(model_.dictionary().get(kIpDataRecord).value_or(0));
+      ip_target_ = static_cast<std::int32_t>(value);
+      ip_elapsed_ns_ = 0;
+      ip_active_ = true;
+    }
+    return 0;
+  }
+  return model_.write_object(id, value);
+}
+
+std::uint32_t Cia402Slave::put(ObjectId id, std::uint32_t raw, std::size_t size, AlState /*state*/) noexcept {
+  // CiA 301 order of checks: the object, access, the length, then the value.
+  const auto type = type_of(id);
+  if (!type) return get(id).abort;
+  if (access_of(id) == Access::ReadOnly) return abort::kReadOnly;
+  if (size != cia402::size_of(*type)) return abort::kTypeMismatch;
+  if (ignored(id)) return 0;  // ESR quirk 8: accepted, not applied
+  return put_app(id, cia402::normalise(*type, raw));
+}
+
+std::uint16_t Cia402Slave::to_model_controlword(std::uint16_t cw) const noexcept {
+  // ESR: bit 6 = 1 is an absolute move in pp (quirk 14 [EXT]); the model follows CiA 402 (1 = relative).
+  if (persona_.controlword_bit6_absolute && model_.active_mode() == cia402::op_mode::kProfilePosition) {
+    return static_cast<std::uint16_t>(cw ^ 0x0040U);
+  }
+  return cw;
+}
+std::uint16_t Cia402Slave::from_model_controlword(std::uint16_t cw) const noexcept { return to_model_controlword(cw); }
+
+// ---------------------------------------------------------------------------------------------
+// Communication objects
+
+std::optional<Cia402Slave::Value> Cia402Slave::get_comm(ObjectId id) const noexcept {
+  const auto& p = persona_;
+  const auto sub = id.sub;
+  const Value no_sub{abort::kNoSubIndex, 0, 0};
+  if (rx_mapping_index(id.index) || tx_mapping_index(id.index)) {
+    const Pdo* d = pdo(id.index, nullptr);
+    if (d == nullptr) return Value{abort::kNoObject, 0, 0};
+    if (sub == 0) return Value{0, d->count, 1};
+    if (sub > p.max_entries) return no_sub;
+    return Value{0, d->entries[sub - 1U], 4};
+  }
+  switch (id.index) {
+    case 0x1010:
+      if (!p.store_parameters) return std::nullopt;
+      if (sub == 0) return Value{0, 1, 1};
+      if (sub == 1) return Value{0, 1, 4};  // bit 0: saves on command
+      return no_sub;
+    case 0x1C00:  // SM0 mailbox out 1, SM1 mailbox in 2, SM2 outputs 3, SM3 inputs 4 [dunker §11.2]
+      if (sub <= 4) return Value{0, sub == 0 ? 4U : sub, 1};
+      return no_sub;
+    case 0x1C12:
+    case 0x1C13: {
+      const Assign& a = id.index == 0x1C12 ? rx_assign_ : tx_assign_;
+      if (sub == 0) return Value{0, a.count, 1};
+      if (sub > p.assign_slots) return no_sub;
+      return Value{0, a.pdos[sub - 1U], 2};
+    }
+    case 0x1C32:
+    case 0x1C33: {
+      if (!p.sync_manager_parameters) return std::nullopt;
+      const bool out = id.index == 0x1C32;
+      switch (sub) {
+        case 0x00: return Value{0, 0x20, 1};
+        case 0x01: return Value{0, out ? sm_out_sync_mode_ : sm_in_sync_mode_, 2};
+        case 0x02: return Value{0, sm_out_cycle_ns_, 4};
+        case 0x03: return Value{0, 0, 4};  // shift time
+        case 0x04: return Value{0, kSyncModesSupported, 2};
+        case 0x05: return Value{0, kMinCycleNs, 4};
+        case 0x06: return Value{0, 0, 4};  // calc and copy time
+        case 0x09: return Value{0, 0, 4};  // delay time
+        case 0x0B: return Value{0, 0, 2};  // SM event missed counter
+        case 0x0C: return Value{0, 0, 2};  // cycle time too small counter
+        case 0x20: return Value{0, 0, 1};  // sync error
+        default: return no_sub;
+      }
+    }
+    case 0x6007:
+      if (sub == 0) return Value{0, to_raw(abort_option_, 2), 2};
+      return no_sub;
+    default:
+      return std::nullopt;
+  }
+}
+
+std::optional<std::uint32_t> Cia402Slave::put_comm(ObjectId id, std::uint32_t raw, std::size_t size,
+                                                   AlState state) noexcept {
+  const auto& p = persona_;
+  const auto sub = id.sub;
+  if (rx_mapping_index(id.index) || tx_mapping_index(id.index)) {
+    bool receive = false;
+    Pdo* d = pdo(id.index, &receive);
+    if (d == nullptr) return abort::kNoObject;
+    return put_pdo(*d, receive, sub, raw, size, state);
+  }
+  switch (id.index) {
+    case 0x1010:
+      if (!p.store_parameters) return std::nullopt;
+      if (sub == 0) return abort::kReadOnly;
+      if (sub != 1) return abort::kNoSubIndex;
+      if (size != 4) return abort::kTypeMismatch;
+      // Accepted; nothing survives a power cycle in the simulator.
+      return raw == kSaveSignature ? 0 : abort::kCannotStore;
+    case 0x1C00:
+      return sub <= 4 ? abort::kReadOnly : abort::kNoSubIndex;
+    case 0x1C12:
+      return put_assign(rx_assign_, true, sub, raw, size, state);
+    case 0x1C13:
+      return put_assign(tx_assign_, false, sub, raw, size, state);
+    case 0x1C32:
+    case 0x1C33: {
+      if (!p.sync_manager_parameters) return std::nullopt;
+      const auto v = get_comm(id);
+      if (v && v->abort != 0) return v->abort;
+      const bool out = id.index == 0x1C32;
+      if (sub != 0x01 && !(sub == 0x02 && out)) return abort::kReadOnly;
+      if (v && size != v->size) return abort::kTypeMismatch;
+      if (state != AlState::PreOp) return abort::kDeviceState;
+      if (sub == 0x02) {
+        sm_out_cycle_ns_ = raw;
+        return 0;
+      }
+      const bool ok = raw == kSyncFreeRun || raw == kSyncSm || raw == kSyncDc0 || (!out && raw == kSyncSm2ForInputs);
+      if (!ok) return abort::kValueRange;
+      (out ? sm_out_sync_mode_ : sm_in_sync_mode_) = static_cast<std::uint16_t>(raw);
+      return 0;
+    }
+    case 0x6007: {
+      if (sub != 0) return abort::kNoSubIndex;
+      if (size != 2) return abort::kTypeMismatch;
+      const auto v = cia402::normalise(DataType::I16, raw);
+      // CiA 402: 0..3 (negative values are manufacturer-specific, none here); ESR 0..1 (§11.2).
+      if (v < 0 || v > p.abort_option_max) return abort::kValueRange;
+      abort_option_ = static_cast<std::int16_t>(v);
+      return 0;
+    }
+    default:
+      return std::nullopt;
+  }
+}
+
+std::uint32_t Cia402Slave::put_pdo(Pdo& d, bool receive, std::uint8_t sub, std::uint32_t raw, std::size_t size,
+                                   AlState state) noexcept {
+  const auto& p = persona_;
+  if (sub > p.max_entries) return abort::kNoSubIndex;  // a 9th entry on ESR (§7.2)
+  if (size != (sub == 0 ? 1U : 4U)) return abort::kTypeMismatch;
+  // Mapping in PRE-OP; ESR RxPDO mapping also in SAFE-OP (quirk 4).
+  const bool writable = state == AlState::PreOp || (state == AlState::SafeOp && receive && p.rx_mapping_writable_in_safeop);
+  if (!writable) return abort::kDeviceState;
+  if (sub == 0) {
+    if (raw > p.max_entries) return abort::kValueTooHigh;
+    std::size_t bits = 0;
+    for (std::size_t k = 0; k < raw; ++k) {
+      if (d.entries[k] == 0 || check_entry(d.entries[k], receive) != 0) return abort::kNotMappable;
+      bits += d.entries[k] & 0xFFU;
+    }
+    if ((bits + 7) / 8 > p.process_data_capacity) return abort::kPdoLength;
+    d.count = static_cast<std::uint8_t>(raw);
+    return 0;
+  }
+  // Count-zero rule: entries change only while sub-index 0 is 0 [ETG.1000.6 PDO mapping].
+  if (d.count != 0) return kAbortSubindexZeroFirst;
+  if (raw != 0 && check_entry(raw, receive) != 0) return abort::kNotMappable;
+  d.entries[sub - 1U] = raw;
+  return 0;
+}
+
+std::uint32_t Cia402Slave::put_assign(Assign& a, bool receive, std::uint8_t sub, std::uint32_t raw, std::size_t size,
+                                      AlState state) noexcept {
+  const auto& p = persona_;
+  if (sub > p.assign_slots) return abort::kNoSubIndex;
+  if (size != (sub == 0 ? 1U : 2U)) return abort::kTypeMismatch;
+  if (state != AlState::PreOp) return abort::kDeviceState;  // [ETG.1000.6: assignment in PRE-OP]
+  // The mapping object of this direction, or null.
+  const auto find = [&](std::uint32_t index) -> const Pdo* {
+    bool rx = false;
+    const Pdo* d = index <= 0xFFFF ? pdo(static_cast<std::uint16_t>(index), &rx) : nullptr;
+    return (d != nullptr && rx == receive) ? d : nullptr;
+  };
+  if (sub == 0) {
+    if (raw > p.assign_slots) return abort::kValueTooHigh;
+    std::size_t bytes = 0;
+    for (std::size_t k = 0; k < raw; ++k) {
+      const Pdo* d = find(a.pdos[k]);
+      if (d == nullptr) return abort::kValueRange;
+      bytes += pdo_bytes(*d);
+    }
+    if (bytes > p.process_data_capacity) return abort::kPdoLength;
+    a.count = static_cast<std::uint8_t>(raw);
+    return 0;
+  }
+  if (a.count != 0) return kAbortSubindexZeroFirst;
+  if (raw != 0 && find(raw) == nullptr) return abort::kValueRange;  // ESR: 1602h does not exist (quirk 3)
+  a.pdos[sub - 1U] = static_cast<std::uint16_t>(raw);
+  return 0;
+}
+
+// ---------------------------------------------------------------------------------------------
+// ObjectDictionary (the CoE server's view)
+
+OdReadResult Cia402Slave::read(std::uint16_t index, std::uint8_t subindex, std::span<std::uint8_t> out,
+                               AlState /*state*/) noexcept {
+  const ObjectId id{index, subindex};
+  if (index >= 0x1008 && index <= 0x100A) {
+    const std::string_view t = text_of(id);
+    if (t.empty()) return {abort::kNoObject, 0};
+    if (subindex != 0) return {abort::kNoSubIndex, 0};
+    if (t.size() > out.size()) return {abort::kOutOfMemory, 0};
+    std::copy(t.begin(), t.end(), out.begin());
+    return {0, t.size()};
+  }
+  const Value v = get_comm(id).value_or(get(id));
+  if (v.abort != 0) return {v.abort, 0};
+  if (v.size > out.size()) return {abort::kOutOfMemory, 0};
+  for (std::size_t k = 0; k < v.size; ++k) out[k] = static_cast<std::uint8_t>(v.raw >> (8U * k));
+  return {0, v.size};
+}
+
+std::uint32_t Cia402Slave::write(std::uint16_t index, std::uint8_t subindex, std::span<const std::uint8_t> data,
+                                 AlState state) noexcept {
+  const ObjectId id{index, subindex};
+  if (index >= 0x1008 && index <= 0x100A) {
+    if (text_of(id).empty()) return abort::kNoObject;
+    return subindex == 0 ? abort::kReadOnly : abort::kNoSubIndex;
+  }
+  if (data.empty() || data.size() > 4) {
+    // Every object here is 1..4 bytes: the object's own abort first, else a length mismatch.
+    const Value v = get_comm(id).value_or(get(id));
+    return v.abort != 0 ? v.abort : abort::kTypeMismatch;
+  }
+  std::uint32_t raw = 0;
+  for (std::size_t k = 0; k < data.size(); ++k) raw |= static_cast<std::uint32_t>(data[k]) << (8U * k);
+  if (const auto c = put_comm(id, raw, data.size(), state)) return *c;
+  return put(id, raw, data.size(), state);
+}
+
+const Cia402Slave::Entry* Cia402Slave::find_entry(ObjectId id) const noexcept {
+  const auto it = std::lower_bound(entries_.begin(), entries_.end(), id.key(),
+                                   [](const Entry& e, std::uint32_t k) { return e.id.key() < k; });
+  return (it != entries_.end() && it->id == id) ? &*it : nullptr;
+}
+
+std::size_t Cia402Slave::list(OdListType type, std::span<std::uint16_t> out) const noexcept {
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < entries_.size();) {
+    const std::uint16_t index = entries_[i].id.index;
+    bool match = type == OdListType::All;
+    for (; i < entries_.size() && entries_[i].id.index == index; ++i) {
+      const auto a = entries_[i].access;
+      if ((type == OdListType::RxPdoMappable && (a & object_access::kRxPdoMappable) != 0) ||
+          (type == OdListType::TxPdoMappable && (a & object_access::kTxPdoMappable) != 0)) {
+        match = true;
+      }
+    }
+    if (!match) continue;
+    if (n < out.size()) out[n] = index;
+    ++n;
+  }
+  return n;
+}
+
+bool Cia402Slave::describe_object(std::uint16_t index, SdoInfoObjectDescription& out) const noexcept {
+  const auto first = std::lower_bound(entries_.begin(), entries_.end(), ObjectId{index, 0}.key(),
+                                      [](const Entry& e, std::uint32_t k) { return e.id.key() < k; });
+  if (first == entries_.end() || first->id.index != index) return false;
+  out = SdoInfoObjectDescription{};
+  out.index = index;
+  out.name = object_name(index);
+  for (auto it = first; it != entries_.end() && it->id.index == index; ++it) {
+    out.max_subindex = std::max(out.max_subindex, it->id.sub);
+    if (it->id.sub <= 1) out.data_type = it->data_type;  // sub-index 1's for arrays and records
+  }
+  const bool array = index == 0x1018 || index == 0x1C00 || index == 0x1C12 || index == 0x1C13 || index == 0x60C3;
+  out.object_code = out.max_subindex == 0 ? object_code::kVariable : (array ? object_code::kArray : object_code::kRecord);
+  return true;
+}
+
+bool Cia402Slave::describe_entry(std::uint16_t index, std::uint8_t subindex, SdoInfoEntryDescription& out) const noexcept {
+  const Entry* e = find_entry({index, subindex});
+  if (e == nullptr) return false;
+  const Entry* sub1 = find_entry({index, 1});
+  out = SdoInfoEntryDescription{};
+  out.index = index;
+  out.subindex = subindex;
+  out.data_type = e->data_type;
+  out.bit_length = e->bits;
+  out.object_access = e->access;
+  out.name = (subindex == 0 && sub1 != nullptr) ? std::string_view("Number of entries") : object_name(index);
+  return true;
+}
+
+void Cia402Slave::build_entries() {
+  const auto& p = persona_;
+  const std::uint16_t rw_preop = kReadAll | object_access::kWritePreOp;
+  auto add = [this](ObjectId id, std::uint16_t type, std::uint16_t access, std::uint16_t bits, Kind kind) {
+    entries_.push_back(Entry{id, type, access, bits, kind});
+  };
+  for (std::uint16_t i = 0x1008; i <= 0x100A; ++i) {
+    const auto t = text_of({i, 0});
+    if (!t.empty()) add({i, 0}, data_type::kVisibleString, kReadAll, static_cast<std::uint16_t>(8 * t.size()), Kind::Text);
+  }
+  if (p.store_parameters) {
+    add({0x1010, 0}, data_type::kUnsigned8, kReadAll, 8, Kind::Comm);
+    add({0x1010, 1}, data_type::kUnsigned32, kReadAll | kWriteAll, 32, Kind::Comm);
+  }
+  for (std::uint8_t s = 0; s <= 4; ++s) add({0x1C00, s}, data_type::kUnsigned8, kReadAll, 8, Kind::Comm);
+  for (const auto* list : {&rx_, &tx_}) {
+    const bool receive = list == &rx_;
+    const std::uint16_t a = static_cast<std::uint16_t>(
+        rw_preop | (receive && p.rx_mapping_writable_in_safeop ? object_access::kWriteSafeOp : 0));
+    for (const Pdo& d : *list) {
+      add({d.index, 0}, data_type::kUnsigned8, a, 8, Kind::Comm);
+      for (std::uint8_t s = 1; s <= p.max_entries; ++s) add({d.index, s}, data_type::kUnsigned32, a, 32, Kind::Comm);
+    }
+  }
+  for (const std::uint16_t i : {std::uint16_t{0x1C12}, std::uint16_t{0x1C13}}) {
+    add({i, 0}, data_type::kUnsigned8, rw_preop, 8, Kind::Comm);
+    for (std::uint8_t s = 1; s <= p.assign_slots; ++s) add({i, s}, data_type::kUnsigned16, rw_preop, 16, Kind::Comm);
+  }
+  if (p.sync_manager_parameters) {
+    for (const std::uint16_t i : {std::uint16_t{0x1C32}, std::uint16_t{0x1C33}}) {
+      constexpr std::array<std::uint8_t, 11> kSubs{0x00, 0x01, 0x02, 0x03, 0x04, 0x05, 0x06, 0x09, 0x0B, 0x0C, 0x20};
+      for (const std::uint8_t s : kSubs) {
+        const auto v = get_comm({i, s});
+        const bool writable = s == 0x01 || (s == 0x02 && i == 0x1C32);
+        const std::uint16_t type = v->size == 1 ? (s == 0x20 ? data_type::kBoolean : data_type::kUnsigned8)
+                                                : (v->size == 2 ? data_type::kUnsigned16 : data_type::kUnsigned32);
+        add({i, s}, type, writable ? rw_preop : kReadAll, static_cast<std::uint16_t>(s == 0x20 ? 1 : 8 * v->size), Kind::Comm);
+      }
+    }
+  }
+  add({0x6007, 0}, data_type::kInteger16, kReadAll | kWriteAll, 16, Kind::Comm);
+  auto application = [&](ObjectId id, Kind kind) {
+    const auto type = type_of(id);
+    const auto access = access_of(id);
+    if (!type || !access) return;
+    auto a = access_bits(*access);
+    if (mappable(id, true)) a = static_cast<std::uint16_t>(a | object_access::kRxPdoMappable);
+    if (mappable(id, false)) a = static_cast<std::uint16_t>(a | object_access::kTxPdoMappable);
+    add(id, coe_type(*type), a, static_cast<std::uint16_t>(8 * cia402::size_of(*type)), kind);
+  };
+  for (const auto& v : p.vendor_objects) application(v.def.id, Kind::Vendor);
+  // The model's dictionary has no iteration: probe the areas it fills (1000h..1FFFh, 6000h..6FFFh).
+  for (std::uint32_t index = 0x1000; index <= 0x6FFF; ++index) {
+    if (index == 0x2000) index = 0x6000;
+    for (std::uint8_t sub = 0; sub <= 8; ++sub) {
+      const ObjectId id{static_cast<std::uint16_t>(index), sub};
+      if (model_.dictionary().type_of(id) && vendor_object(id) == nullptr) application(id, Kind::Model);
+    }
+  }
+  std::stable_sort(entries_.begin(), entries_.end(), [](const Entry& a, const Entry& b) { return a.id.key() < b.id.key(); });
+  entries_.erase(std::unique(entries_.begin(), entries_.end(), [](const Entry& a, const Entry& b) { return a.id == b.id; }),
+                 entries_.end());
+}
+
+void Cia402Slave::build_sii(std::uint32_t serial, std::uint16_t alias) {
+  const auto& p = persona_;
+  // The power-on assigned PDOs as TXPDO/RXPDO categories [ETG.1000.6 §5.4], SM2/SM3 lengths from
+  // them. Entry data types are the CoE codes (low byte).
+  std::vector<std::vector<SiiBuildEntry>> entries;
+  std::vector<SiiBuildPdo> rx_pdos;
+  std::vector<SiiBuildPdo> tx_pdos;
+  entries.reserve(2 * kMaxAssign);
+  for (const auto* a : {&rx_assign_, &tx_assign_}) {
+    const bool receive = a == &rx_assign_;
+    for (std::size_t k = 0; k < a->count; ++k) {
+      const Pdo* d = pdo(a->pdos[k], nullptr);
+      if (d == nullptr) continue;
+      auto& list = entries.emplace_back();
+      for (std::size_t e = 0; e < d->count; ++e) {
+        const std::uint32_t m = d->entries[e];
+        const ObjectId id{static_cast<std::uint16_t>(m >> 16), static_cast<std::uint8_t>(m >> 8)};
+        const auto type = type_of(id).value_or(DataType::U32);
+        list.push_back(SiiBuildEntry{id.index, id.sub, object_name(id.index), static_cast<std::uint8_t>(coe_type(type)),
+                                     static_cast<std::uint8_t>(m & 0xFFU), 0});
+      }
+      const SiiBuildPdo pd{d->index, static_cast<std::uint8_t>(receive ? 2 : 3), 0,
+                           receive ? std::string_view("Outputs") : std::string_view("Inputs"), 0, list};
+      (receive ? rx_pdos : tx_pdos).push_back(pd);
+    }
+  }
+  const std::array<std::uint8_t, 3> fmmus{sii_fmmu_usage::kOutputs, sii_fmmu_usage::kInputs, sii_fmmu_usage::kSyncMStatus};
+  const std::array<SiiSyncManager, 4> sms{
+      SiiSyncManager{kDriveMailboxOut, kDriveMailboxSize, sm_control::kMailboxOut, 0, 1, sii_sm_type::kMailboxOut},
+      SiiSyncManager{kDriveMailboxIn, kDriveMailboxSize, sm_control::kMailboxIn, 0, 1, sii_sm_type::kMailboxIn},
+      SiiSyncManager{kDriveOutputs, static_cast<std::uint16_t>(assigned_bytes(true)), sm_control::kOutputs, 0, 1,
+                     sii_sm_type::kOutputs},
+      SiiSyncManager{kDriveInputs, static_cast<std::uint16_t>(assigned_bytes(false)), sm_control::kInputs, 0, 1,
+                     sii_sm_type::kInputs},
+  };
+  // DC category: free run and SYNC0 (assign/activate 0300h: cyclic operation + SYNC0 [ETG.2010]).
+  std::array<SiiBuildDc, 2> dcs{};
+  dcs[0].name = "FreeRun";
+  dcs[1].name = "DC SYNC0";
+  dcs[1].dc.assign_activate = 0x0300;
+  dcs[1].dc.cycle_time0 = 1000000;
+  SiiProfile profile;
+  profile.header.station_alias = alias;
+  profile.header.identity = SiiIdentity{p.vendor_id, p.product_code, p.revision, serial};
+  profile.header.standard_mailbox = SiiMailbox{kDriveMailboxOut, kDriveMailboxSize, kDriveMailboxIn, kDriveMailboxSize};
+  profile.header.mailbox_protocols = mailbox_protocol::kCoE;
+  profile.group = p.sii_group;
+  profile.image = "";
+  profile.order = p.sii_order;
+  profile.name = p.device_name;
+  profile.general.coe_details = coe_details::kSdo | coe_details::kSdoInfo | coe_details::kPdoAssign | coe_details::kPdoConfig;
+  profile.general.ds402_channels = 1;
+  profile.general.physical_ports = 0x0011;  // ports 0 and 1 MII
+  profile.fmmus = fmmus;
+  profile.sync_managers = sms;
+  profile.rx_pdos = rx_pdos;
+  profile.tx_pdos = tx_pdos;
+  if (p.dc_supported) profile.dcs = dcs;
+  for (const std::size_t bytes : {std::size_t{2048}, std::size_t{4096}}) {
+    profile.eeprom_bytes = bytes;
+    sii_.assign(bytes, 0);
+    const SiiBuildResult r = drivegate::ethercat::build_sii(profile, sii_);
+    if (r.ok()) {
+      sii_.resize(r.size);
+      return;
+    }
+    if (r.error != SiiBuildError::ContentTooLarge) break;
+  }
+  refuse(p, "its SII image cannot be built");
+}
+
+// ---------------------------------------------------------------------------------------------
+// ESC state machine and cycle
+
+std::uint16_t Cia402Slave::on_state_change(AlState from, AlState to) noexcept {
+  // 1C32h:01 = 2 (DC SYNC0) needs SYNC0 running before OP: 0981h cyclic operation + SYNC0
+  // [ETG.1020 synchronisation; ETG.1000.6 AL status code 0030h].
+  if (from == AlState::SafeOp && to == AlState::Op && persona_.sync_manager_parameters && sm_out_sync_mode_ == kSyncDc0) {
+    const std::uint8_t act = esc_ != nullptr ? esc_->memory()[reg::kDcActivation] : 0;
+    const std::uint8_t need = dc_activation::kCyclicOperation | dc_activation::kSync0;
+    if ((act & need) != need) return al_status_code::kInvalidDcSyncConfig;
+  }
+  return 0;
+}
+
+void Cia402Slave::on_state_entered(AlState from, AlState to) noexcept {
+  if (from != AlState::Op || to == AlState::Op) return;
+  // The ESC clears 0440h bit 0 before it leaves OP for an expired SM watchdog (esc_slave.cpp
+  // watchdog_check): that tells the watchdog from a requested transition.
+  const bool watchdog = esc_ != nullptr && (esc_->memory()[reg::kWatchdogStatusProcessData] & 0x01U) == 0;
+  // A requested exit counts only while the drive runs: a master that disables the drive first
+  // (digest "What a master must do", step 13) leaves OP without a reaction.
+  const bool running = model_.state() == core::AxisState::OperationEnabled;
+  if (watchdog || (persona_.abort_on_requested_leave_op && running)) comm_loss();
+}
+
+void Cia402Slave::comm_loss() noexcept {
+  ++counters_.comm_losses;
+  // 6007h [CiA 402; dunker §8.2]: 1 fault (EMCY comm_loss_code), 2 disable voltage, 3 quick stop.
+  switch (abort_option_) {
+    case 1:
+      model_.inject_fault(persona_.comm_loss_code);
+      comm_fault_raised_ = true;
+      break;
+    case 2:
+      (void)model_.write_object(kControlword, 0x0000);
+      break;
+    case 3:
+      (void)model_.write_object(kControlword, 0x0002);
+      break;
+    default:
+      break;  // 0: no reaction (ESR default: the drive keeps its last set-point, §12)
+  }
+}
+
+void Cia402Slave::exchange(std::span<const std::uint8_t> outputs, std::span<std::uint8_t> inputs, AlState state,
+                           std::uint64_t now_ns) noexcept {
+  // RxPDOs are applied in OP only [dunker §5: SAFE-OP "not applied"].
+  if (state == AlState::Op && outputs.size() >= output_size()) apply_outputs(outputs);
+  advance(now_ns);
+  report_emcys();
+  watch_al_status();
+  fill_inputs(inputs);
+}
+
+void Cia402Slave::apply_outputs(std::span<const std::uint8_t> outputs) noexcept {
+  std::size_t at = 0;
+  for (std::size_t k = 0; k < rx_assign_.count; ++k) {
+    const Pdo* d = pdo(rx_assign_.pdos[k], nullptr);
+    if (d == nullptr) continue;
+    for (std::size_t e = 0; e < d->count; ++e) {
+      const std::uint32_t m = d->entries[e];
+      const std::size_t n = (m & 0xFFU) / 8;
+      if (at + n > outputs.size()) return;
+      std::uint32_t raw = 0;
+      for (std::size_t b = 0; b < n; ++b) raw |= static_cast<std::uint32_t>(outputs[at + b]) << (8U * b);
+      at += n;
+      const ObjectId id{static_cast<std::uint16_t>(m >> 16), static_cast<std::uint8_t>(m >> 8)};
+      const auto type = type_of(id);
+      if (!type || ignored(id)) continue;
+      if (put_app(id, cia402::normalise(*type, raw)) != 0) ++counters_.refused_pdo_values;
+    }
+  }
+}
+
+void Cia402Slave::fill_inputs(std::span<std::uint8_t> inputs) const noexcept {
+  std::size_t at = 0;
+  for (std::size_t k = 0; k < tx_assign_.count; ++k) {
+    const Pdo* d = pdo(tx_assign_.pdos[k], nullptr);
+    if (d == nullptr) continue;
+    for (std::size_t e = 0; e < d->count; ++e) {
+      const std::uint32_t m = d->entries[e];
+      const std::size_t n = (m & 0xFFU) / 8;
+      if (at + n > inputs.size()) return;
+      const Value v = get({static_cast<std::uint16_t>(m >> 16), static_cast<std::uint8_t>(m >> 8)});
+      for (std::size_t b = 0; b < n; ++b) inputs[at + b] = static_cast<std::uint8_t>(v.raw >> (8U * b));
+      at += n;
+    }
+  }
+}
+
+void Cia402Slave::advance(std::uint64_t now_ns) noexcept {
+  if (!started_) {
+    started_ = true;
+    model_ns_ = now_ns;
+    return;
+  }
+  if (now_ns <= model_ns_) return;
+  if (now_ns - model_ns_ > kMaxCatchUpNs) model_ns_ = now_ns - kMaxCatchUpNs;  // a stalled line: no jump
+  while (now_ns - model_ns_ >= kModelStepNs) {
+    if (ip_active_) {
+      // 60C2h period = units x 10^index s (index -3: ms) [dunker §11.2].
+      const auto units = model_.dictionary().get(cia402::obj::kIpTimePeriodUnits.id).value_or(1);
+      auto index = model_.dictionary().get(cia402::obj::kIpTimePeriodIndex.id).value_or(-3);
+      double period_ns = static_cast<double>(std::max<std::int64_t>(units, 1));
+      for (index += 9; index > 0; --index) period_ns *= 10.0;
+      ip_elapsed_ns_ += kModelStepNs;
+      const double f = std::min(1.0, static_cast<double>(ip_elapsed_ns_) / period_ns);
+      const double v = static_cast<double>(ip_start_) + (static_cast<double>(ip_target_) - ip_start_) * f;
+      (void)model_.write_object(kIpDataRecord, std::llround(v));
+    }
+    model_.step(core::Duration(kModelStepNs));
+    model_ns_ += kModelStepNs;
+  }
+  // The communication fault has no lasting cause: once raised, a fault reset clears it.
+  if (comm_fault_raised_ && faulted(model_.state())) {
+    comm_fault_raised_ = false;
+    if (!injected_) model_.clear_fault_cause();
+  }
+}
+
+void Cia402Slave::report_emcys() noexcept {
+  while (const auto e = model_.take_pending_emcy()) {
+    if (e->error_code == 0 && !persona_.emcy_on_fault_clear) continue;
+    // ESR: bytes 3..7 always zero (quirk 11).
+    const CoeEmergency emcy{e->error_code, e->error_register, {}};
+    if (esc_ == nullptr || !esc_->post_emergency(emcy)) ++counters_.emcy_dropped;
+  }
+}
+
+void Cia402Slave::watch_al_status() noexcept {
+  // The ESC refuses PRE-OP -> SAFE-OP with 001Dh/001Eh before asking the application; the drive
+  // sees the refusal in AL status and reports A000h [dunker App. C, §5]. The SM watchdog (001Bh)
+  // has its own reaction (6007h).
+  if (esc_ == nullptr) return;
+  const auto mem = esc_->memory();
+  const bool error = (core::get_u16(mem, reg::kAlStatus) & kAlErrorBit) != 0;
+  const std::uint16_t code = core::get_u16(mem, reg::kAlStatusCode);
+  if (error && !al_error_seen_ && persona_.transition_error_emcy && code != al_status_code::kSmWatchdog) {
+    const CoeEmergency emcy{0xA000, 0x01, {}};
+    if (!esc_->post_emergency(emcy)) ++counters_.emcy_dropped;
+  }
+  al_error_seen_ = error;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Factory
+
+std::unique_ptr<Cia402Slave> make_cia402_slave(std::string_view persona, Cia402SlaveOptions options) {
+  return std::make_unique<Cia402Slave>(ethercat_persona_for(persona), std::move(options));
+}
+
+Cia402Device make_cia402_device(std::string_view persona, Cia402SlaveOptions options) {
+  Cia402Device d;
+  d.app = make_cia402_slave(persona, std::move(options));
+  d.esc = std::make_unique<EscSlave>(d.app->esc_config(), d.app->sii(), d.app.get());
+  return d;
+}
+
+}  // namespace drivegate::ethercat::sim
