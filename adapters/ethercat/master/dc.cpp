@@ -539,15 +539,17 @@ void DcSetup::compute_delays() noexcept {
 
 void DcSetup::advance_if_done() noexcept {
   if (status_ != DcSetupStatus::Running) return;
+  // The step ends when every slave finished it (or failed); then a failed reference clock ends the
+  // setup (every slave's own failure is in its report by then).
+  const bool all = std::all_of(slaves_.begin(), slaves_.begin() + static_cast<std::ptrdiff_t>(count_),
+                               [](const Slave& s) { return s.done; });
+  if (!all) return;
   const Slave& ref = slaves_[*reference_];
   if (ref.report.status == DcSlaveStatus::Failed) {
     const std::string_view why = ref.report.text.view();
     fail_line("reference clock failed: %.*s", static_cast<int>(why.size()), why.data());
     return;
   }
-  const bool all = std::all_of(slaves_.begin(), slaves_.begin() + static_cast<std::ptrdiff_t>(count_),
-                               [](const Slave& s) { return s.done; });
-  if (!all) return;
   switch (phase_) {
     case DcStep::ReceiveTimes: enter(DcStep::Delays); return;
     case DcStep::Offsets: enter(DcStep::StaticDrift); return;
