@@ -1,6 +1,7 @@
 #include "adapters/ethercat/sim/esc_slave.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 
 #include "adapters/ethercat/wire/al_status.hpp"
@@ -133,6 +134,11 @@ void EscSlave::power_on() noexcept {
   mailbox_pending_ = false;
   outputs_valid_ = false;
   wd_triggered_ = false;
+  // The DC unit restarts with the ESC: a fresh local clock, SYNC0 off.
+  clock_.reset(cfg_.clock_offset_ns, cfg_.drift_ppm);
+  sync0_running_ = false;
+  sync0_next_ = sync0_cycle_ = sync0_last_ = sync0_count_ = 0;
+  sync0_fired_ = false;
   set_port1_link(port1_link_);
 }
 
@@ -249,11 +255,8 @@ void EscSlave::set_pdi_deactivate(unsigned n, bool deactivate) noexcept {
 // ---- Physical memory access -------------------------------------------------------------------
 
 void EscSlave::refresh_dynamic_registers() noexcept {
-  if (cfg_.dc_supported) {
-    // System time 0910h = local time + system time offset 0920h [ETG.1000.4 §6 DC].
-    const std::uint64_t sys = local_time(now_ns_) + u64(reg::kDcSystemTimeOffset);
-    set64(reg::kDcSystemTime, cfg_.dc_64bit ? sys : (sys & 0xFFFFFFFFU));
-  }
+  // The system time as the datagram passes (a read of 0910h gives it) [ETG.1000.4 §6 DC].
+  if (cfg_.dc_supported) set64(reg::kDcSystemTime, system_time(now_ns_));
 }
 
 bool EscSlave::phys_read(std::uint32_t ado, std::span<std::uint8_t> data, bool or_in) noexcept {
@@ -296,12 +299,8 @@ bool EscSlave::phys_write(std::uint32_t ado, std::span<const std::uint8_t> data)
         if ((written & sii_control::kCommandMask) != 0) sii_command();
       }
     }
-    // System time written (ARMW/FRMW of the other slaves, or FPWR): the DC control loop compares
-    // it with the local copy; the difference goes to 092Ch [ETG.1000.4 §6 DC].
     if (cfg_.dc_supported && ado <= reg::kDcSystemTime && ado + len >= reg::kDcSystemTime + 4U) {
-      const std::uint32_t received = get_u32(data, reg::kDcSystemTime - ado);
-      const auto local = static_cast<std::uint32_t>(local_time(now_ns_) + u64(reg::kDcSystemTimeOffset));
-      set32(reg::kDcSystemTimeDifference, encode_system_time_difference(static_cast<std::int32_t>(local - received)));
+      system_time_written(ado, data);
     }
     register_written(ado, len);
   }
@@ -330,6 +329,100 @@ void EscSlave::register_written(std::uint32_t start, std::uint32_t len) noexcept
     if (downstream_) set32(reg::kDcReceiveTimePort1, static_cast<std::uint32_t>(local_time(port1_ns_)));
     set64(reg::kDcReceiveTimeProcessingUnit, local_time(port0_ns_));
   }
+  if (cfg_.dc_supported) {
+    // A write to the speed counter start restarts the control loop; a new offset or delay makes
+    // the error jump [ETG.1000.4 §6 DC registers 0920h, 0928h, 0930h].
+    if (overlaps(start, len, reg::kDcSpeedCounterStart, 2)) {
+      clock_.advance(now_ns_);
+      clock_.reset_loop();
+    } else if (overlaps(start, len, reg::kDcSystemTimeOffset, 12)) {
+      clock_.advance(now_ns_);
+      clock_.restart_window();
+    }
+    if (overlaps(start, len, reg::kDcActivation, 1)) dc_activation_written();
+  }
+}
+
+// ---- Distributed clocks [ETG.1000.4 §6 DC registers] ------------------------------------------
+
+std::uint64_t EscSlave::system_time(std::uint64_t now_ns) const noexcept {
+  // System time 0910h = local time + system time offset 0920h; 32 bits on a 32-bit DC unit.
+  const std::uint64_t sys = local_time(now_ns) + u64(reg::kDcSystemTimeOffset);
+  return cfg_.dc_64bit ? sys : (sys & 0xFFFFFFFFU);
+}
+
+bool EscSlave::time_reached(std::uint64_t a, std::uint64_t b) const noexcept {
+  if (cfg_.dc_64bit) return a >= b;
+  return static_cast<std::int32_t>(static_cast<std::uint32_t>(a) - static_cast<std::uint32_t>(b)) >= 0;
+}
+
+void EscSlave::system_time_written(std::uint32_t ado, std::span<const std::uint8_t> data) noexcept {
+  // A written system time (FRMW/ARMW from the reference clock, or any write) is the reference's
+  // time when the frame passed it; the frame reaches this ESC 0928h ns later. The difference of the
+  // own system time against received + delay goes to 092Ch and drives the control loop
+  // [ETG.1000.4 §6 DC: 0910h write, 0928h, 092Ch]. Compared over 64 bits when the write carries
+  // 8 bytes and the unit is 64-bit, else over the low 32 bits.
+  const auto len = static_cast<std::uint32_t>(data.size());
+  const std::size_t at = reg::kDcSystemTime - ado;
+  const bool wide = cfg_.dc_64bit && ado + len >= reg::kDcSystemTime + 8U;
+  const std::uint64_t delay = u32(reg::kDcSystemTimeDelay);
+  const std::uint64_t own = system_time(now_ns_);
+  std::int64_t diff = 0;
+  if (wide) {
+    diff = static_cast<std::int64_t>(own - get_u64(data, at) - delay);
+  } else {
+    diff = static_cast<std::int32_t>(static_cast<std::uint32_t>(own) - get_u32(data, at) - static_cast<std::uint32_t>(delay));
+  }
+  const double error = static_cast<double>(diff) + clock_.fraction(now_ns_);
+  set32(reg::kDcSystemTimeDifference, encode_system_time_difference(static_cast<std::int64_t>(std::llround(error))));
+  clock_.sample(now_ns_, error);
+}
+
+void EscSlave::dc_activation_written() noexcept {
+  // 0981h bit 0 cyclic operation + bit 1 SYNC0: on activation the unit takes the start time 0990h
+  // and cycle 09A0h; a start time not in the future never fires (a 64-bit ESC waits for it
+  // forever): 0984h bit 2 says so. 0984h bit 0: first pulse pending [ETG.1000.4 §6 DC, 0981h,
+  // 0984h, 0990h, 09A0h].
+  const std::uint8_t act = mem_[reg::kDcActivation];
+  const bool on = (act & dc_activation::kCyclicOperation) != 0 && (act & dc_activation::kSync0) != 0;
+  if (!on) {
+    sync0_running_ = false;
+    mem_[reg::kDcActivationStatus] = 0;
+    return;
+  }
+  if (sync0_running_ || (mem_[reg::kDcActivationStatus] & 0x04U) != 0) return;  // already activated
+  const std::uint64_t mask = cfg_.dc_64bit ? ~std::uint64_t{0} : 0xFFFFFFFFU;
+  const std::uint64_t start = u64(reg::kDcSync0StartTime) & mask;
+  sync0_cycle_ = u32(reg::kDcSync0CycleTime);
+  if (time_reached(system_time(now_ns_), start)) {
+    mem_[reg::kDcActivationStatus] = 0x04;
+    return;
+  }
+  sync0_running_ = true;
+  sync0_next_ = start;
+  mem_[reg::kDcActivationStatus] = 0x01;
+}
+
+void EscSlave::sync0_cycle(std::uint64_t now_ns) noexcept {
+  if (!sync0_running_) return;
+  const std::uint64_t sys = system_time(now_ns);
+  if (!time_reached(sys, sync0_next_)) return;
+  const std::uint64_t mask = cfg_.dc_64bit ? ~std::uint64_t{0} : 0xFFFFFFFFU;
+  if (sync0_cycle_ == 0) {  // cycle time 0: a single pulse
+    sync0_last_ = sync0_next_;
+    ++sync0_count_;
+    sync0_running_ = false;
+  } else {
+    const std::uint64_t behind = (sys - sync0_next_) & mask;
+    const std::uint64_t k = behind / sync0_cycle_;
+    sync0_last_ = (sync0_next_ + k * sync0_cycle_) & mask;
+    sync0_count_ += k + 1;
+    sync0_next_ = (sync0_last_ + sync0_cycle_) & mask;
+  }
+  set64(reg::kDcSync0StartTime, sync0_next_);  // read: the next SYNC0 pulse
+  mem_[reg::kDcActivationStatus] = static_cast<std::uint8_t>(mem_[reg::kDcActivationStatus] & ~0x01U);
+  mem_[reg::kDcSync0Status] = 0x01;
+  sync0_fired_ = true;
 }
 
 // ---- Datagrams --------------------------------------------------------------------------------
@@ -671,6 +764,10 @@ void EscSlave::watchdog_check(std::uint64_t now_ns) noexcept {
 
 void EscSlave::pdi_cycle(std::uint64_t now_ns) noexcept {
   now_ns_ = now_ns;
+  if (cfg_.dc_supported) {
+    clock_.advance(now_ns);
+    sync0_cycle(now_ns);
+  }
   if (sii_busy_ > 0 && --sii_busy_ == 0) {
     set16(reg::kSiiControl, static_cast<std::uint16_t>(u16(reg::kSiiControl) & ~(sii_control::kBusy | sii_control::kCommandMask)));
   }
@@ -686,7 +783,10 @@ void EscSlave::pdi_cycle(std::uint64_t now_ns) noexcept {
     set16(reg::kWatchdogStatusProcessData, 1);
   }
   watchdog_check(now_ns);
+  const bool sync0 = sync0_fired_;
+  sync0_fired_ = false;
   if (app_ == nullptr) return;
+  if (sync0) app_->on_sync0(sync0_last_, now_ns);
   const std::size_t out_n = std::min(app_->output_size(), zeros_.size());
   const std::size_t in_n = std::min(app_->input_size(), inputs_.size());
   std::span<const std::uint8_t> outputs(zeros_.data(), out_n);

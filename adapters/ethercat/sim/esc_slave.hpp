@@ -18,7 +18,12 @@
 //   (write to a full mailbox, read of an empty one, any access while the SM is disabled or
 //   deactivated by the PDI) does not touch memory and does not count;
 // - AL state machine with the checks of ETG.1000.6 §5.3.2, SM watchdog, SII EEPROM interface,
-//   mailbox with repeat, CoE server, DC registers.
+//   mailbox with repeat, CoE server, DC registers;
+// - distributed clocks (when EscConfig::dc_supported): a local clock with an offset and a drift
+//   (DcClock), receive time latches, system time = local + 0920h, the system time difference 092Ch
+//   of a written system time against the own one plus the delay 0928h, a control loop that makes
+//   the clock follow, and SYNC0 pulses at start + k·cycle once 0981h activates them (0984h
+//   activation status, 0990h reads the next pulse).
 #include <array>
 #include <bitset>
 #include <cstddef>
@@ -28,6 +33,7 @@
 #include <vector>
 
 #include "adapters/ethercat/sim/coe_server.hpp"
+#include "adapters/ethercat/sim/dc_clock.hpp"
 #include "adapters/ethercat/sim/object_dictionary.hpp"
 #include "adapters/ethercat/wire/frame.hpp"
 #include "adapters/ethercat/wire/mailbox.hpp"
@@ -58,6 +64,11 @@ class SlaveApplication {
                         std::uint64_t now_ns) noexcept = 0;
   // The CoE object dictionary; null for a slave without CoE.
   virtual ObjectDictionary* object_dictionary() noexcept { return nullptr; }
+  // SYNC0 fired (DC slaves with 0981h = 03h): `pulse_ns` is the system time of the last pulse since
+  // the previous PDI cycle (several may have passed; EscSlave::sync0_pulses() counts them all),
+  // `now_ns` the line's time. Called in the PDI cycle before exchange(), so a drive model can latch
+  // its set-points on SYNC0.
+  virtual void on_sync0(std::uint64_t /*pulse_ns*/, std::uint64_t /*now_ns*/) noexcept {}
 };
 
 struct EscConfig {
@@ -72,7 +83,8 @@ struct EscConfig {
   std::uint16_t features = 0x01CC;   // 0008h ESC features; bit 2 DC is set from dc_supported
   bool dc_supported = false;         // DC unit present (ESR/Dunker drives: none)
   bool dc_64bit = true;
-  std::int64_t clock_offset_ns = 0;  // this slave's local clock minus the line's time
+  std::int64_t clock_offset_ns = 0;  // this slave's local clock minus the line's time at power-on
+  double drift_ppm = 0.0;            // its oscillator's error: + runs fast (DcClock)
   // SII EEPROM reads: 8 bytes per read (0502h bit 6 = 1) or 4.
   bool sii_read_8_bytes = true;
   // Frames the SII busy bit stays set after a command (the master must poll).
@@ -107,9 +119,16 @@ class EscSlave {
   std::uint16_t al_status_code() const noexcept;
   std::uint16_t station_address() const noexcept;
   std::span<const std::uint8_t> memory() const noexcept { return {mem_.data(), mem_.size()}; }
-  std::uint64_t local_time(std::uint64_t now_ns) const noexcept {
-    return static_cast<std::uint64_t>(static_cast<std::int64_t>(now_ns) + cfg_.clock_offset_ns);
-  }
+  // DC: the local clock and the system time (local + 0920h; 32 bits on a 32-bit DC) at line time
+  // `now_ns`.
+  std::uint64_t local_time(std::uint64_t now_ns) const noexcept { return clock_.local(now_ns); }
+  std::uint64_t system_time(std::uint64_t now_ns) const noexcept;
+  const DcClock& dc_clock() const noexcept { return clock_; }
+  // SYNC0: pulses so far, the system time of the last one (0 before the first), whether the unit
+  // runs (activated with a start time in the future).
+  std::uint64_t sync0_pulses() const noexcept { return sync0_count_; }
+  std::uint64_t last_sync0() const noexcept { return sync0_last_; }
+  bool sync0_running() const noexcept { return sync0_running_; }
   // Queues a CoE emergency [ETG.1000.6 §5.6.4]; false when the mailbox queue is full or the slave
   // has no mailbox.
   bool post_emergency(const CoeEmergency& e) noexcept;
@@ -164,6 +183,11 @@ class EscSlave {
   void load_sm1() noexcept;
   void sm1_repeat() noexcept;
   void watchdog_check(std::uint64_t now_ns) noexcept;
+  void system_time_written(std::uint32_t ado, std::span<const std::uint8_t> data) noexcept;
+  void dc_activation_written() noexcept;
+  void sync0_cycle(std::uint64_t now_ns) noexcept;
+  // a is at or after b in the slave's system time width (32-bit DC wraps).
+  bool time_reached(std::uint64_t a, std::uint64_t b) const noexcept;
 
   EscConfig cfg_;
   SlaveApplication* app_ = nullptr;
@@ -201,6 +225,13 @@ class EscSlave {
   std::uint64_t port1_ns_ = 0;
   bool downstream_ = false;
   bool port1_link_ = false;
+  DcClock clock_;
+  bool sync0_running_ = false;
+  std::uint64_t sync0_next_ = 0;   // system time of the next pulse
+  std::uint64_t sync0_cycle_ = 0;  // 09A0h at activation; 0 = one pulse
+  std::uint64_t sync0_last_ = 0;
+  std::uint64_t sync0_count_ = 0;
+  bool sync0_fired_ = false;       // since the last PDI cycle
   std::array<std::uint8_t, kMaxDatagramData> scratch_{};
 };
 

@@ -12,8 +12,10 @@ SimLine::SimLine(MemoryLink& link, SimLineConfig config) : link_(link), cfg_(con
 
 SimLine::~SimLine() { link_.set_sink(nullptr); }
 
-std::size_t SimLine::add(EscSlave& slave) {
-  slaves_.push_back(Entry{&slave, true});
+std::size_t SimLine::add(EscSlave& slave) { return add(slave, cfg_.hop_delay_ns); }
+
+std::size_t SimLine::add(EscSlave& slave, std::uint32_t hop_delay_ns) {
+  slaves_.push_back(Entry{&slave, true, hop_delay_ns});
   update_links();
   return slaves_.size() - 1;
 }
@@ -108,12 +110,15 @@ void SimLine::on_frame(FrameView frame) noexcept {
     run_pdi();
     return;
   }
-  const std::uint64_t d = cfg_.hop_delay_ns;
+  std::uint64_t s_last = 0;
+  for (std::size_t k = 0; k < n; ++k) s_last += slaves_[k].hop_ns;
   const std::size_t last = n - 1;
+  std::uint64_t s_k = 0;
   for (std::size_t k = 0; k < n; ++k) {
     EscSlave& esc = *slaves_[k].esc;
-    const std::uint64_t port0 = now_ + (k + 1) * d;
-    const std::uint64_t port1 = now_ + (last + 1) * d + (last - k) * d;
+    s_k += slaves_[k].hop_ns;
+    const std::uint64_t port0 = now_ + s_k;
+    const std::uint64_t port1 = now_ + s_last + (s_last - s_k);
     esc.begin_frame(port0, port1, k < last);
     for (std::size_t i = 0; i < count; ++i) {
       const Datagram& g = datagrams_[i];

@@ -3,10 +3,13 @@
 // slaves in order on the way out (each processes the datagrams, ADP increments, WKC counts) and
 // returns through them to the master].
 //
-// Timing for DC: the frame leaves the master at the line's time `now`; each hop (cable + ESC
-// forwarding) takes `hop_delay_ns`, out and back, so slave k sees it on port 0 at now + (k+1)·d
-// and, with a downstream neighbour, on port 1 at now + (last+1)·d + (last-k)·d; the difference
-// gives the master's propagation-delay computation 2·(last-k)·d.
+// Timing for DC: the frame leaves the master at the line's time `now`; the hop into slave j (cable
+// + forwarding) takes h_j ns (`hop_delay_ns`, or per slave given to add()), the same out and back.
+// With S_k = h_0 + ... + h_k, slave k sees the frame on port 0 at now + S_k and, with a downstream
+// neighbour, on port 1 at now + S_last + (S_last - S_k); port 1 minus port 0 is the round trip
+// 2·(S_last - S_k) behind it, and half the difference of two slaves' round trips is the delay
+// between them (what the master's propagation-delay computation finds) [ETG.1000.4 §6 DC receive
+// times]. Each ESC's clock (offset, drift, control loop) is its own: EscConfig / DcClock.
 //
 // Faults: slave k powered off (it and everything behind it unreachable; slave k-1 closes its
 // port 1, as a real ESC does on link loss); power back = the slave restarts (INIT, station
@@ -48,8 +51,10 @@ class SimLine final : public FrameSink {
   SimLine(const SimLine&) = delete;
   SimLine& operator=(const SimLine&) = delete;
 
-  // Appends a slave at the end of the line (before frames pass); returns its position.
+  // Appends a slave at the end of the line (before frames pass); returns its position. The hop
+  // into it takes the configured hop_delay_ns, or `hop_delay_ns`.
   std::size_t add(EscSlave& slave);
+  std::size_t add(EscSlave& slave, std::uint32_t hop_delay_ns);
   std::size_t size() const noexcept { return slaves_.size(); }
   EscSlave& slave(std::size_t k) noexcept { return *slaves_[k].esc; }
 
@@ -80,6 +85,7 @@ class SimLine final : public FrameSink {
   struct Entry {
     EscSlave* esc = nullptr;
     bool powered = true;
+    std::uint32_t hop_ns = 0;  // master or previous slave -> this one
   };
   void update_links() noexcept;
   void run_pdi() noexcept;

@@ -260,18 +260,21 @@ std::array<std::uint8_t, kSmEntrySize> encode_sm(const SmEntry& s) noexcept;
 // nullopt when `in` is shorter than 8 bytes.
 std::optional<SmEntry> decode_sm(std::span<const std::uint8_t> in) noexcept;
 
-// System time difference register 0x092C: sign-magnitude, bit 31 set = local copy smaller than the
-// received time [ETG.1000.4 §6, DC registers]. Returns the signed difference in ns.
+// System time difference register 0x092C [ETG.1000.4 §6 DC registers]: sign and magnitude, not two's
+// complement. Bits 0-30: |difference| in ns; bit 31 = 1: the local copy of the system time is
+// smaller than the received time (local - received < 0), 0: greater or equal. Returns the signed
+// difference (local - received) in ns.
 constexpr std::int32_t decode_system_time_difference(std::uint32_t raw) noexcept {
   const auto magnitude = static_cast<std::int32_t>(raw & 0x7FFFFFFFU);
   return (raw & 0x80000000U) ? -magnitude : magnitude;
 }
-// The register value of a signed difference in ns (the inverse of the decoder; the magnitude is
-// kept to 31 bits).
-constexpr std::uint32_t encode_system_time_difference(std::int32_t diff) noexcept {
-  const std::uint32_t magnitude =
-      diff < 0 ? static_cast<std::uint32_t>(-static_cast<std::int64_t>(diff)) : static_cast<std::uint32_t>(diff);
-  return (magnitude & 0x7FFFFFFFU) | (diff < 0 ? 0x80000000U : 0U);
+// The register value of a signed difference (local - received) in ns, the inverse of the decoder;
+// a magnitude beyond 31 bits saturates at 7FFFFFFFh (2.1 s), keeping the sign.
+constexpr std::uint32_t encode_system_time_difference(std::int64_t diff) noexcept {
+  constexpr std::uint64_t kMax = 0x7FFFFFFFU;
+  const std::uint64_t magnitude =
+      diff < 0 ? static_cast<std::uint64_t>(-(diff + 1)) + 1U : static_cast<std::uint64_t>(diff);
+  return static_cast<std::uint32_t>(magnitude > kMax ? kMax : magnitude) | (diff < 0 ? 0x80000000U : 0U);
 }
 
 }  // namespace drivegate::ethercat
