@@ -165,6 +165,11 @@ struct EcatHarness {
     for (const auto& e : events) s += std::string(core::to_string(e.kind)) + ": " + std::string(e.text.view()) + "\n";
     return s;
   }
+  const CyclicExchange& cx() const {
+    const CyclicExchange* p = bus->exchange();
+    if (p == nullptr) throw std::runtime_error("the bus has no process image yet");
+    return *p;
+  }
   std::string details() const {
     std::string s;
     for (std::size_t k = 0; k < bus->slave_count(); ++k) s += std::string(bus->slave_detail(k)) + "\n";
