@@ -243,8 +243,9 @@ void EthercatBus::enter(Slave& s, Phase p, core::TimePoint now) noexcept {
     case Phase::Sync:
     case Phase::SafeOp:
     case Phase::ToOp: link = core::LinkState::Configuring; break;
-    case Phase::Op: link = core::LinkState::Operational; break;
-    case Phase::LeftOp:
+    // LeftOp: the cycle its AL status code is read in; the link goes Lost with the sentence after.
+    case Phase::Op:
+    case Phase::LeftOp: link = core::LinkState::Operational; break;
     case Phase::Lost: link = s.had_op ? core::LinkState::Lost : core::LinkState::Offline; break;
     case Phase::SafeStop: link = core::LinkState::Degraded; break;
   }
