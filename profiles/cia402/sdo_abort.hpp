@@ -17,6 +17,8 @@ inline constexpr std::uint32_t kOutOfMemory = 0x05040005;
 inline constexpr std::uint32_t kUnsupportedAccess = 0x06010000;
 inline constexpr std::uint32_t kWriteOnly = 0x06010001;  // attempt to read a write-only object
 inline constexpr std::uint32_t kReadOnly = 0x06010002;   // attempt to write a read-only object
+// Sub-index cannot be written, sub-index 0 must be 0 first (ETG.1000.6 Table 41; also CiA 301).
+inline constexpr std::uint32_t kSubindexZeroFirst = 0x06010003;
 inline constexpr std::uint32_t kNoObject = 0x06020000;
 inline constexpr std::uint32_t kNotMappable = 0x06040041;
 inline constexpr std::uint32_t kPdoLength = 0x06040042;

@@ -128,7 +128,7 @@ TEST(EthercatCia402Slave, EsrMappingFollowsCountZeroRuleAndWhitelist) {
   DriveLine l("esr-triodrive");
   l.preop();
   // An entry while :00 != 0: 06010003h [ETG.1000.6 SDO abort codes].
-  EXPECT_EQ(l.download(0x1600, 1, 0x60400010, 4), kAbortSubindexZeroFirst);
+  EXPECT_EQ(l.download(0x1600, 1, 0x60400010, 4), cia402::sdo_abort_code::kSubindexZeroFirst);
   // TV-6 steps 1..7.
   EXPECT_EQ(l.download(0x1C12, 0, 0, 1), 0U);
   EXPECT_EQ(l.download(0x1600, 0, 0, 1), 0U);

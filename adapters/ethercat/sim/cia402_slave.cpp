@@ -539,7 +539,7 @@ std::uint32_t Cia402Slave::put_pdo(Pdo& d, bool receive, std::uint8_t sub, std::
     return 0;
   }
   // Count-zero rule: entries change only while sub-index 0 is 0 [ETG.1000.6 PDO mapping].
-  if (d.count != 0) return kAbortSubindexZeroFirst;
+  if (d.count != 0) return cia402::sdo_abort_code::kSubindexZeroFirst;
   if (raw != 0 && check_entry(raw, receive) != 0) return abort::kNotMappable;
   d.entries[sub - 1U] = raw;
   return 0;
@@ -569,7 +569,7 @@ std::uint32_t Cia402Slave::put_assign(Assign& a, bool receive, std::uint8_t sub,
     a.count = static_cast<std::uint8_t>(raw);
     return 0;
   }
-  if (a.count != 0) return kAbortSubindexZeroFirst;
+  if (a.count != 0) return cia402::sdo_abort_code::kSubindexZeroFirst;
   if (raw != 0 && find(raw) == nullptr) return abort::kValueRange;  // ESR: 1602h does not exist (quirk 3)
   a.pdos[sub - 1U] = static_cast<std::uint16_t>(raw);
   return 0;

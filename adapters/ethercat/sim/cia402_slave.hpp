@@ -53,9 +53,6 @@
 
 namespace drivegate::ethercat::sim {
 
-// ETG.1000.6 SDO abort code (not in CiA 301): an entry written while sub-index 0 is not 0.
-inline constexpr std::uint32_t kAbortSubindexZeroFirst = 0x06010003;
-
 // Process data layout of the persona's ESC (the SII's SyncM category says the same).
 inline constexpr std::uint16_t kDriveMailboxOut = 0x1000;  // SM0
 inline constexpr std::uint16_t kDriveMailboxIn = 0x1080;   // SM1
