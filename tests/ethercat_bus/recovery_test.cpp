@@ -60,3 +60,46 @@ TEST(EthercatBusRecovery, SafeStopWhenControlIsLost) {
 
 }  // namespace
 }  // namespace drivegate::ethercat::test
+
+namespace drivegate::ethercat::test {
+namespace {
+
+// A drive fault the drive announces by CoE emergency [ETG.1000.6 §5.6.4]: an `emcy` event of its
+// axis with the device profile's text, and the profile's fault report.
+TEST(EthercatBusEmcy, DriveFaultEmergencyBecomesAnEventAndTheFaultReport) {
+  EcatHarness h;
+  ASSERT_TRUE(h.run_until([&] { return h.all_up(); }, 5s)) << h.details();
+  h.gen.app->inject_fault(0x2310);
+  const auto emcy = [&] {
+    for (const auto& e : h.events)
+      if (e.kind == core::EventKind::Emcy && e.code == 0x2310) return true;
+    return false;
+  };
+  ASSERT_TRUE(h.run_until(emcy, 500ms)) << h.events_text();
+  std::string text;
+  for (const auto& e : h.events)
+    if (e.kind == core::EventKind::Emcy) text = std::string(e.text.view());
+  EXPECT_NE(text.find("EMCY 0x2310"), std::string::npos) << text;
+  EXPECT_NE(text.find("Continuous over-current"), std::string::npos) << text;  // generic-cia402.yaml
+  const cia402::DriveFaultReport r = h.bus->access(h.axis("gen")).fault_report();
+  EXPECT_TRUE(r.valid);
+  EXPECT_EQ(r.code, 0x2310);
+  EXPECT_EQ(r.text, "Continuous over-current");
+  ASSERT_TRUE(h.run_until([&] { return h.snap("gen").state == core::AxisState::Fault; }, 500ms));
+  EXPECT_EQ(h.bus->link_state(h.axis("gen")), core::LinkState::Operational);
+}
+
+// close(): every slave to SAFE-OP, then INIT, and the link closed.
+TEST(EthercatBusClose, TakesTheSlavesDownToInit) {
+  EcatHarness h;
+  ASSERT_TRUE(h.run_until([&] { return h.all_up(); }, 5s)) << h.details();
+  h.bus->close();
+  EXPECT_EQ(h.esr.esc->state(), AlState::Init);
+  EXPECT_EQ(h.panel_esc->state(), AlState::Init);
+  EXPECT_EQ(h.gen.esc->state(), AlState::Init);
+  EXPECT_FALSE(h.link->is_open());
+  EXPECT_EQ(h.bus->link_state(h.axis("esr")), core::LinkState::Offline);
+}
+
+}  // namespace
+}  // namespace drivegate::ethercat::test
