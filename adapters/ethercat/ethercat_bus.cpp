@@ -436,6 +436,16 @@ void EthercatBus::boot_done(core::TimePoint now) noexcept {
   for (std::size_t k = 0; k < slaves_.size(); ++k) {
     Slave& s = *slaves_[k];
     const bool known = k < boot_->slave_count() && boot_->slave(k).status == SlaveStatus::Ready;
+    if (known && s.plan.io != nullptr && !image_.ok()) {
+      // An I/O slave whose sizes the plan leaves open: its SII's process data SMs say them
+      // [ETG.1000.6 §5.4 SyncM category]. Only at the first layout: the offsets never move.
+      const SiiInfo& sii = boot_->sii(k);
+      for (std::size_t i = 0; i < sii.sync_manager_count; ++i) {
+        const SiiSyncManager& sm = sii.sync_managers[i];
+        if (sm.type == sii_sm_type::kOutputs && !s.plan.io->output_bytes) s.plan.output_bits = sm.length * 8U;
+        if (sm.type == sii_sm_type::kInputs && !s.plan.io->input_bytes) s.plan.input_bits = sm.length * 8U;
+      }
+    }
     image_slaves_[k] = known ? image_slave_from_sii(boot_->sii(k), s.station, s.plan.output_bits, s.plan.input_bits)
                              : planned_image_slave(s.plan);
     s.image_from_sii = known;

@@ -108,3 +108,32 @@ buses:
 
 }  // namespace
 }  // namespace drivegate::ethercat::test
+
+namespace drivegate::ethercat::test {
+namespace {
+
+// Mapped objects in the image: little-endian at their PDO entry offsets, sign-extended per type;
+// the I/O slave's sizes taken from its SII when the plan leaves them open.
+TEST(EthercatBusImage, MappedObjectsAndIoSizesFromTheSii) {
+  std::string yaml = kLine;
+  yaml.replace(yaml.find(", inputs: 2, outputs: 2"), std::string(", inputs: 2, outputs: 2").size(), "");
+  EcatHarness h(yaml);
+  ASSERT_TRUE(h.run_until([&] { return h.all_up(); }, 5s)) << h.details();
+  EXPECT_EQ(h.bus->image().slave(1).output_bytes, 2);
+  EXPECT_EQ(h.bus->image().slave(1).input_bytes, 2);
+  SlaveAccess& gen = h.bus->access(h.axis("gen"));
+  // 6071h (INTEGER16) sits after 6040h (2 bytes) and 6060h (1 byte): offset 3 of the outputs.
+  gen.write({0x6071, 0}, -100);
+  EXPECT_EQ(gen.read({0x6071, 0}), -100);
+  const auto out = h.cx().inputs(2);  // inputs; the outputs are read back through the access
+  EXPECT_EQ(out.size(), 15U);
+  EXPECT_TRUE(gen.mapped({0x6064, 0}));
+  EXPECT_FALSE(gen.mapped({0x6081, 0}));
+  // The drive's position (6064h, INTEGER32 at input offset 7) as the model has it.
+  h.cycle();
+  EXPECT_EQ(gen.read({0x6064, 0}), h.gen.app->drive().read_object({0x6064, 0}).value);
+  EXPECT_TRUE(gen.inputs_fresh());
+}
+
+}  // namespace
+}  // namespace drivegate::ethercat::test
