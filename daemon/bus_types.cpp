@@ -2,9 +2,9 @@
 // is the one place that names every adapter; config/, the plan, the printout and the bus factory
 // reach the bus types only through the registry (config/bus_types.hpp).
 #include "adapters/canopen/bus_type.hpp"
+#include "adapters/ethercat/bus_type.hpp"
 #include "adapters/sim/bus_type.hpp"
 #include "config/bus_types.hpp"
-#include "config/ethercat/bus_type.hpp"
 
 namespace drivegate::config {
 
@@ -24,7 +24,7 @@ BusTypeRegistry BusTypeRegistry::builtin() {
   BusTypeRegistry r;
   r.add(sim::bus_type());
   r.add(canopen::bus_type());
-  r.add(ethercat_bus_type());  // profiles' ethercat: sections; no adapter yet
+  r.add(ethercat::bus_type());
   // PROFINET device numbers.
   r.add(known("profinet", 65535));
   return r;

@@ -232,7 +232,7 @@ TEST(ScanBus, RefusesBusTypesWithoutAScanner) {
     (void)scan_bus(r, registry);
     FAIL() << "scanned ethercat";
   } catch (const core::ScanError& e) {
-    EXPECT_STREQ(e.what(), "cannot scan ethercat: no adapter in this build (scans: canopen)");
+    EXPECT_STREQ(e.what(), "cannot scan ethercat: ethercat has no bus scan (scans: canopen)");
   }
   r.bus_type = "canbus";
   EXPECT_THROW((void)scan_bus(r, registry), core::ScanError);

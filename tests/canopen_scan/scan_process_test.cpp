@@ -170,7 +170,7 @@ TEST(ScanProcess, RefusalsAreOneClearLine) {
   EXPECT_NE(r.out.find("drivegated: --scan canopen:dgscan9: cannot open the bus: socketcan: "), std::string::npos) << r.out;
   r = drivegated("--scan ethercat:eth0");
   EXPECT_EQ(r.status, 1);
-  EXPECT_NE(r.out.find("cannot scan ethercat: no adapter in this build"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("cannot scan ethercat: ethercat has no bus scan"), std::string::npos) << r.out;
   r = drivegated("--scan profinet:eth0");
   EXPECT_NE(r.out.find("cannot scan profinet: no adapter in this build"), std::string::npos) << r.out;
   r = drivegated("--scan sim:x");

@@ -242,11 +242,11 @@ TEST(LoadErrors, BusTypes) {
   const std::string e = errors_of(R"(gateway: { name: g }
 buses:
   - { name: a, type: simm, cycle_time: 1ms }
-  - { name: b, type: ethercat, cycle_time: 1ms }
+  - { name: b, type: profinet, cycle_time: 1ms }
   - { name: c, type: sim, cycle_time: 1ms, options: { latency: 2 } }
 )");
-  EXPECT_REPORTED(e, "t.yaml:3:22: buses[0].type: unknown bus type \"simm\", did you mean \"sim\"? (available: sim, canopen)");
-  EXPECT_REPORTED(e, "t.yaml:4:22: buses[1].type: bus type \"ethercat\" has no adapter in this build (available: sim, canopen)");
+  EXPECT_REPORTED(e, "t.yaml:3:22: buses[0].type: unknown bus type \"simm\", did you mean \"sim\"? (available: sim, canopen, ethercat)");
+  EXPECT_REPORTED(e, "t.yaml:4:22: buses[1].type: bus type \"profinet\" has no adapter in this build (available: sim, canopen, ethercat)");
   EXPECT_REPORTED(e, "t.yaml:5:55: buses[2].options.latency: unknown field (allowed: acyclic_latency_cycles)");
 }
 

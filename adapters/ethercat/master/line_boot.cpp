@@ -90,6 +90,7 @@ void LineBoot::start(core::TimePoint now) noexcept {
     s.phase = Phase::Idle;
     s.pending = Pending{};
     s.report = SlaveReport{};
+    s.restart = false;
   }
   line_pending_ = Pending{};
   set(line_pending_, Command::BRD, physical_address(0, reg::kType), 2);
@@ -369,23 +370,92 @@ void LineBoot::line_group_done() noexcept {
     line_text_.format("%zu slave(s) configured, %zu found: position %zu and after missing", expected_count_, found_,
                       found_);
   }
-  for (std::size_t i = 0; i < found_; ++i) {
-    Slave& s = slaves_[i];
-    s.report.status = SlaveStatus::Busy;
-    s.report.step = BootStep::Sii;
-    s.image_size = 0;
-    s.sii_word = 0;
-    s.sii_next_category = kSiiHeaderBytes;
-    s.sii_tries_left = config_.retries;
-    s.phase = Phase::SiiStatus;
-    s.deadline = now_ + config_.sii_timeout;
-    slave_phase(s);
+  for (std::size_t i = 0; i < found_; ++i) start_sii(slaves_[i]);
+}
+
+void LineBoot::start_sii(Slave& s) noexcept {
+  s.report.status = SlaveStatus::Busy;
+  s.report.step = BootStep::Sii;
+  s.image_size = 0;
+  s.sii_word = 0;
+  s.sii_next_category = kSiiHeaderBytes;
+  s.sii_tries_left = config_.retries;
+  s.phase = Phase::SiiStatus;
+  s.deadline = now_ + config_.sii_timeout;
+  slave_phase(s);
+}
+
+void LineBoot::reached(Slave& s) noexcept {
+  s.phase = Phase::Idle;
+  s.report.status = SlaveStatus::Ready;
+  if (s.restart && s.report.target == AlState::Init) {
+    s.restart = false;
+    start_sii(s);
   }
+}
+
+void LineBoot::accept_identities(std::size_t position, std::span<const SiiIdentity> also, bool any) noexcept {
+  if (position >= kMaxSlaves) return;
+  slaves_[position].also = also;
+  slaves_[position].any_identity = any;
+}
+
+bool LineBoot::identity_accepted(const Slave& s, const SiiIdentity& f) const noexcept {
+  if (s.any_identity) return true;
+  const ExpectedSlave& e = expected_[s.report.position];
+  const auto same = [&](std::uint32_t v, std::uint32_t p, std::uint32_t r) {
+    return f.vendor_id == v && f.product_code == p && (r == 0 || f.revision == r);
+  };
+  if (same(e.vendor_id, e.product_code, e.revision)) return true;
+  return std::any_of(s.also.begin(), s.also.end(),
+                     [&](const SiiIdentity& a) { return same(a.vendor_id, a.product_code, a.revision); });
+}
+
+bool LineBoot::restart_slave(std::size_t position, core::TimePoint now) noexcept {
+  if (line_ != LinePhase::Slaves && line_ != LinePhase::Done) return false;
+  if (position >= expected_count_) return false;
+  now_ = now;
+  // A slave missing at the boot (and those before it that were missing too) joins the line.
+  for (std::size_t k = found_; k <= position; ++k) {
+    Slave& m = slaves_[k];
+    m.report = SlaveReport{};
+    m.report.position = static_cast<std::uint16_t>(k);
+    m.report.station = static_cast<std::uint16_t>(config_.first_station + k);
+    m.report.status = SlaveStatus::Failed;
+    m.report.step = BootStep::Address;
+    m.phase = Phase::Idle;
+    m.pending = Pending{};
+  }
+  found_ = std::max(found_, position + 1);
+  Slave& s = slaves_[position];
+  if (s.report.status == SlaveStatus::Busy) return false;
+  s.report.status = SlaveStatus::Busy;
+  s.report.step = BootStep::Address;
+  s.report.text.assign("");
+  s.report.al_code = 0;
+  s.restart = true;
+  s.pending.waiting = false;  // an answer to an earlier datagram of this slave is ignored (seq)
+  s.phase = Phase::Probe;
+  slave_phase(s);
+  if (line_ == LinePhase::Done) line_ = LinePhase::Slaves;
+  return true;
 }
 
 void LineBoot::slave_phase(Slave& s) noexcept {
   const std::uint16_t station = s.report.station;
   switch (s.phase) {
+    case Phase::Probe:
+      set(s.pending, Command::FPRD, physical_address(station, reg::kAlStatus), 2);
+      break;
+    case Phase::Readdress: {
+      // A slave back from power loss has station address 0: give it its station by position
+      // [ETG.1000.4 §5.4 APWR; register 0010h].
+      std::array<std::uint8_t, 2> addr{};
+      put_u16(addr, 0, station);
+      set(s.pending, Command::APWR, physical_address(auto_increment_adp(s.report.position), reg::kStationAddress), 2,
+          addr);
+      break;
+    }
     case Phase::SiiStatus:
     case Phase::SiiBusy:
       set(s.pending, Command::FPRD, physical_address(station, reg::kSiiControl), 2);
@@ -459,10 +529,29 @@ void LineBoot::slave_phase(Slave& s) noexcept {
 
 BootStep LineBoot::step_of(Phase p) noexcept {
   if (p == Phase::Mailbox) return BootStep::Mailbox;
+  if (p == Phase::Probe || p == Phase::Readdress) return BootStep::Address;
   return p >= Phase::AlCheck ? BootStep::Transition : BootStep::Sii;
 }
 
 void LineBoot::slave_answer(Slave& s, const DatagramAnswer& a) noexcept {
+  if (s.phase == Phase::Probe) {
+    // Answered at its station: it kept its address; else re-address it by position.
+    s.phase = a.wkc == 1 ? Phase::Idle : Phase::Readdress;
+    if (a.wkc == 1) {
+      begin_transition(s, AlState::Init);
+    } else {
+      slave_phase(s);
+    }
+    return;
+  }
+  if (s.phase == Phase::Readdress) {
+    if (a.wkc != 1) {
+      fail(s, BootStep::Address, "no answer at position %u (APWR 0x0010 WKC %u)", s.report.position + 1U, a.wkc);
+      return;
+    }
+    begin_transition(s, AlState::Init);
+    return;
+  }
   // Every datagram here addresses one slave by its station address: WKC 1 when it executed it.
   if (a.wkc != 1) {
     fail(s, step_of(s.phase), "%.*s 0x%04X not executed (WKC %u)", static_cast<int>(command_name(a.command).size()),
@@ -529,8 +618,7 @@ void LineBoot::slave_answer(Slave& s, const DatagramAnswer& a) noexcept {
         return;
       }
       if (st.state() == s.report.target) {
-        s.phase = Phase::Idle;
-        s.report.status = SlaveStatus::Ready;
+        reached(s);
         return;
       }
       s.phase = Phase::AlRequest;
@@ -552,8 +640,7 @@ void LineBoot::slave_answer(Slave& s, const DatagramAnswer& a) noexcept {
         return;
       }
       if (st.state() == s.report.target) {  // the target, no error: done
-        s.phase = Phase::Idle;
-        s.report.status = SlaveStatus::Ready;
+        reached(s);
         return;
       }
       slave_phase(s);  // not there yet: poll again (timeout in poll())
@@ -583,8 +670,7 @@ void LineBoot::slave_answer(Slave& s, const DatagramAnswer& a) noexcept {
       }
       // An earlier error acknowledged: go on with the transition.
       if (st.state() == s.report.target) {
-        s.phase = Phase::Idle;
-        s.report.status = SlaveStatus::Ready;
+        reached(s);
       } else if ((s.ack_control & 0x0F) == static_cast<std::uint16_t>(s.report.target)) {
         s.phase = Phase::AlPoll;  // the acknowledge requested the target already (going down)
         slave_phase(s);
@@ -594,6 +680,8 @@ void LineBoot::slave_answer(Slave& s, const DatagramAnswer& a) noexcept {
       }
       return;
     }
+    case Phase::Probe:
+    case Phase::Readdress:
     case Phase::Idle:
       return;
   }
@@ -646,7 +734,7 @@ void LineBoot::identify(Slave& s) noexcept {
     return;
   }
   const ExpectedSlave& e = expected_[s.report.position];
-  if (f.vendor_id != e.vendor_id || f.product_code != e.product_code || (e.revision != 0 && f.revision != e.revision)) {
+  if (!identity_accepted(s, f)) {
     fail(s, BootStep::Identity,
          "identity mismatch: expected vendor 0x%08X product 0x%08X revision 0x%08X, found vendor 0x%08X product "
          "0x%08X revision 0x%08X",

@@ -36,6 +36,12 @@
 // report) can be asked again with request_state(): the error was acknowledged, so no new start()
 // is needed.
 //
+// restart_slave() re-initialises one slave while the others keep running (recovery after it was
+// lost, lost power or left OP): FPRD 0130h at its station; no answer there (a slave back from power
+// loss has station 0) -> APWR 0010h by its position gives the station again [ETG.1000.4 §5.4
+// auto-increment addressing]; then INIT (error acknowledged first), SII, identity, mailbox and
+// PRE-OP exactly as in the boot. The caller resets the slave's CoeSdoClient and configures it again.
+//
 // Each failing slave stops at its step with one sentence, e.g.
 //   "slave 2 (0x1002, ESR TrioDrive): PRE-OP -> SAFE-OP refused: 0x001D invalid output configuration"
 // Slaves are numbered from 1 in texts (slave n = position n - 1, station first_station + n - 1).
@@ -139,6 +145,18 @@ class LineBoot final : public DatagramOwner {
   // earlier step).
   bool request_state(std::size_t position, AlState target, core::TimePoint now) noexcept;
 
+  // Identities accepted at `position` besides the expected one (a device profile that lists
+  // several brandings; revision 0 = any); `any`: every identity is accepted there (a generic
+  // profile: the caller checks the slave further, e.g. its 1000h). The span must outlive the boot.
+  // Call before start().
+  void accept_identities(std::size_t position, std::span<const SiiIdentity> also, bool any = false) noexcept;
+
+  // Re-initialises the slave at `position` (see the header comment) without touching the others.
+  // False when the line steps have not run (status() Idle or Failed), the position is beyond the
+  // configured slaves, or the slave is busy. A position beyond the slaves found at the boot (it
+  // was missing) is taken in, together with the missing ones before it.
+  bool restart_slave(std::size_t position, core::TimePoint now) noexcept;
+
  private:
   // One datagram an actor (the line or a slave) waits for, kept to be sent again when lost.
   struct Pending {
@@ -154,7 +172,7 @@ class LineBoot final : public DatagramOwner {
   };
   enum class LinePhase : std::uint8_t { Idle, Count, Reset, ResetWait, Address, Slaves, Done, Failed };
   enum class Phase : std::uint8_t {
-    Idle, SiiStatus, SiiCommand, SiiBusy, SiiClear, SiiData, Mailbox, AlCheck, AlRequest, AlPoll, AlCode, AlAck, AlAckPoll,
+    Idle, Probe, Readdress, SiiStatus, SiiCommand, SiiBusy, SiiClear, SiiData, Mailbox, AlCheck, AlRequest, AlPoll, AlCode, AlAck, AlAckPoll,
   };
   struct Slave {
     SlaveReport report{};
@@ -166,6 +184,9 @@ class LineBoot final : public DatagramOwner {
     std::uint16_t ack_control = 0;  // AL control written by AlAck
     bool refused = false;           // AlAck acknowledges a refusal (else an error found before the request)
     bool eight_byte_reads = false;
+    bool restart = false;           // restart_slave(): INIT reached -> SII and on
+    std::span<const SiiIdentity> also{};  // accept_identities()
+    bool any_identity = false;
     std::uint32_t sii_word = 0;  // next word address to read
     int sii_tries_left = 0;      // reads of this word given again after an EEPROM error
     std::size_t sii_next_category = 0;  // image offset of the next SII category header to walk
@@ -189,6 +210,9 @@ class LineBoot final : public DatagramOwner {
   [[nodiscard]] static BootStep step_of(Phase p) noexcept;
   void sii_chunk(Slave& s, std::span<const std::uint8_t> data) noexcept;
   void identify(Slave& s) noexcept;
+  void start_sii(Slave& s) noexcept;
+  void reached(Slave& s) noexcept;  // the transition's target reached, no error
+  [[nodiscard]] bool identity_accepted(const Slave& s, const SiiIdentity& f) const noexcept;
   void begin_transition(Slave& s, AlState target) noexcept;
   void acknowledge(Slave& s, AlState state, bool refused) noexcept;  // AlAck with state | 10h
   void fail_refused(Slave& s) noexcept;
