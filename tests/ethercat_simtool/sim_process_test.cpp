@@ -212,6 +212,44 @@ TEST_F(EthercatSimProcess, ConsoleFaultsAsTheMasterSeesThem) {
   EXPECT_EQ(sim_->stop(), 0);
 }
 
+// One drivegate-sim for both bus types of a config: shared verbs go to the bus type that has the
+// target, and a target both have must be named with its bus.
+TEST_F(EthercatSimProcess, ServesACanopenBusBesideTheEthercatLine) {
+  sim_.reset();
+  std::string yaml = test::three_io_config(veth_->a());
+  yaml += R"(  - name: can0
+    type: canopen
+    cycle_time: 4ms
+    options: { transport: udp-multicast, interface: 127.0.0.1, port: 15999 }
+axes:
+  - { name: m1, bus: can0, address: 1, device: kollmorgen-akd, mechanics: { encoder_counts_per_rev: 1048576 } }
+  - { name: m5, bus: can0, address: 5, device: kollmorgen-akd, mechanics: { encoder_counts_per_rev: 1048576 } }
+)";
+  std::ofstream(config_) << yaml;
+  {
+    const NetnsScope in(*ns_b_);
+    sim_ = std::make_unique<SimProcess>(std::vector<std::string>{config_.string(), "--interface", veth_->b()});
+  }
+  EXPECT_EQ(sim_->line(), "drivegate-sim: 3 slaves on ethercat " + veth_->b() + " (bus ec0)") << sim_->error_text();
+  EXPECT_EQ(sim_->line(), "drivegate-sim: 2 nodes on udp-multicast 239.74.163.2:15999");
+  test::TestMaster master(*master_link_);
+  EXPECT_EQ(master.count(3), 3);
+
+  EXPECT_EQ(sim_->command("power-off 5"), "ok power-off node 5");
+  EXPECT_EQ(sim_->command("power-off 3"), "ok power-off ec0:3");
+  EXPECT_EQ(master.count(3), 2);
+  EXPECT_EQ(sim_->command("power-off 1"), "error: 1 is a CANopen node and an EtherCAT position: name it as BUS:1");
+  EXPECT_EQ(sim_->command("power-off ec0:1"), "ok power-off ec0:1");
+  EXPECT_EQ(sim_->command("power-on can0:5"), "ok power-on node 5");
+  EXPECT_EQ(sim_->command("corrupt 1"), "ok corrupt ec0 1");
+  EXPECT_EQ(sim_->command("corrupt 1 ec0"), "ok corrupt ec0 1");
+  EXPECT_EQ(sim_->command("corrupt 1 2"), "ok corrupt node 1");
+  const std::string status = sim_->command("status");
+  EXPECT_EQ(status.rfind("status: can0:1 akd ", 0), 0U) << status;
+  EXPECT_EQ(item(status, "ec0:1"), "ec0:1 generic-io off") << status;
+  EXPECT_EQ(sim_->stop(), 0);
+}
+
 TEST(EthercatSimTool, AnInterfaceItCannotOpenIsNamed) {
   const auto config = write_config("nosuch", test::three_io_config("dgtnosuch0"));
   SimProcess sim({config.string()});
