@@ -1,0 +1,64 @@
+#include "adapters/ethercat/sim/sim_personas.hpp"
+
+#include <stdexcept>
+#include <utility>
+
+#include "adapters/ethercat/sim/generic_io.hpp"
+
+namespace drivegate::ethercat::sim {
+
+PersonaRegistry PersonaRegistry::builtin() {
+  PersonaRegistry r;
+  r.add(std::string(kGenericIoPersona), make_generic_io);
+  // The CiA 402 drives (sim/cia402_slave.hpp) go here, one entry per persona name:
+  //   for (const char* name : {"esr-triodrive", "generic-cia402"})
+  //     r.add(name, [](const SlaveRequest& q) { return make_cia402_parts(q); });
+  // with make_cia402_parts building make_cia402_slave(q.persona, options) and returning
+  // { app, its sii(), its esc_config(), power_on = power_cycle() }.
+  return r;
+}
+
+void PersonaRegistry::add(std::string name, PersonaFactory factory) {
+  for (auto& e : entries_) {
+    if (e.name == name) {
+      e.make = std::move(factory);
+      return;
+    }
+  }
+  entries_.push_back(Entry{std::move(name), std::move(factory)});
+}
+
+const PersonaFactory* PersonaRegistry::find(std::string_view name) const noexcept {
+  for (const auto& e : entries_) {
+    if (e.name == name) return &e.make;
+  }
+  return nullptr;
+}
+
+std::string PersonaRegistry::names() const {
+  std::string s;
+  for (const auto& e : entries_) s += (s.empty() ? "" : ", ") + e.name;
+  return s;
+}
+
+SimSlaveParts make_generic_io(const SlaveRequest& request) {
+  const config::EthercatIoSlave* io = request.io;
+  const int inputs = io != nullptr && io->input_bytes ? *io->input_bytes : kSimIoDefaultBytes;
+  const int outputs = io != nullptr && io->output_bytes ? *io->output_bytes : kSimIoDefaultBytes;
+  // GenericIoSlave's SM2/SM3 sit 100h apart (1000h outputs, 1100h inputs) and its PDOs hold one
+  // entry per byte: at most 256 bytes each way.
+  if (inputs < 0 || inputs > 256 || outputs < 0 || outputs > 256)
+    throw std::invalid_argument(request.name + ": a simulated generic-io slave has 0..256 input and output bytes, got " +
+                                std::to_string(inputs) + " in, " + std::to_string(outputs) + " out");
+  const SiiIdentity identity{io != nullptr && io->vendor_id ? *io->vendor_id : kSimIoVendorId,
+                             io != nullptr && io->product_code ? *io->product_code : kSimIoProductCode, 1,
+                             request.serial};
+  auto app = std::make_unique<GenericIoSlave>(static_cast<std::size_t>(inputs), static_cast<std::size_t>(outputs),
+                                              identity);
+  SimSlaveParts parts;
+  parts.sii.assign(app->sii().begin(), app->sii().end());
+  parts.app = std::move(app);
+  return parts;
+}
+
+}  // namespace drivegate::ethercat::sim
