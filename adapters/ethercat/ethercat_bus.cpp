@@ -1,4 +1,5 @@
 #include "adapters/ethercat/ethercat_bus.hpp"
+#include "adapters/ethercat/sim_transport.hpp"
 
 #include <algorithm>
 #include <map>
@@ -819,10 +820,7 @@ void EthercatBus::close() noexcept {
 
 std::unique_ptr<EthercatBus> make_ethercat_bus(const config::BusPlan& plan) {
   const auto& o = plan.section<config::EthercatBusOptions>();
-  if (o.transport == config::EthercatTransportKind::Simulated)
-    throw core::BusError("bus '" + plan.name +
-                         "': transport sim is not yet available in this build (the simulated EtherCAT line is made by "
-                         "drivegate-sim's line builder)");
+  if (o.transport == config::EthercatTransportKind::Simulated) return make_simulated_ethercat_bus(plan);
   RawSocketOptions r;
   r.interface = o.interface;
   return std::make_unique<EthercatBus>(plan, std::make_unique<RawSocketLink>(std::move(r)));

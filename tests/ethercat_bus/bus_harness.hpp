@@ -84,6 +84,17 @@ struct EcatHarness {
     events.reserve(4096);
   }
 
+  // The bus as the daemon makes it: the type's make_bus (transport sim: the line from the
+  // profiles' personas, inside the bus).
+  void make_from_factory() {
+    const auto& bp = plan.buses.at(0);
+    for (const auto& a : bp.axes) specs.push_back(a.spec);
+    std::unique_ptr<core::Bus> made = bp.type_info->make_bus(bp);
+    bus.reset(dynamic_cast<EthercatBus*>(made.release()));
+    runner = std::make_unique<core::BusRunner>(*bus, specs);
+    bus->open(now);
+  }
+
   core::AxisIndex axis(const std::string& name) const {
     for (std::size_t i = 0; i < specs.size(); ++i)
       if (specs[i].name == name) return static_cast<core::AxisIndex>(i);

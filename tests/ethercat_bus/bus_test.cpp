@@ -23,6 +23,19 @@ TEST(EthercatBus, ReachesOpWithTheAxesDisabled) {
   EXPECT_EQ(h.bus->link_detail(h.axis("esr")), "slave 1 (0x1001, ESR TrioDrive D/ES): in OP");
 }
 
+// `transport: sim` as the daemon builds it: the line made from the profiles' personas (the ESR,
+// the `io:` panel, the generic drive) comes up, and a drive enables.
+TEST(EthercatBus, TransportSimMakesTheLineFromTheProfiles) {
+  EcatHarness h(kLine, false);
+  h.make_from_factory();
+  ASSERT_TRUE(h.run_until([&] { return h.all_up(); }, 5s)) << h.details() << h.events_text();
+  EXPECT_EQ(h.bus->link_detail(h.axis("esr")), "slave 1 (0x1001, ESR TrioDrive D/ES): in OP");
+  EXPECT_EQ(h.snap("gen").state, AxisState::SwitchOnDisabled);
+  const auto id = h.push("gen", CommandKind::Enable);
+  ASSERT_EQ(h.wait_final(id, 3s), ReplyStatus::Completed) << h.reason(id) << h.events_text();
+  EXPECT_EQ(h.snap("gen").state, AxisState::OperationEnabled);
+}
+
 }  // namespace
 }  // namespace drivegate::ethercat::test
 

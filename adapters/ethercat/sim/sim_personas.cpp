@@ -3,18 +3,36 @@
 #include <stdexcept>
 #include <utility>
 
+#include "adapters/ethercat/sim/cia402_slave.hpp"
 #include "adapters/ethercat/sim/generic_io.hpp"
+#include "adapters/sim/sim_bus.hpp"
 
 namespace drivegate::ethercat::sim {
+
+namespace {
+
+SimSlaveParts make_cia402_parts(const SlaveRequest& q) {
+  Cia402SlaveOptions options;
+  options.serial = q.serial;
+  if (!q.axes.empty()) options.drive = drivegate::sim::drive_config_for(*q.axes.front());
+  auto app = make_cia402_slave(q.persona, options);
+  Cia402Slave* p = app.get();
+  SimSlaveParts parts;
+  parts.sii.assign(p->sii().begin(), p->sii().end());
+  parts.esc = p->esc_config();
+  parts.power_on = [p] { p->power_cycle(); };
+  parts.app = std::move(app);
+  return parts;
+}
+
+}  // namespace
 
 PersonaRegistry PersonaRegistry::builtin() {
   PersonaRegistry r;
   r.add(std::string(kGenericIoPersona), make_generic_io);
-  // The CiA 402 drives (sim/cia402_slave.hpp) go here, one entry per persona name:
-  //   for (const char* name : {"esr-triodrive", "generic-cia402"})
-  //     r.add(name, [](const SlaveRequest& q) { return make_cia402_parts(q); });
-  // with make_cia402_parts building make_cia402_slave(q.persona, options) and returning
-  // { app, its sii(), its esc_config(), power_on = power_cycle() }.
+  // The CiA 402 drives (sim/cia402_slave.hpp), with the first axis' mechanics.
+  for (const char* name : {"esr-triodrive", "generic-cia402"})
+    r.add(name, make_cia402_parts);
   return r;
 }
 

@@ -50,7 +50,6 @@
 #include "adapters/ethercat/sim/line_builder.hpp"
 #include "adapters/ethercat/sim/line_console.hpp"
 #include "adapters/ethercat/sim/sim_endpoint.hpp"
-#include "config/ethercat/bus_type.hpp"
 #include "config/ethercat/plan.hpp"
 #include "config/loader.hpp"
 
@@ -400,22 +399,6 @@ int usage() {
   return 2;
 }
 
-// The config's bus types for the simulator. The ethercat type has no adapter in this build yet, so
-// the loader would refuse its buses ("has no adapter in this build"); the simulator never makes the
-// gateway's bus, so a stand-in factory makes the type available here. Remove this once the
-// ethercat adapter registers its make_bus (daemon/bus_types.cpp).
-config::LoadOptions load_options() {
-  config::LoadOptions o;
-  if (const auto t = o.bus_types.find("ethercat"); t == nullptr || !t->available()) {
-    config::BusTypeInfo e = config::ethercat_bus_type();
-    e.make_bus = [](const config::BusPlan&) -> std::unique_ptr<core::Bus> {
-      throw core::BusError("drivegate-sim does not run a gateway's ethercat bus");
-    };
-    o.bus_types.add(std::move(e));
-  }
-  return o;
-}
-
 // The interface a --interface option names for `bus` ("BUS=IFACE" first, then a bare "IFACE").
 std::string interface_for(const std::string& bus, const std::vector<std::string>& options, const std::string& fallback) {
   for (const auto& o : options) {
@@ -448,7 +431,7 @@ int run(int argc, char** argv) {
   }
   if (file.empty()) return usage();
 
-  const config::Plan plan = config::load_plan(file, load_options());
+  const config::Plan plan = config::load_plan(file);
   std::vector<SimBus> buses;
   std::vector<EcatBus> ecat;
   std::vector<std::string> ready;
