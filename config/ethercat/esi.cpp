@@ -455,7 +455,22 @@ class Parser {
     return type.bits;
   }
 
+  // Whether the object being expanded, or the device's dictionary, is full (after one error).
+  [[nodiscard]] bool full() const noexcept { return object_full_ || device_full_; }
+
   void add(EsiObject o, const XMLElement* at, const std::string& path, const Resolved& type) {
+    // A record or array has at most 256 sub-indices; more entries can only come from a file that
+    // expands a type without end, and must not exhaust memory.
+    if (++object_entries_ > 256) {
+      object_full_ = true;
+      error(at, path, "gives object " + hex_index(o.id.index) + " more than 256 sub-indices");
+      return;
+    }
+    if (out_->objects.size() >= kMaxEsiEntries) {
+      device_full_ = true;
+      error(object_at_, object_path_, "the dictionary has more than " + std::to_string(kMaxEsiEntries) + " entries");
+      return;
+    }
     if (!type.known)
       warning(at, path,
               "Type " + in_quotes(o.type) + " is neither an ETG base type nor in DataTypes; its size is taken from BitSize");
@@ -465,6 +480,7 @@ class Parser {
 
   void read_dictionary(const XMLElement* dictionary, const std::string& path, EsiDevice& dev) {
     out_ = &dev;
+    device_full_ = false;
     data_types_.clear();
     if (const XMLElement* types = dictionary->FirstChildElement("DataTypes"))
       for (const XMLElement* t = types->FirstChildElement("DataType"); t != nullptr; t = t->NextSiblingElement("DataType")) {
@@ -475,8 +491,14 @@ class Parser {
     dev.has_dictionary = objects != nullptr;
     int position = 0;
     for (const XMLElement* o = objects ? objects->FirstChildElement("Object") : nullptr; o != nullptr;
-         o = o->NextSiblingElement("Object"))
-      object(o, child_path(child_path(path, "Objects"), "Object", ++position));
+         o = o->NextSiblingElement("Object")) {
+      object_entries_ = 0;
+      object_full_ = false;
+      object_at_ = o;
+      object_path_ = child_path(child_path(path, "Objects"), "Object", ++position);
+      object(o, object_path_);
+      if (device_full_) break;
+    }
     auto& list = dev.objects;
     std::stable_sort(list.begin(), list.end(), [](const EsiObject& a, const EsiObject& b) { return a.id.key() < b.id.key(); });
     for (std::size_t i = 1; i < list.size(); ++i)
@@ -548,7 +570,7 @@ class Parser {
         if (const auto total = parse_esi_number(text_of(arr->FirstChildElement("BitSize"))))
           bits = static_cast<int>(*total / *elements);
       const std::uint64_t start = first.value_or(lbound.value_or(1));
-      for (std::uint64_t i = 0; i < *elements; ++i, ++flat) {
+      for (std::uint64_t i = 0; i < *elements && !full(); ++i, ++flat) {
         if (start + i > 0xFF) {
           error(arr, apath, "has elements beyond sub-index 255");
           return;
@@ -578,7 +600,7 @@ class Parser {
       return;
     }
     int position = 0;
-    for (const XMLElement* s = dt->FirstChildElement("SubItem"); s != nullptr; s = s->NextSiblingElement("SubItem")) {
+    for (const XMLElement* s = dt->FirstChildElement("SubItem"); s != nullptr && !full(); s = s->NextSiblingElement("SubItem")) {
       const std::string spath = tpath + "/SubItem[" + std::to_string(++position) + "]";
       const Flags f = flags(s->FirstChildElement("Flags"), child_path(spath, "Flags"), object_flags);
       const std::string stype = trimmed(s->FirstChildElement("Type"));
@@ -616,6 +638,12 @@ class Parser {
     }
   }
 
+  static std::string hex_index(std::uint16_t index) {
+    char buf[8];
+    std::snprintf(buf, sizeof buf, "%04Xh", unsigned{index});
+    return buf;
+  }
+
   static std::string object_name(const EsiObject& o) { return id_text(o.id) + " " + in_quotes(o.name); }
 
   std::string label_;
@@ -624,6 +652,11 @@ class Parser {
   std::size_t warnings_ = 0;
   std::map<std::string, const XMLElement*> data_types_;
   EsiDevice* out_ = nullptr;
+  const XMLElement* object_at_ = nullptr;  // the object being expanded
+  std::string object_path_;
+  std::size_t object_entries_ = 0;  // its entries
+  bool object_full_ = false;
+  bool device_full_ = false;
 };
 
 }  // namespace

@@ -140,6 +140,8 @@ struct EsiFile {
 
 // Vendors' ESI files run to many megabytes (one file per terminal family); larger ones are refused.
 inline constexpr std::uint64_t kMaxEsiBytes = 64 * 1024 * 1024;
+// Dictionary entries (objects and sub-indices) per device: real devices have a few thousand.
+inline constexpr std::size_t kMaxEsiEntries = 65536;
 // Warnings reported per file; the rest are counted in one last warning.
 inline constexpr std::size_t kMaxEsiWarnings = 50;
 

@@ -436,6 +436,28 @@ TEST(Esi, DictionaryErrorsAreExact) {
             "t.xml:4:1: DataType \"A\"/ArrayInfo: has no Elements\n");
 }
 
+TEST(Esi, ExpansionIsBoundedPerObjectAndPerDevice) {
+  // Two arrays of 200 elements in one record: sub-indices repeat, and past 256 entries it stops.
+  const std::string arr = "<DataType><Name>A</Name><BaseType>UINT</BaseType><ArrayInfo><LBound>1</LBound>"
+                          "<Elements>200</Elements></ArrayInfo></DataType>";
+  EXPECT_EQ(parse(dictionary(arr + "<DataType><Name>R</Name><SubItem><Name>a</Name><Type>A</Type></SubItem>"
+                                   "<SubItem><Name>b</Name><Type>A</Type></SubItem></DataType>",
+                             "<Object><Index>#x2000</Index><Type>R</Type></Object>"))
+                .errors,
+            "t.xml:3:1: DataType \"A\": gives object 2000h more than 256 sub-indices\n");
+  // 258 objects of 256 entries each: the device's dictionary stops at kMaxEsiEntries.
+  std::string objects;
+  for (int i = 0; i < 258; ++i)
+    objects += "<Object><Index>" + std::to_string(0x2000 + i) + "</Index><Type>R</Type></Object>";
+  const std::string full = "<DataType><Name>F</Name><BaseType>UINT</BaseType><ArrayInfo><LBound>1</LBound>"
+                           "<Elements>255</Elements></ArrayInfo></DataType><DataType><Name>R</Name><SubItem><SubIdx>0"
+                           "</SubIdx><Name>n</Name><Type>USINT</Type></SubItem><SubItem><Name>e</Name><Type>F</Type>"
+                           "</SubItem></DataType>";
+  EXPECT_EQ(parse(dictionary(full, objects)).errors,
+            "t.xml:4:1: Device[1]/Profile[1]/Dictionary/Objects/Object[257]: the dictionary has more than 65536 "
+            "entries\n");
+}
+
 TEST(Esi, OdditiesOfOtherToolsAreWarnings) {
   const Outcome o = parse(dictionary(
       // a cycle of aliases, which ends as an unknown type
