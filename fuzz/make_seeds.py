@@ -9,6 +9,8 @@ can_engines:   frame records (format in fuzz_can_engines.cpp) for each persona: 
                heartbeat, guarding RTR, EMCY, PDO.
 eds:           copies of tests/config/devices/akd-canopen.eds and of the EDS test corpus
                tests/config/eds/*.eds (number forms, data types, CompactSubObj, a file in the wild).
+esi:           copies of the ESI test files tests/config/esi/*.xml (a drive, a DC drive, I/O terminals)
+               and a few small malformed ones.
 config:        a copy of config/demo.yaml.
 ethercat_frame:   EtherCAT frames (ETG.1000.4 §5 layout): one APRD, a multi-datagram frame, a
                   VLAN-tagged frame, a cyclic LRW + FRMW frame, a frame with C bit, truncated ones.
@@ -106,6 +108,21 @@ def copies():
     shutil.copy(ROOT / "tests/config/devices/akd-canopen.eds", d / "akd-canopen.eds")
     for eds in sorted((ROOT / "tests/config/eds").glob("*.eds")):
         shutil.copy(eds, d / eds.name)
+    d = CORPUS / "esi"
+    d.mkdir(parents=True, exist_ok=True)
+    for esi in sorted((ROOT / "tests/config/esi").glob("*.xml")):
+        shutil.copy(esi, d / esi.name)
+    (d / "unclosed.xml").write_text("<EtherCATInfo><Vendor><Id>#x2</Id></Vendor>\n<Descriptions>")
+    (d / "alias-cycle.xml").write_text(
+        "<EtherCATInfo><Vendor><Id>2</Id></Vendor><Descriptions><Devices><Device><Type ProductCode=\"1\"/>"
+        "<Profile><Dictionary><DataTypes><DataType><Name>A</Name><BaseType>B</BaseType></DataType>"
+        "<DataType><Name>B</Name><BaseType>A</BaseType></DataType><DataType><Name>R</Name>"
+        "<SubItem><SubIdx>0</SubIdx><Name>n</Name><Type>A</Type><BitSize>8</BitSize></SubItem>"
+        "<SubItem><Name>E</Name><Type>ARR</Type></SubItem></DataType><DataType><Name>ARR</Name>"
+        "<BaseType>UINT</BaseType><ArrayInfo><LBound>1</LBound><Elements>3</Elements></ArrayInfo></DataType>"
+        "</DataTypes><Objects><Object><Index>#x2000</Index><Name>r</Name><Type>R</Type></Object>"
+        "<Object><Index>#x2001</Index><Name>a</Name><Type>A</Type><BitSize>16</BitSize></Object>"
+        "</Objects></Dictionary></Profile></Device></Devices></Descriptions></EtherCATInfo>\n")
     d = CORPUS / "config"
     d.mkdir(parents=True, exist_ok=True)
     shutil.copy(ROOT / "config/demo.yaml", d / "demo.yaml")

@@ -7,6 +7,7 @@ PACKAGES=(
   build-essential cmake pkg-config       # toolchain
   libfastrtps-dev libfastcdr-dev fastddsgen  # Fast DDS and its IDL code generator
   libyaml-cpp-dev                        # configuration files
+  libtinyxml2-dev                        # EtherCAT ESI files (XML) given for slaves
   libspdlog-dev                          # logging
   googletest libgtest-dev                # unit and integration tests
   libsystemd-dev systemd                 # sd_notify; systemd-analyze verifies the unit in tests

@@ -3,11 +3,12 @@
 #include <map>
 
 #include "config/ethercat/bus_options.hpp"
+#include "config/ethercat/esi_checks.hpp"
 
 namespace drivegate::config {
 
 void read_ethercat_axis(const MapReader& axis, const BusPlan& bus, const DeviceProfile* device,
-                        const std::filesystem::path& /*base_dir*/, AxisPlan& a) {
+                        const std::filesystem::path& base_dir, AxisPlan& a) {
   if (device && !device->has_section<EthercatDeviceSpec>()) {
     axis.error("device", "device profile \"" + device->name + "\" has no ethercat section, which an axis on an "
                          "ethercat bus needs (profiles/devices/README.md \"EtherCAT\")");
@@ -15,7 +16,7 @@ void read_ethercat_axis(const MapReader& axis, const BusPlan& bus, const DeviceP
   }
   auto& ax = a.sections.edit<EthercatAxisSpec>();
   const MapReader c = axis.map("ethercat", Need::Optional);
-  c.check_keys({"axis"});
+  c.check_keys({"axis", "esi"});
   const int axes = device ? device->section<EthercatDeviceSpec>().axes : 1;
   if (const auto n = c.integer("axis", Need::Optional, 0, 7, "an axis index of the slave (0 = its first)")) {
     if (*n >= axes)
@@ -24,6 +25,16 @@ void read_ethercat_axis(const MapReader& axis, const BusPlan& bus, const DeviceP
                           std::to_string(*n));
     else
       ax.slave_axis = static_cast<int>(*n);
+  }
+  // The ESI's problems go to the same Problems with its file name, so into Plan::warnings and
+  // --check-config.
+  if (const auto esi = read_esi_key(c, base_dir, ax.esi); esi && device) {
+    const std::string esi_name = "ESI \"" + std::filesystem::path{ax.esi}.filename().string() + "\"";
+    if (const EsiDevice* dev = pick_esi_device(c, *esi, esi_name, *device)) {
+      ax.esi_device = esi_device_text(*dev);
+      check_device_against_esi(c, *device, ax.slave_axis, esi_name, *dev);
+      ax.esi_objects = dev->objects;
+    }
   }
   if (device && device->section<EthercatDeviceSpec>().distributed_clocks &&
       !bus.section<EthercatBusOptions>().distributed_clocks)

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <set>
 
+#include "config/ethercat/esi_checks.hpp"
 #include "config/scalars.hpp"
 #include "config/text_util.hpp"
 
@@ -37,7 +38,7 @@ void read_io(const MapReader& b, EthercatBusOptions& c) {
   for (std::size_t i = 0; i < list->size(); ++i) {
     const MapReader m{(*list)[i], indexed(b.field("io"), i), b.source()};
     if (!m.present()) continue;
-    m.check_keys({"name", "position", "vendor_id", "product_code", "inputs", "outputs"});
+    m.check_keys({"name", "position", "vendor_id", "product_code", "inputs", "outputs", "esi"});
     EthercatIoSlave s;
     s.name = m.name("name", Need::Required).value_or("");
     s.position = static_cast<int>(m.integer("position", Need::Required, 1, 65535, "a position on the line (1 = next to the gateway)").value_or(0));
@@ -49,6 +50,10 @@ void read_io(const MapReader& b, EthercatBusOptions& c) {
     if (!s.name.empty() && !names.insert(s.name).second) m.error("name", "I/O slave \"" + s.name + "\" is listed twice");
     if (s.position != 0 && !positions.insert(s.position).second)
       m.error("position", "position " + std::to_string(s.position) + " is given to two I/O slaves");
+    // Relative to the configuration file, like every file it names.
+    const std::filesystem::path base_dir = std::filesystem::absolute(std::filesystem::path{b.source().file}).parent_path();
+    if (const auto esi = read_esi_key(m, base_dir, s.esi))
+      check_io_slave_against_esi(m, *esi, "ESI \"" + std::filesystem::path{s.esi}.filename().string() + "\"", s);
     c.io.push_back(std::move(s));
   }
 }

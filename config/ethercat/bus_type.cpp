@@ -3,6 +3,7 @@
 #include "config/ethercat/axis_section.hpp"
 #include "config/ethercat/bus_options.hpp"
 #include "config/ethercat/device_section.hpp"
+#include "config/ethercat/parameters.hpp"
 
 namespace drivegate::config {
 
@@ -42,6 +43,7 @@ BusTypeInfo ethercat_bus_type() {
   t.mapped_objects = ethercat_mapped_objects;
   t.check_bus = {check_ethercat_slaves};
   t.resource = resource;
+  t.find_parameter = find_ethercat_parameter;
   return t;
 }
 

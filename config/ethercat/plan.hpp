@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "config/canopen/plan.hpp"  // PdoEntrySpec, StartupWrite: CoE shares CANopen's objects
+#include "config/ethercat/esi.hpp"
 #include "core/clock.hpp"
 #include "profiles/cia402/objects.hpp"
 
@@ -71,6 +72,8 @@ struct EthercatIoSlave {
   std::optional<std::uint32_t> product_code;
   std::optional<int> input_bytes;   // slave -> master
   std::optional<int> output_bytes;  // master -> slave
+  std::string esi;         // an ESI file for the slave (absolute path), empty: none
+  std::string esi_device;  // the ESI device it was checked against (esi_device_text), empty: none
 };
 
 struct EthercatBusOptions {
@@ -91,6 +94,10 @@ struct EthercatBusOptions {
 struct EthercatAxisSpec {
   int slave_axis = 0;  // which axis of a multi-axis slave (objects + slave_axis x axis_offset)
   std::string esi;     // an ESI file for the slave (absolute path), empty: none
+  std::string esi_device;  // the ESI device the axis' device was checked against (esi_device_text)
+  // The ESI device's dictionary (empty without an ESI or when it has none): parameter names and
+  // types (find_esi_object), like CanopenAxisOptions::eds_objects.
+  std::vector<EsiObject> esi_objects;
 };
 
 }  // namespace drivegate::config

@@ -101,7 +101,7 @@ buses:
   EXPECT_REPORTED(e, "buses[0].options.boot_retry_max: must not be shorter than boot_retry (20s), got 10s");
   EXPECT_REPORTED(e, "buses[0].io[1].name: I/O slave \"a\" is listed twice");
   EXPECT_REPORTED(e, "buses[0].io[1].position: position 4 is given to two I/O slaves");
-  EXPECT_REPORTED(e, "buses[0].io[1].colour: unknown field (allowed: name, position, vendor_id, product_code, inputs, outputs)");
+  EXPECT_REPORTED(e, "buses[0].io[1].colour: unknown field (allowed: name, position, vendor_id, product_code, inputs, outputs, esi)");
   EXPECT_REPORTED(e, "buses[1].cycle_time: must be a duration in 125us..100ms");
   EXPECT_REPORTED(e, "buses[1].options.sm_watchdog: must be a multiple of 100us (the watchdog counts 100us steps), got 10050us");
 }
@@ -122,12 +122,12 @@ axes:
   - { name: a, bus: ec0, address: 1, device: generic-cia402, mechanics: { encoder_counts_per_rev: 4096 } }
   - { name: b, bus: ec0, address: 1, device: generic-cia402, mechanics: { encoder_counts_per_rev: 4096 } }
   - { name: c, bus: ec0, address: 2, device: generic-cia402, mechanics: { encoder_counts_per_rev: 4096 }, ethercat: { axis: 1 } }
-  - { name: d, bus: ec0, address: 3, device: esr-triodrive, mechanics: { encoder_counts_per_rev: 4096 }, ethercat: { axis: 0, esi: x.xml } }
+  - { name: d, bus: ec0, address: 3, device: esr-triodrive, mechanics: { encoder_counts_per_rev: 4096 }, ethercat: { axis: 0, colour: red } }
 )";
   const std::string e = errors_of(yaml, options());
   EXPECT_REPORTED(e, "axes[1].address: axis \"b\": position 1 on bus \"ec0\" is already used by axes[0].address (axis \"a\")");
   EXPECT_REPORTED(e, "axes[2].ethercat.axis: device \"generic-cia402\" carries 1 axis per slave (0..0), got 1");
-  EXPECT_REPORTED(e, "axes[3].ethercat.esi: unknown field (allowed: axis)");
+  EXPECT_REPORTED(e, "axes[3].ethercat.colour: unknown field (allowed: axis, esi)");
   EXPECT_REPORTED(e, "I/O slave \"panel\" is at position 2, where axis \"c\" is");
 }
 
