@@ -3,6 +3,8 @@
 // stops and disables every axis before exiting.
 #include <algorithm>
 #include <atomic>
+#include <cmath>
+#include <map>
 #include <chrono>
 #include <cstdio>
 #include <condition_variable>
@@ -30,12 +32,15 @@ constexpr const char* kUsage =
     "                      [--x AXIS] [--y AXIS] [--spindle AXIS] [--turntable AXIS]\n"
     "                      [--spindle-speed V] [--jog-seconds S] [--plain]\n"
     "Enables the demo axes, homes the turntable, moves x and y, moves the CANopen drives akd, nord\n"
-    "and sd6 out and back, jogs the spindle, then stops and disables everything. Axis names default\n"
+    "and sd6 and the EtherCAT drives esr and servo out and back, streams a stroke to esr (ip) and\n"
+    "servo (csp), jogs the spindle, then stops and disables everything. Axis names default\n"
     "to those of demo.yaml (x, y, spindle, turntable); axes that no gateway offers are skipped.\n"
     "--plain prints step lines without the live table.\n";
 
 // Keep-alive rate for the spindle jog: several times what a typical command timeout needs.
 constexpr auto kKeepAlivePeriod = std::chrono::milliseconds(50);
+// Streamed set-points (ip, csp): the gateway holds the last one until the next arrives.
+constexpr auto kStreamPeriod = std::chrono::milliseconds(10);
 
 class Demo {
  public:
@@ -115,6 +120,68 @@ class Demo {
     const auto s = client_.send(stop, true, timeout_);
     log("stop " + axis + ": " + std::string(to_string(s.outcome)) + (s.reason.empty() ? "" : " (" + s.reason + ")"));
     return s.ok() && !interrupted();
+  }
+
+  // Streamed set-points: each axis in its cyclic `mode` (ip, csp) follows one raised-cosine stroke
+  // of `stroke` (its unit) out and back over `seconds`, a set-point every kStreamPeriod, then
+  // stands where it started.
+  bool stream(const std::vector<std::pair<std::string, double>>& strokes, const std::string& mode, double seconds) {
+    if (interrupted() || strokes.empty()) return !interrupted();
+    std::map<std::string, std::string> gateway_of;
+    std::map<std::string, double> start;
+    for (const auto& [axis, stroke] : strokes) {
+      CommandRequest req;
+      req.axis = axis;
+      req.gateway = gateway_;
+      req.kind = "set_mode";
+      req.mode = mode;
+      const auto r = client_.send(req, true, timeout_);
+      log("mode " + mode + " " + axis + ": " + std::string(to_string(r.outcome)) + (r.reason.empty() ? "" : " (" + r.reason + ")"));
+      if (!r.ok()) return false;
+      gateway_of[axis] = r.gateway;
+      for (const auto& st : client_.states())
+        if (st.axis == axis && st.gateway == r.gateway) start[axis] = st.position;
+    }
+    const auto t0 = SteadyClock::now();
+    auto next = t0;
+    for (;;) {
+      if (interrupted()) return false;
+      const double t = std::min(std::chrono::duration<double>(SteadyClock::now() - t0).count(), seconds);
+      const double shape = 0.5 * (1.0 - std::cos(2.0 * 3.141592653589793 * t / seconds));
+      for (const auto& [axis, stroke] : strokes) {
+        const auto error = client_.stream_setpoint(axis, gateway_of[axis], start[axis] + stroke * shape, 0, 0);
+        if (!error.empty()) {
+          log("stream " + axis + ": " + error);
+          return false;
+        }
+      }
+      if (t >= seconds) break;
+      next += kStreamPeriod;
+      std::this_thread::sleep_until(next);
+    }
+    // Stopped and back in profile position before the stream falls silent: a cyclic mode without
+    // set-points runs into the axis' command timeout (a quick stop), and a set-point still on its
+    // way when the stop was taken would restart the stream.
+    bool ok = true;
+    for (const auto& [axis, stroke] : strokes) {
+      CommandRequest req;
+      req.axis = axis;
+      req.gateway = gateway_of[axis];
+      req.kind = "stop";
+      ok = step(mode + " stroke done, stop " + axis, req) && ok;
+      // The drive settles on its last interpolation period; profile position is taken at rest.
+      client_.wait_until(
+          [&] {
+            for (const auto& st : client_.states())
+              if (st.axis == axis && st.gateway == req.gateway) return st.velocity == 0.0;
+            return false;
+          },
+          timeout_);
+      req.kind = "set_mode";
+      req.mode = "pp";
+      ok = ok && step("mode pp " + axis, req);
+    }
+    return ok;
   }
 
   // Safe end, also after Ctrl-C: stop and disable every axis we touched, whatever happened before.
@@ -217,9 +284,10 @@ int run(int argc, char** argv) {
       std::cerr << "drivegate-demo: skipping axis '" << a << "': " << client.route(a, gateway).error << "\n";
     }
   }
-  // The CANopen drives of the demo config, each moved out and back (in its own unit).
-  const std::vector<std::pair<std::string, double>> canopen_moves{{"akd", 20}, {"nord", 3}, {"sd6", 2}};
-  for (const auto& [a, distance] : canopen_moves)
+  // The CANopen and EtherCAT drives of the demo config, each moved out and back (in its own unit).
+  const std::vector<std::pair<std::string, double>> fieldbus_moves{
+      {"akd", 20}, {"nord", 3}, {"sd6", 2}, {"esr", 5}, {"servo", 30}};
+  for (const auto& [a, distance] : fieldbus_moves)
     if (offered(a)) axes.push_back(a);
   if (axes.empty()) {
     std::cerr << "drivegate-demo: none of the demo axes is available\n";
@@ -244,10 +312,14 @@ int run(int argc, char** argv) {
   }
   for (const double scale : {1.0, 0.0}) {
     std::vector<CommandRequest> moves;
-    for (const auto& [a, distance] : canopen_moves)
+    for (const auto& [a, distance] : fieldbus_moves)
       if (has(a)) moves.push_back(move(a, scale * distance));
     if (ok && !moves.empty()) ok = demo.together("move", moves);
   }
+  // The EtherCAT drives on streamed set-points: the ESR in interpolated position (its only cyclic
+  // position mode), the generic servo in cyclic synchronous position.
+  if (ok && has("esr")) ok = demo.stream({{"esr", 3}}, "ip", 2.0);
+  if (ok && has("servo")) ok = demo.stream({{"servo", 20}}, "csp", 2.0);
   if (ok && has(spindle)) ok = demo.jog(spindle, speed, jog_seconds);
   if (interrupted()) demo.log("interrupted: disabling all axes");
   demo.shut_down(axes);
