@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include "config/canopen/plan.hpp"
+#include "config/ethercat/plan.hpp"
 #include "config/sim/plan.hpp"
 #include "config/describe.hpp"
 #include "config/loader.hpp"
@@ -144,7 +145,7 @@ TEST(LoadValid, FixedDeviceUnitsAndDefaults) {
 TEST(LoadValid, DemoConfigLoads) {
   const Plan plan = load_plan(DRIVEGATE_DEMO_CONFIG);
   EXPECT_TRUE(plan.warnings.empty());
-  ASSERT_EQ(plan.buses.size(), 2U);
+  ASSERT_EQ(plan.buses.size(), 3U);
   const BusPlan& bus = plan.buses[0];
   EXPECT_EQ(bus.type, "sim");
   EXPECT_EQ(bus.cycle_time, core::Duration{1ms});
@@ -177,6 +178,17 @@ TEST(LoadValid, DemoConfigLoads) {
   EXPECT_EQ(can.axes[0].device.name, "kollmorgen-akd");
   EXPECT_EQ(can.axes[1].device.name, "nord-sk500p");
   EXPECT_EQ(can.axes[2].device.name, "stoeber-sd6");
+
+  // The EtherCAT line: an ESR TrioDrive, an I/O slave and a generic servo, simulated in-process.
+  const BusPlan& ec = plan.buses[2];
+  EXPECT_EQ(ec.type, "ethercat");
+  EXPECT_EQ(ec.section<EthercatBusOptions>().transport, EthercatTransportKind::Simulated);
+  ASSERT_EQ(ec.section<EthercatBusOptions>().io.size(), 1U);
+  EXPECT_EQ(ec.section<EthercatBusOptions>().io[0].position, 2);
+  ASSERT_EQ(ec.axes.size(), 2U);
+  EXPECT_EQ(ec.axes[0].device.name, "esr-triodrive");
+  EXPECT_EQ(ec.axes[1].device.name, "generic-cia402");
+  EXPECT_EQ(ec.axes[1].address, 3);
 }
 
 TEST(LoadValid, DescribePlanShowsTheImportantNumbers) {
