@@ -13,6 +13,7 @@
 #include "adapters/ethercat/sim/esc_slave.hpp"
 #include "adapters/ethercat/sim/generic_io.hpp"
 #include "adapters/ethercat/sim/sim_line.hpp"
+#include "tests/ethercat_sim/line_exchange.hpp"
 
 namespace drivegate::ethercat {
 namespace {
@@ -33,14 +34,7 @@ struct IoLine {
   }
   void cycle(LineBoot& boot) {
     boot.poll(now, tx);
-    line.set_time(static_cast<std::uint64_t>(core::to_ns(now)));
-    for (const auto& f : tx.take_frames(now + 1ms)) {
-      link.send(FrameView(f.data(), f.size()));
-      std::array<FrameBuffer, 1> rx;
-      if (link.receive(rx) == 1) tx.on_frame(rx[0].view());
-    }
-    now += 1ms;
-    tx.expire(now);
+    drivegate::ethercat::test::exchange_over_line(tx, link, line, now);
   }
   void run(LineBoot& boot) {
     for (int i = 0; i < 5000 && boot.status() == LineStatus::Running; ++i) cycle(boot);

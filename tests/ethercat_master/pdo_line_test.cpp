@@ -134,7 +134,7 @@ TEST(PdoLine, BootMapSafeOpCyclicOpAndAPoweredOffSlave) {
 
   // Zero allocations per cycle: the exchange, Transactions, the link and the simulated line.
   {
-    const test::AllocationScope scope;
+    const drivegate::test::AllocationScope scope;
     b.cycles(cx, 100);
     EXPECT_EQ(scope.count(), 0U);
   }

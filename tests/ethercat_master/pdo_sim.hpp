@@ -21,6 +21,7 @@
 #include "adapters/ethercat/sim/sim_line.hpp"
 #include "core/bytes.hpp"
 #include "core/clock.hpp"
+#include "tests/ethercat_sim/line_exchange.hpp"
 
 namespace drivegate::ethercat::pdo_test {
 
@@ -208,14 +209,7 @@ struct PdoLine {
     poll(now);
     if (boot) boot->poll(now, tx);
     for (auto& c : clients) c->poll(now, tx);
-    line.set_time(static_cast<std::uint64_t>(core::to_ns(now)));
-    for (const auto& f : tx.take_frames(now + 1ms)) {
-      link.send(FrameView(f.data(), f.size()));
-      std::array<FrameBuffer, 1> rx;
-      if (link.receive(rx) == 1) tx.on_frame(rx[0].view());
-    }
-    now += 1ms;
-    tx.expire(now);
+    drivegate::ethercat::test::exchange_over_line(tx, link, line, now);
   }
   void cycle() {
     cycle([](core::TimePoint) {});

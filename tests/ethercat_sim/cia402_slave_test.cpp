@@ -16,6 +16,7 @@
 #include "core/clock.hpp"
 #include "tests/ethercat_sim/drive_line.hpp"
 #include "tests/support/alloc_counter.hpp"
+#include "tests/ethercat_sim/line_exchange.hpp"
 
 namespace drivegate::ethercat::sim {
 namespace {
@@ -574,14 +575,7 @@ TEST(EthercatCia402Slave, LineBootFindsBothPersonasAndReadsIdentity) {
   auto cycle = [&] {
     boot.poll(now, tx);
     if (client) client->poll(now, tx);
-    line.set_time(static_cast<std::uint64_t>(core::to_ns(now)));
-    for (const auto& f : tx.take_frames(now + 1ms)) {
-      link.send(FrameView(f.data(), f.size()));
-      std::array<FrameBuffer, 1> rx;
-      if (link.receive(rx) == 1) tx.on_frame(rx[0].view());
-    }
-    now += 1ms;
-    tx.expire(now);
+    drivegate::ethercat::test::exchange_over_line(tx, link, line, now);
   };
   boot.start(now);
   for (int i = 0; i < 20000 && boot.status() == LineStatus::Running; ++i) cycle();

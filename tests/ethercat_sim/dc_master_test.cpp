@@ -16,6 +16,7 @@
 #include "core/clock.hpp"
 #include "tests/ethercat_sim/harness.hpp"
 #include "tests/support/alloc_counter.hpp"
+#include "tests/ethercat_sim/line_exchange.hpp"
 
 namespace drivegate::ethercat::sim {
 namespace {
@@ -86,14 +87,7 @@ struct DcLine {
   void cycle() {
     if (cyclic.configured()) cyclic.poll(now, tx);
     if (setup) setup->poll(now, tx);
-    bus.line().set_time(static_cast<std::uint64_t>(core::to_ns(now)));
-    for (const auto& f : tx.take_frames(now + 1ms)) {
-      bus.link().send(FrameView(f.data(), f.size()));
-      std::array<FrameBuffer, 1> rx;
-      if (bus.link().receive(rx) == 1) tx.on_frame(rx[0].view());
-    }
-    now += 1ms;
-    tx.expire(now);
+    drivegate::ethercat::test::exchange_over_line(tx, bus.link(), bus.line(), now);
     bus.line().advance(static_cast<std::uint64_t>(core::to_ns(now)));
   }
   void run_setup(int max_cycles = 5000) {
@@ -285,14 +279,7 @@ TEST(EthercatSimDcMaster, ThirtyTwoBitReferenceIsExtended) {
   const auto cycle = [&] {
     if (cyclic.configured()) cyclic.poll(now, tx);
     setup.poll(now, tx);
-    bus.line().set_time(static_cast<std::uint64_t>(core::to_ns(now)));
-    for (const auto& f : tx.take_frames(now + 1ms)) {
-      bus.link().send(FrameView(f.data(), f.size()));
-      std::array<FrameBuffer, 1> rx;
-      if (bus.link().receive(rx) == 1) tx.on_frame(rx[0].view());
-    }
-    now += 1ms;
-    tx.expire(now);
+    drivegate::ethercat::test::exchange_over_line(tx, bus.link(), bus.line(), now);
     bus.line().advance(static_cast<std::uint64_t>(core::to_ns(now)));
   };
   setup.start(now);

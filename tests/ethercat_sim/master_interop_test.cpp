@@ -10,6 +10,7 @@
 #include "adapters/ethercat/master/line_boot.hpp"
 #include "core/clock.hpp"
 #include "tests/ethercat_sim/coe_line.hpp"
+#include "tests/ethercat_sim/line_exchange.hpp"
 
 namespace drivegate::ethercat::sim {
 namespace {
@@ -31,14 +32,7 @@ struct Interop {
   void cycle() {
     if (boot) boot->poll(now, tx);
     for (auto& c : clients) c->poll(now, tx);
-    line.set_time(static_cast<std::uint64_t>(core::to_ns(now)));
-    for (const auto& f : tx.take_frames(now + 1ms)) {
-      link.send(FrameView(f.data(), f.size()));
-      std::array<FrameBuffer, 1> rx;
-      if (link.receive(rx) == 1) tx.on_frame(rx[0].view());
-    }
-    now += 1ms;
-    tx.expire(now);
+    drivegate::ethercat::test::exchange_over_line(tx, link, line, now);
   }
 
   MemoryLink link{16};
