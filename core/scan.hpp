@@ -79,6 +79,9 @@ struct ScanResult {
   // Options the scan could not learn and assumed: key and what to check, a CHECK comment in the
   // skeleton (CANopen: the bit rate, which SocketCAN does not tell).
   std::vector<std::pair<std::string, std::string>> bus_option_checks;
+  // Lists of the bus entry besides its options (EtherCAT `io:`): the key, then one YAML flow
+  // mapping per item ("{ name: io-3, position: 3, inputs: 2 }"), written as they are.
+  std::vector<std::pair<std::string, std::vector<std::string>>> bus_lists;
   // What the scan assumed, for the table's first line ("bit rate not given (500 kbit/s assumed ...)");
   // empty: nothing.
   std::string assumed;

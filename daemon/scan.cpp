@@ -167,6 +167,10 @@ std::string skeleton_text(const core::ScanResult& result, core::Duration cycle_t
       if (check_key == key) y << "    # CHECK: " << check;
     y << "\n";
   }
+  for (const auto& [key, items] : result.bus_lists) {
+    y << "    " << key << ":" << (items.empty() ? " []\n" : "\n");
+    for (const auto& item : items) y << "      - " << item << "\n";
+  }
   const auto is_axis = [](const core::FoundDevice& d) { return d.drive && d.conflict.empty(); };
   const bool any = std::any_of(result.devices.begin(), result.devices.end(), is_axis);
   y << "axes:" << (any ? "\n" : " []\n");

@@ -5,6 +5,7 @@
 #include <optional>
 
 #include "adapters/ethercat/ethercat_bus.hpp"
+#include "adapters/ethercat/scan.hpp"
 #include "config/ethercat/bus_type.hpp"
 
 namespace drivegate::ethercat {
@@ -102,6 +103,7 @@ config::BusTypeInfo bus_type() {
   t.describe_bus.push_back(describe_image);
   t.describe_axis = describe_axis;
   t.make_bus = make_bus;
+  t.scan = {.plan = ethercat_scan_plan, .run = run_ethercat_scan};
   return t;
 }
 
