@@ -44,8 +44,9 @@ std::string_view to_string(BusDcLine s) noexcept {
   return "?";
 }
 
-BusDc::BusDc(std::span<const std::uint16_t> stations, std::span<const bool> wanted, BusDcConfig config) noexcept
-    : config_(config) {
+BusDc::BusDc(Transactions& tx, std::span<const std::uint16_t> stations, std::span<const bool> wanted,
+             BusDcConfig config) noexcept
+    : tx_(&tx), config_(config) {
   count_ = std::min({stations.size(), wanted.size(), kMaxSlaves});
   bool any = false;
   for (std::size_t k = 0; k < count_; ++k) {
@@ -71,7 +72,8 @@ void BusDc::restart_line() noexcept {
     s.text.clear();
   }
   if (line_ != BusDcLine::Off) line_ = BusDcLine::Idle;
-  setup_.reset();
+  drop_setup();
+  tx_->forget(&cyclic_);  // answers of the earlier run
   cyclic_ = DcCyclic{};
   reference_.reset();
   rejoin_.reset();
@@ -253,6 +255,7 @@ void BusDc::probes_done() noexcept {
     infos[k].sync0_cycle_ns = config_.cycle_ns;
     infos[k].sync0_shift_ns = config_.shift_ns;
   }
+  drop_setup();
   setup_.emplace(std::span<const DcSlaveInfo>(infos.data(), count_), config_.setup);
   setup_->start(now_);
   line_ = BusDcLine::Setup;
@@ -381,10 +384,16 @@ void BusDc::on_result(std::uint32_t tag, const DatagramAnswer& a) noexcept {
   }
 }
 
-void BusDc::forget_all(Transactions& tx) noexcept {
-  tx.forget(this);
-  if (setup_) tx.forget(&*setup_);
-  tx.forget(&cyclic_);
+void BusDc::drop_setup() noexcept {
+  // Its datagrams still in flight must not reach a destroyed (or a new) DcSetup.
+  if (setup_) tx_->forget(&*setup_);
+  setup_.reset();
+}
+
+void BusDc::forget_all() noexcept {
+  tx_->forget(this);
+  drop_setup();
+  tx_->forget(&cyclic_);
 }
 
 // ---- Rejoin -------------------------------------------------------------------------------------

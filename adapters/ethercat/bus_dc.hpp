@@ -64,7 +64,9 @@ class BusDc final : public DatagramOwner {
   // SYNC0 running; Failed: text() says why (the bus fails the slave; it comes back as a rejoin).
   enum class Verdict : std::uint8_t { Wait, Free, Sync0, Failed };
 
-  BusDc(std::span<const std::uint16_t> stations, std::span<const bool> wanted, BusDcConfig config) noexcept;
+  // `tx`: the bus' Transactions (a DcSetup made anew forgets the old one's datagrams there).
+  BusDc(Transactions& tx, std::span<const std::uint16_t> stations, std::span<const bool> wanted,
+        BusDcConfig config) noexcept;
 
   // From open(): ns since 2000 = to_ns(now) + base.
   void set_base(std::int64_t system_time_base_ns) noexcept;
@@ -87,7 +89,7 @@ class BusDc final : public DatagramOwner {
   // Later in the frame: the probe, DcSetup, a rejoin.
   void poll(core::TimePoint now, Transactions& tx) noexcept;
   void on_result(std::uint32_t tag, const DatagramAnswer& answer) noexcept override;
-  void forget_all(Transactions& tx) noexcept;
+  void forget_all() noexcept;  // the bus goes away
 
   // Diagnostics.
   [[nodiscard]] BusDcLine line() const noexcept { return line_; }
@@ -147,6 +149,9 @@ class BusDc final : public DatagramOwner {
     return master_system_time(t, config_.setup.system_time_base_ns);
   }
 
+  void drop_setup() noexcept;
+
+  Transactions* tx_;
   BusDcConfig config_;
   std::size_t count_ = 0;
   std::array<Slave, kMaxSlaves> slaves_{};

@@ -166,7 +166,7 @@ EthercatBus::EthercatBus(const config::BusPlan& plan, std::unique_ptr<Link> link
     dc.shift_ns = static_cast<std::int32_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(options_.sync0_shift).count());
     // A 092Ch round about once a second.
     dc.difference_every = static_cast<std::uint32_t>(std::max<std::int64_t>(1, std::chrono::seconds(1) / cycle_time_));
-    dc_ = std::make_unique<BusDc>(std::span<const std::uint16_t>(stations.data(), n),
+    dc_ = std::make_unique<BusDc>(tx_, std::span<const std::uint16_t>(stations.data(), n),
                                   std::span<const bool>(wanted.data(), n), dc);
   }
   for (std::size_t k = 0; k < slaves_.size(); ++k) {
@@ -219,7 +219,7 @@ EthercatBus::~EthercatBus() {
   }
   if (boot_) tx_.forget(boot_.get());
   if (cx_) tx_.forget(&*cx_);
-  if (dc_) dc_->forget_all(tx_);
+  if (dc_) dc_->forget_all();
 }
 
 void EthercatBus::open(core::TimePoint now) {
