@@ -34,7 +34,7 @@ axes:
 // The line of kDcLine: generic drives at 1 and 3 whose clocks start apart and drift apart
 // (EscConfig clock offset and ppm), hop delays of 300/450/520 ns.
 struct DcHarness : EcatHarness {
-  explicit DcHarness(const std::string& yaml = kDcLine) : EcatHarness(yaml, false) {
+  explicit DcHarness(const std::string& yaml = kDcLine, bool slave3_has_dc = true) : EcatHarness(yaml, false) {
     const auto& bp = plan.buses.at(0);
     for (const auto& ax : bp.axes) specs.push_back(ax.spec);
     auto memory = std::make_unique<MemoryLink>(64);
@@ -51,6 +51,7 @@ struct DcHarness : EcatHarness {
     sim::EscConfig c3 = gen.app->esc_config();
     c3.clock_offset_ns = -7'500'000;
     c3.drift_ppm = -40.0;
+    c3.dc_supported = slave3_has_dc;
     gen.esc = std::make_unique<sim::EscSlave>(c3, gen.app->sii(), gen.app.get());
     line->add(*esr.esc, 300);
     line->add(*panel_esc, 450);
@@ -206,6 +207,24 @@ TEST(EthercatBusDc, PowerCycledReferenceClockGetsSync0Again) {
   EXPECT_TRUE(h.gen.esc->sync0_running());
   h.run_until([] { return false; }, 2s);
   EXPECT_LT(std::llabs(h.true_difference()), 2000) << h.true_difference();
+}
+
+// Slave 3's ESC has no DC unit (0008h bit 2 clear) although its profile asks for SYNC0: one
+// warning, it runs free (1C32h left at free run), slave 1 alone is synchronized.
+TEST(EthercatBusDc, DcDriveWithoutDcUnitRunsFree) {
+  DcHarness h(kDcLine, false);
+  ASSERT_TRUE(h.run_until([&] { return h.all_up(); }, 5s)) << h.details() << h.events_text();
+  EXPECT_EQ(h.bus->dc().verdict(0), BusDc::Verdict::Sync0);
+  EXPECT_EQ(h.bus->dc().verdict(2), BusDc::Verdict::Free);
+  EXPECT_TRUE(h.esr.esc->sync0_running());
+  EXPECT_FALSE(h.gen.esc->sync0_running());
+  EXPECT_EQ(h.gen.app->sync_mode(), 0U);
+  EXPECT_NE(h.events_text().find("warning: bus ec0: slave 3 (0x1003): its device profile asks for distributed clocks, "
+                                 "its ESC has none (0008h bit 2): it runs free"),
+            std::string::npos)
+      << h.events_text();
+  EXPECT_NE(h.events_text().find("SYNC0 every 1000000 ns (shift 250000 ns) on 1 slave\n"), std::string::npos)
+      << h.events_text();
 }
 
 // With DC: the FRMW first in the frame and the 092Ch rounds, and still nothing allocates.
