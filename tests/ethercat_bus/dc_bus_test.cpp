@@ -227,6 +227,49 @@ TEST(EthercatBusDc, DcDriveWithoutDcUnitRunsFree) {
       << h.events_text();
 }
 
+// Records the first datagram of the first frame sent in each cycle, and passes every frame on to
+// the line.
+class FirstDatagramTap final : public FrameSink {
+ public:
+  explicit FirstDatagramTap(FrameSink& next) : next_(next) {}
+  void on_frame(FrameView frame) noexcept override {
+    // Ethernet header (14 bytes), EtherCAT header (2), then the first datagram: command, index,
+    // ADP (u16), ADO (u16) [ETG.1000.4 §5.3 frame structure, §5.4 datagram].
+    if (first_of_cycle && frame.size() >= 22) {
+      command = frame[16];
+      adp = core::get_u16(frame, 18);
+      ado = core::get_u16(frame, 20);
+      first_of_cycle = false;
+    }
+    next_.on_frame(frame);
+  }
+  bool first_of_cycle = false;
+  std::uint8_t command = 0;
+  std::uint16_t adp = 0, ado = 0;
+
+ private:
+  FrameSink& next_;
+};
+
+// Every cycle's first frame starts with the FRMW of the reference clock's system time (0910h at
+// 0x1001; FRMW = 14 [ETG.1000.4 Table 12]), the slot bus_image_options() keeps for it.
+TEST(EthercatBusDc, FrmwIsTheFirstDatagramOfEveryCycle) {
+  DcHarness h;
+  ASSERT_TRUE(h.run_until([&] { return h.all_up(); }, 5s)) << h.details();
+  FirstDatagramTap tap(*h.line);
+  h.link->set_sink(&tap);
+  for (int i = 0; i < 100; ++i) {
+    tap.first_of_cycle = true;
+    tap.command = 0;
+    h.cycle();
+    ASSERT_EQ(tap.command, static_cast<std::uint8_t>(Command::FRMW)) << "cycle " << i;
+    ASSERT_EQ(tap.adp, 0x1001U);
+    ASSERT_EQ(tap.ado, 0x0910U);
+  }
+  h.link->set_sink(h.line.get());
+  EXPECT_TRUE(h.up("b"));
+}
+
 // With DC: the FRMW first in the frame and the 092Ch rounds, and still nothing allocates.
 TEST(EthercatBusDc, NoAllocationPerCycleWithDc) {
   DcHarness h;
