@@ -2,6 +2,7 @@
 #include "adapters/ethercat/sim_transport.hpp"
 
 #include <algorithm>
+#include <ctime>
 #include <map>
 #include <thread>
 
@@ -149,6 +150,25 @@ EthercatBus::EthercatBus(const config::BusPlan& plan, std::unique_ptr<Link> link
   lb.preop_to_safeop = options_.transition_timeout;
   lb.safeop_to_op = options_.transition_timeout;
   boot_ = std::make_unique<LineBoot>(expected_, lb);
+  {
+    // Distributed clocks: the drives whose profile asks for them, on a bus that runs them.
+    std::array<std::uint16_t, LineBoot::kMaxSlaves> stations{};
+    std::array<bool, LineBoot::kMaxSlaves> wanted{};
+    const std::size_t n = std::min(slaves_.size(), stations.size());
+    for (std::size_t k = 0; k < n; ++k) {
+      stations[k] = slaves_[k]->station;
+      const config::AxisPlan* a = slaves_[k]->plan.axis;
+      wanted[k] = a != nullptr && a->device.section<config::EthercatDeviceSpec>().distributed_clocks;
+    }
+    BusDcConfig dc;
+    dc.enabled = options_.distributed_clocks;
+    dc.cycle_ns = static_cast<std::uint32_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(cycle_time_).count());
+    dc.shift_ns = static_cast<std::int32_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(options_.sync0_shift).count());
+    // A 092Ch round about once a second.
+    dc.difference_every = static_cast<std::uint32_t>(std::max<std::int64_t>(1, std::chrono::seconds(1) / cycle_time_));
+    dc_ = std::make_unique<BusDc>(tx_, std::span<const std::uint16_t>(stations.data(), n),
+                                  std::span<const bool>(wanted.data(), n), dc);
+  }
   for (std::size_t k = 0; k < slaves_.size(); ++k) {
     const auto& ids = slaves_[k]->identities;
     boot_->accept_identities(k, ids.empty() ? std::span<const SiiIdentity>{} : std::span<const SiiIdentity>(ids).subspan(1),
@@ -199,6 +219,7 @@ EthercatBus::~EthercatBus() {
   }
   if (boot_) tx_.forget(boot_.get());
   if (cx_) tx_.forget(&*cx_);
+  if (dc_) dc_->forget_all();
 }
 
 void EthercatBus::open(core::TimePoint now) {
@@ -209,6 +230,12 @@ void EthercatBus::open(core::TimePoint now) {
   }
   open_ = true;
   last_now_ = now;
+  // The DC system time base: CLOCK_REALTIME read once here against the bus' `now` (the daemon's
+  // cycle clock is steady_clock, CLOCK_MONOTONIC): master_system_time(now) is then ns since 2000
+  // [ETG.1000.4 §6 DC system time]. The engines read no clock.
+  timespec rt{};
+  ::clock_gettime(CLOCK_REALTIME, &rt);
+  dc_->set_base(system_time_base(static_cast<std::int64_t>(rt.tv_sec) * 1'000'000'000 + rt.tv_nsec, core::to_ns(now)));
   link_seen_ = link_->poll_state(now);
   for (auto& s : slaves_) {
     set_detail(*s, "booting");
@@ -223,6 +250,7 @@ void EthercatBus::start_boot(core::TimePoint now) noexcept {
     for (std::size_t a : s->axes) axes_[a].io->forget_requests();
     enter(*s, Phase::Boot, now);
   }
+  dc_->restart_line();
   boot_->start(now);
   line_booting_ = true;
   line_backoff_ = false;
@@ -235,6 +263,9 @@ void EthercatBus::set_detail(Slave& s, const char* what) noexcept {
 void EthercatBus::enter(Slave& s, Phase p, core::TimePoint now) noexcept {
   s.phase = p;
   s.since = now;
+  // A slave that restarts (or is lost: it may come back from a power cycle with its DC registers
+  // zero) gets its distributed clocks again.
+  if (p == Phase::Restart || p == Phase::Lost) dc_->forget(s.plan.position);
   core::LinkState link = core::LinkState::Offline;
   switch (p) {
     case Phase::Boot: link = core::LinkState::Booting; break;
@@ -320,6 +351,7 @@ void EthercatBus::receive(core::TimePoint now) noexcept {
   } else if (line_backoff_ && now - line_since_ >= line_wait_ && link_seen_ == LinkState::Up) {
     start_boot(now);
   }
+  dc_step(now);
   for (std::size_t k = 0; k < slaves_.size(); ++k) advance(k, now);
   const std::uint64_t completed = cx_ ? cx_->last_completed_cycle() : 0;
   for (auto& x : axes_) {
@@ -338,6 +370,7 @@ void EthercatBus::transmit(core::TimePoint now) noexcept {
     if (s->coe) s->coe->poll(now, tx_);
     if (s->phase == Phase::Configure) s->setup.poll(now, tx_);
   }
+  dc_->poll(now, tx_);  // the DC set-up's datagrams, after the process data
   const auto frames = tx_.take_frames(now + cycle_time_);
   if (!frames.empty()) {
     const SendResult r = link_->send(frames);
@@ -346,15 +379,70 @@ void EthercatBus::transmit(core::TimePoint now) noexcept {
   publish_counters();
 }
 
-void EthercatBus::queue_dc(core::TimePoint /*now*/) noexcept {
-  // Seam for master/dc.hpp: the FRMW of the reference clock's system time goes here, first in the
-  // cycle's frame (ETG.1000.4 §9.2.3; digest step 6). Not in this build yet.
+void EthercatBus::queue_dc(core::TimePoint now) noexcept {
+  // DcCyclic's FRMW of the reference clock's system time, first in the cycle's frame (its slot in
+  // bus_image_options()) [ETG.1000.4 §5.4 FRMW, master/dc.hpp].
+  dc_->poll_cyclic(now, tx_);
 }
 
-bool EthercatBus::dc_ready(std::size_t /*k*/) const noexcept {
-  // Seam for master/dc.hpp: propagation delays, offsets and SYNC0 (0981h) of a DC drive are set
-  // here, between the PDO set-up and SAFE-OP (digest step 5). Free run until it lands.
-  return true;
+void EthercatBus::dc_step(core::TimePoint now) noexcept {
+  std::array<BusDcView, LineBoot::kMaxSlaves> views{};
+  const std::size_t n = std::min(slaves_.size(), views.size());
+  for (std::size_t k = 0; k < n; ++k) {
+    const Phase p = slaves_[k]->phase;
+    BusDcView& v = views[k];
+    v.present = !line_booting_ && k < boot_->slave_count() && p != Phase::Lost && p != Phase::Restart && p != Phase::Boot;
+    v.at_sync = p == Phase::Sync;
+    v.configuring = p == Phase::Boot || p == Phase::Restart || p == Phase::DeviceType || p == Phase::Configure;
+    v.running = p == Phase::SafeOp || p == Phase::ToOp || p == Phase::Op || p == Phase::LeftOp || p == Phase::SafeStop;
+  }
+  dc_->step(now, std::span<const BusDcView>(views.data(), n));
+  core::FixedString<240> text;
+  bool warning = false;
+  while (dc_->take_event(text, warning)) bus_event(warning ? core::EventKind::Warning : core::EventKind::Info, text.view());
+  const DcCyclic& c = dc_->cyclic();
+  dc_difference_.store(c.configured() && c.difference_valid() ? static_cast<std::int64_t>(c.max_abs_difference_ns()) : -1,
+                       std::memory_order_relaxed);
+  dc_master_offset_.store(c.configured() && c.has_reference_time() ? c.master_minus_reference_ns() : 0,
+                          std::memory_order_relaxed);
+}
+
+bool EthercatBus::dc_ready(std::size_t k, core::TimePoint now) noexcept {
+  Slave& s = *slaves_[k];
+  if (!dc_->wanted(k)) return true;
+  switch (dc_->verdict(k)) {
+    case BusDc::Verdict::Wait: return false;
+    case BusDc::Verdict::Free: return true;
+    case BusDc::Verdict::Failed:
+      s.detail.assign(dc_->text(k));
+      fail(k, now);
+      return false;
+    case BusDc::Verdict::Sync0: break;
+  }
+  if (s.sync_mode_done || !s.coe) return true;
+  // SYNC0 runs: the drive's SM2 synchronisation to DC SYNC0, 1C32h:01 = 2, in PRE-OP (a drive
+  // checks it at SAFE-OP -> OP: AL status code 0030h otherwise) [ETG.1020 synchronisation; the
+  // generic-cia402 persona's 1C32h]. A drive without 1C32h takes SYNC0 as it is.
+  constexpr std::uint32_t kSyncDc0 = 2;
+  if (s.sync_mode_sdo == 0) {
+    s.sync_mode_sdo = s.coe->download_value(0x1C32, 1, kSyncDc0, 2);
+    if (s.sync_mode_sdo != 0) set_detail(s, "SYNC0 running: 1C32h:01 = 2 (DC SYNC0)");
+    return false;
+  }
+  const CoeSdoResult r = s.coe->result(s.sync_mode_sdo);
+  if (r.status == CoeSdoStatus::Queued || r.status == CoeSdoStatus::InFlight) return false;
+  if (r.status != CoeSdoStatus::Unknown) s.coe->take(s.sync_mode_sdo);
+  s.sync_mode_sdo = 0;
+  if (r.status == CoeSdoStatus::Done || r.abort_code == cia402::sdo_abort_code::kNoObject ||
+      r.abort_code == cia402::sdo_abort_code::kNoSubIndex) {
+    s.sync_mode_done = true;
+    return true;
+  }
+  core::FixedString<160> why;
+  why.format("1C32h:01 = 2 (DC SYNC0) refused: %s", cia402::sdo_abort_text(r.abort_code).data());
+  set_detail(s, why.c_str());
+  fail(k, now);
+  return false;
 }
 
 void EthercatBus::handle_link(core::TimePoint now) noexcept {
@@ -600,6 +688,9 @@ void EthercatBus::advance(std::size_t k, core::TimePoint now) noexcept {
         case PdoSetupStatus::Done:
           for (std::size_t i = 0; i < s.setup.warning_count(); ++i)
             bus_event(core::EventKind::Warning, s.setup.warning(i));
+          s.sync_mode_sdo = 0;
+          s.sync_mode_done = false;
+          if (dc_->wanted(k)) set_detail(s, "setting up distributed clocks (SYNC0)");
           enter(s, Phase::Sync, now);
           break;
         case PdoSetupStatus::Failed:
@@ -610,7 +701,7 @@ void EthercatBus::advance(std::size_t k, core::TimePoint now) noexcept {
       }
       break;
     case Phase::Sync:
-      if (!dc_ready(k)) break;
+      if (!dc_ready(k, now)) break;
       if (boot_->request_state(k, AlState::SafeOp, now)) {
         set_detail(s, "PRE-OP -> SAFE-OP");
         enter(s, Phase::SafeOp, now);

@@ -11,8 +11,11 @@
 //                once for every configured slave (one datagram per slave, so each has its own
 //                working counter and the others keep their inputs when one is gone).
 //   configure:   PdoSetup (start-up writes, PDO assignment and mapping read back, SM2/SM3, FMMUs,
-//                SM watchdog from the bus options); then the DC step (a seam: nothing yet, see
-//                master/dc.hpp); the cyclic frame runs from here on with the slave's outputs zero.
+//                SM watchdog from the bus options); then the DC step (bus_dc.hpp: with the bus
+//                option distributed_clocks and a profile with distributed_clocks, once the line's
+//                DC slaves are set up: DcSetup, SYNC0 every cycle_time + sync0_shift, then 1C32h:01
+//                = 2 over CoE where the drive has 1C32h; an ESC without DC runs free); the cyclic
+//                frame runs from here on with the slave's outputs zero, DcCyclic's FRMW first.
 //   SAFE-OP, OP: LineBoot::request_state(); the axes' links are operational in OP only, and the
 //                drives come up disabled (controlword 0).
 //   lost:        no answer for `lost_cycles` cycles, or its AL state left OP (the AL status check
@@ -21,7 +24,8 @@
 //   recovery:    after boot_retry (doubling up to boot_retry_max while it fails):
 //                LineBoot::restart_slave() (probe at its station, re-address by position after a
 //                power loss, INIT, SII, identity, mailbox, PRE-OP), CoeSdoClient::reset(), the whole
-//                configuration again, SAFE-OP, OP; the axes come back disabled.
+//                configuration again (a DC slave: its offset, delay and SYNC0 again, on its own),
+//                SAFE-OP, OP; the axes come back disabled.
 //   safe stop:   the profile found the drive not following its controlword: link Degraded,
 //                controlword quick stop (0002h) in the process data until the drive left
 //                operation enabled (3 s at most), disable voltage (0000h), the slave to SAFE-OP,
@@ -45,6 +49,7 @@
 #include <string>
 #include <vector>
 
+#include "adapters/ethercat/bus_dc.hpp"
 #include "adapters/ethercat/link/link.hpp"
 #include "adapters/ethercat/master/coe_sdo_client.hpp"
 #include "adapters/ethercat/master/cyclic_exchange.hpp"
@@ -92,7 +97,7 @@ class EthercatBus final : public core::Bus, private EmergencySink, private Datag
     Restart,    // LineBoot::restart_slave() runs
     DeviceType, // a generic profile: 1000h read over CoE
     Configure,  // PdoSetup
-    Sync,       // DC seam (nothing yet)
+    Sync,       // distributed clocks (bus_dc.hpp), 1C32h:01 = 2
     SafeOp,     // PRE-OP -> SAFE-OP
     ToOp,       // SAFE-OP -> OP
     Op,
@@ -133,6 +138,15 @@ class EthercatBus final : public core::Bus, private EmergencySink, private Datag
   [[nodiscard]] SlaveAccess& access(std::size_t axis) noexcept { return *axes_[axis].io; }
   [[nodiscard]] std::uint64_t events_dropped() const noexcept { return events_dropped_; }
   [[nodiscard]] Link& link() noexcept { return *link_; }
+  // Distributed clocks (bus thread): the line's setup, the cyclic FRMW, per slave its verdict.
+  [[nodiscard]] const BusDc& dc() const noexcept { return *dc_; }
+  // Any thread: the largest |system time difference| (092Ch) of the DC slaves' last complete
+  // round in ns, -1 before one completed or without DC; the master's system time minus the
+  // reference clock's at the last cycle (ns, 0 without DC).
+  [[nodiscard]] std::int64_t dc_max_difference_ns() const noexcept { return dc_difference_.load(std::memory_order_relaxed); }
+  [[nodiscard]] std::int64_t dc_master_minus_reference_ns() const noexcept {
+    return dc_master_offset_.load(std::memory_order_relaxed);
+  }
 
  private:
   struct Slave {
@@ -158,6 +172,8 @@ class EthercatBus final : public core::Bus, private EmergencySink, private Datag
     int safe_step = 0;
     bool left_op_waiting = false;
     std::uint16_t left_op_seq = 0;
+    CoeSdoId sync_mode_sdo = 0;  // Sync: the 1C32h:01 = 2 download
+    bool sync_mode_done = false;
     std::vector<std::size_t> axes;
     core::FixedString<200> detail;
     std::atomic<core::LinkState> link{core::LinkState::Offline};
@@ -185,10 +201,12 @@ class EthercatBus final : public core::Bus, private EmergencySink, private Datag
   void push_event(const core::Event& e) noexcept;
   void bus_event(core::EventKind kind, std::string_view text) noexcept;
   void set_detail(Slave& s, const char* what) noexcept;  // "slave n (0x..., name): what"
-  // DC seam (master/dc.hpp): datagrams queued first in the cycle's frame; the per-slave step
-  // between the PDO set-up and SAFE-OP. Nothing yet.
+  // Distributed clocks (bus_dc.hpp): DcCyclic's FRMW queued first in the cycle's frame; the line
+  // state once per cycle; the per-slave step between the PDO set-up and SAFE-OP (false: wait;
+  // a failure fails the slave itself).
   void queue_dc(core::TimePoint now) noexcept;
-  [[nodiscard]] bool dc_ready(std::size_t k) const noexcept;
+  void dc_step(core::TimePoint now) noexcept;
+  [[nodiscard]] bool dc_ready(std::size_t k, core::TimePoint now) noexcept;
   void publish_counters() noexcept;
   [[nodiscard]] bool all_op() const noexcept;
 
@@ -206,6 +224,7 @@ class EthercatBus final : public core::Bus, private EmergencySink, private Datag
   std::vector<std::unique_ptr<Slave>> slaves_;
   std::vector<Axis> axes_;
   std::array<FrameBuffer, 8> rx_{};
+  std::unique_ptr<BusDc> dc_;
 
   bool open_ = false;
   bool line_booting_ = false;
@@ -230,6 +249,8 @@ class EthercatBus final : public core::Bus, private EmergencySink, private Datag
   std::atomic<std::uint64_t> lost_{0};
   std::atomic<std::uint64_t> dropped_{0};
   std::atomic<std::uint64_t> errors_{0};
+  std::atomic<std::int64_t> dc_difference_{-1};
+  std::atomic<std::int64_t> dc_master_offset_{0};
 };
 
 // A bus for the plan: transport raw -> RawSocketLink on the interface; transport sim -> BusError
