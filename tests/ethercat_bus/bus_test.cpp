@@ -79,7 +79,7 @@ TEST(EthercatBusModes, EsrEnablesAndFollowsIpSetpoints) {
   expect_completed(h, h.push("esr", CommandKind::Disable), 3s, "disable");
 }
 
-// csp on the generic drive, free run (no DC in this build).
+// csp on the generic drive (on SYNC0: the bus runs distributed clocks for it by default).
 TEST(EthercatBusModes, GenericFollowsCspSetpoints) {
   EcatHarness h;
   up(h);
