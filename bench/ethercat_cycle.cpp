@@ -56,6 +56,7 @@ struct Options {
   std::vector<int> slaves{1, 8, 64};
   std::vector<std::string> links{"memory", "veth"};
   int period_us = 1000;
+  int lost_cycles = 0;  // 0: the bus' default (3)
 };
 
 std::optional<int> parse_int(std::string_view s) {
@@ -101,6 +102,7 @@ std::optional<Options> parse(int argc, char** argv) {
     if (!n || *n <= 0) return std::nullopt;
     if (arg == "--cycles") o.cycles = *n;
     else if (arg == "--period-us") o.period_us = *n;
+    else if (arg == "--lost-cycles") o.lost_cycles = *n;
     else return std::nullopt;
   }
   return o;
@@ -148,8 +150,9 @@ config::LoadOptions load_options() {
 std::string plan_yaml(const Options& o, int slaves, const std::string& interface) {
   std::string y = "gateway: { name: bench }\nbuses:\n  - name: ec0\n    type: ethercat\n    cycle_time: " +
                   std::to_string(o.period_us) + "us\n";
-  y += interface.empty() ? "    options: { transport: sim }\n"
-                         : "    options: { transport: raw, interface: " + interface + " }\n";
+  const std::string lost = o.lost_cycles > 0 ? ", lost_cycles: " + std::to_string(o.lost_cycles) : "";
+  y += interface.empty() ? "    options: { transport: sim" + lost + " }\n"
+                         : "    options: { transport: raw, interface: " + interface + lost + " }\n";
   y += "axes:\n";
   for (int i = 1; i <= slaves; ++i)
     y += "  - { name: a" + std::to_string(i) + ", bus: ec0, address: " + std::to_string(i) +
@@ -500,7 +503,8 @@ int main(int argc, char** argv) {
   if (!o) {
     std::fprintf(stderr,
                  "usage: bench_ethercat_cycle [--cycles N (default 100000)] [--slaves LIST (default 1,8,64)]\n"
-                 "                            [--links memory,veth] [--period-us N (default 1000)]\n");
+                 "                            [--links memory,veth] [--period-us N (default 1000)]\n"
+                 "                            [--lost-cycles N (default: the bus' 3)]\n");
     return 2;
   }
   return drivegate::bench::run(*o);
