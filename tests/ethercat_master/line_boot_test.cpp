@@ -392,5 +392,50 @@ TEST(EthercatLineBoot, DisconnectedLineFailsAfterRetries) {
   EXPECT_EQ(h.boot->line_text(), "count: no answer to BRD 0x0000 (frame lost 4 times): is the line connected?");
 }
 
+// A line of 64 slaves (LineBoot::kMaxSlaves) boots: the per-slave records are allocated for the
+// configured slaves by the constructor; stations 1001h..1040h [APWR 0010h = 1001h + position].
+TEST(EthercatLineBoot, SixtyFourSlavesReachPreOp) {
+  const std::vector<ExpectedSlave> expected(LineBoot::kMaxSlaves, ExpectedSlave{kVendor, kProduct, 0, "ESR TrioDrive"});
+  Harness h(line_of(LineBoot::kMaxSlaves), expected);
+  EXPECT_EQ(h.boot->capacity(), 64U);
+  h.boot->start(h.now);
+  h.run();
+  ASSERT_EQ(h.boot->status(), LineStatus::Done) << h.boot->line_text();
+  EXPECT_TRUE(h.boot->ok()) << h.boot->slave(0).text.view();
+  EXPECT_EQ(h.boot->slave_count(), 64U);
+  for (std::size_t i = 0; i < 64; ++i) {
+    EXPECT_EQ(h.boot->slave(i).status, SlaveStatus::Ready) << i;
+    EXPECT_EQ(h.line.slaves[i].station(), 0x1001 + i);
+    EXPECT_EQ(h.line.slaves[i].al_state(), 2);
+  }
+  EXPECT_EQ(h.tx.counters().datagrams_lost, 0U);
+}
+
+// Capacity: the configured slaves + 8 extra, at least 16, at most 64. Extra slaves within it are
+// reported and left in INIT; a line longer than it fails the count with the numbers.
+TEST(EthercatLineBoot, CapacityIsTheConfiguredSlavesPlusSpare) {
+  {
+    Harness h(line_of(11), kThree);  // 3 configured: capacity 16, 8 extra slaves fit
+    EXPECT_EQ(h.boot->capacity(), 16U);
+    h.boot->start(h.now);
+    h.run();
+    ASSERT_EQ(h.boot->status(), LineStatus::Done) << h.boot->line_text();
+    EXPECT_FALSE(h.boot->ok());
+    EXPECT_EQ(h.boot->slave_count(), 11U);
+    EXPECT_EQ(h.boot->slave(10).status, SlaveStatus::Extra);
+  }
+  {
+    Harness h(line_of(17), kThree);
+    h.boot->start(h.now);
+    h.run();
+    ASSERT_EQ(h.boot->status(), LineStatus::Failed);
+    EXPECT_EQ(h.boot->line_text(), "count: 17 slaves on the line, at most 16 supported with 3 configured");
+  }
+  const std::vector<ExpectedSlave> forty(40, ExpectedSlave{kVendor, kProduct, 0, "ESR TrioDrive"});
+  EXPECT_EQ(LineBoot(forty, {}).capacity(), 48U);
+  const std::vector<ExpectedSlave> sixty(60, ExpectedSlave{kVendor, kProduct, 0, "ESR TrioDrive"});
+  EXPECT_EQ(LineBoot(sixty, {}).capacity(), 64U);
+}
+
 }  // namespace
 }  // namespace drivegate::ethercat

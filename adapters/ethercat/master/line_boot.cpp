@@ -73,10 +73,14 @@ std::string_view to_string(SlaveStatus s) noexcept {
   return "?";
 }
 
-LineBoot::LineBoot(std::span<const ExpectedSlave> expected, LineBootConfig config) noexcept : config_(config) {
+LineBoot::LineBoot(std::span<const ExpectedSlave> expected, LineBootConfig config) : config_(config) {
   expected_count_ = std::min(expected.size(), kMaxSlaves);
   std::copy_n(expected.begin(), expected_count_, expected_.begin());
+  capacity_ = std::min(kMaxSlaves, std::max(kMinSlots, expected_count_ + kSpareSlots));
+  slaves_ = std::make_unique<Slave[]>(capacity_);
 }
+
+LineBoot::~LineBoot() = default;
 
 void LineBoot::start(core::TimePoint now) noexcept {
   now_ = now;
@@ -86,7 +90,7 @@ void LineBoot::start(core::TimePoint now) noexcept {
   found_ = 0;
   group_left_ = 0;
   group_due_ = false;
-  for (auto& s : slaves_) {
+  for (auto& s : std::span<Slave>(slaves_.get(), capacity_)) {
     s.phase = Phase::Idle;
     s.pending = Pending{};
     s.report = SlaveReport{};
@@ -234,7 +238,7 @@ void LineBoot::poll(core::TimePoint now, Transactions& tx) noexcept {
         send(s.pending, static_cast<std::uint32_t>(i), tx);
       }
       if (line_ == LinePhase::Slaves &&
-          std::none_of(slaves_.begin(), slaves_.begin() + static_cast<std::ptrdiff_t>(found_),
+          std::none_of(slaves_.get(), slaves_.get() + found_,
                        [](const Slave& s) { return s.report.status == SlaveStatus::Busy; })) {
         line_ = LinePhase::Done;
       }
@@ -306,8 +310,9 @@ void LineBoot::line_answer(const DatagramAnswer& a) noexcept {
     fail_line("count: no slave answered BRD 0x0000 (WKC 0)");
     return;
   }
-  if (a.wkc > kMaxSlaves) {
-    fail_line("count: %u slaves on the line, at most %zu supported", a.wkc, kMaxSlaves);
+  if (a.wkc > capacity_) {
+    fail_line("count: %u slaves on the line, at most %zu supported with %zu configured", a.wkc, capacity_,
+              expected_count_);
     return;
   }
   found_ = a.wkc;
@@ -395,7 +400,7 @@ void LineBoot::reached(Slave& s) noexcept {
 }
 
 void LineBoot::accept_identities(std::size_t position, std::span<const SiiIdentity> also, bool any) noexcept {
-  if (position >= kMaxSlaves) return;
+  if (position >= capacity_) return;
   slaves_[position].also = also;
   slaves_[position].any_identity = any;
 }
@@ -844,7 +849,7 @@ LineStatus LineBoot::status() const noexcept {
 
 bool LineBoot::ok() const noexcept {
   if (line_ != LinePhase::Done || found_ != expected_count_) return false;
-  return std::all_of(slaves_.begin(), slaves_.begin() + static_cast<std::ptrdiff_t>(found_), [](const Slave& s) {
+  return std::all_of(slaves_.get(), slaves_.get() + found_, [](const Slave& s) {
     return s.report.status == SlaveStatus::Ready && s.report.state != AlState::Init;
   });
 }

@@ -48,10 +48,14 @@
 //
 // A lost datagram is sent again up to `retries` times, then the step fails with "no answer". The
 // engine is driven by poll(now, tx) (queues what is due) and on_result() (Transactions calls it);
-// it never blocks. LineBoot is large (SII images and parsed SiiInfo per slave): allocate it once.
+// it never blocks. LineBoot is large (an SII image and its parsed SiiInfo per slave, about 19 KB):
+// the constructor allocates the per-slave records once, for capacity() slaves (the configured ones
+// plus kSpareSlots for extra slaves, at least kMinSlots, at most kMaxSlaves); nothing allocates
+// afterwards. A line with more slaves than capacity() fails the count step.
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string_view>
 
@@ -113,12 +117,20 @@ enum class LineStatus : std::uint8_t { Idle, Running, Done, Failed };
 
 class LineBoot final : public DatagramOwner {
  public:
-  static constexpr std::size_t kMaxSlaves = 16;
+  static constexpr std::size_t kMaxSlaves = 64;
+  static constexpr std::size_t kMinSlots = 16;   // slaves a boot can count and report at least
+  static constexpr std::size_t kSpareSlots = 8;  // beyond the configured ones, for extra slaves
   static constexpr std::size_t kMaxSiiBytes = 8192;
 
   // `expected`: one entry per configured position, front first (at most kMaxSlaves are used;
-  // name views must outlive the boot).
-  LineBoot(std::span<const ExpectedSlave> expected, LineBootConfig config) noexcept;
+  // name views must outlive the boot). Allocates the per-slave records (see capacity()).
+  LineBoot(std::span<const ExpectedSlave> expected, LineBootConfig config);
+  ~LineBoot();
+  LineBoot(const LineBoot&) = delete;
+  LineBoot& operator=(const LineBoot&) = delete;
+
+  // Slaves this boot can take: min(kMaxSlaves, max(kMinSlots, configured + kSpareSlots)).
+  [[nodiscard]] std::size_t capacity() const noexcept { return capacity_; }
 
   // (Re)starts the boot from the count. Answers to datagrams of an earlier run still in flight
   // are ignored.
@@ -239,7 +251,8 @@ class LineBoot final : public DatagramOwner {
   std::uint16_t reset_wkc_ = 0;
   core::TimePoint now_{};
   core::FixedString<240> line_text_{};
-  std::array<Slave, kMaxSlaves> slaves_{};
+  std::size_t capacity_ = 0;
+  std::unique_ptr<Slave[]> slaves_;  // capacity_ records, allocated by the constructor
 };
 
 }  // namespace drivegate::ethercat
