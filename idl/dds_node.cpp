@@ -52,7 +52,7 @@ constexpr std::array<TopicQos, kTopicCount> kQos{{
     {TopicId::AxisLink, true, true, false, 1, "gateway, axis"},
 }};
 
-// Clients (reply instances) a gateway keeps apart at once; memory grows with use, not up front.
+// Instances (axes, buses, clients) a topic keeps apart at once; memory grows with use, not up front.
 constexpr std::int32_t kMaxInstances = 1000;
 
 template <typename Qos>
@@ -69,9 +69,10 @@ void apply(const TopicQos& q, Qos& qos) {
   } else {
     qos.history().kind = dds::KEEP_LAST_HISTORY_QOS;
     qos.history().depth = q.depth;
-    if (q.depth > 1) {
-      // Instances come and go with clients (the gateway unregisters a client's when it leaves);
-      // Fast DDS's default limits (10 instances, 400 samples each) would refuse the eleventh.
+    if (!q.key.empty()) {
+      // One instance per axis, bus or client: Fast DDS's default limits (10 instances, 400
+      // samples each) would refuse the eleventh axis' state, and a client's replies come and go
+      // with clients (the gateway unregisters a client's when it leaves).
       qos.resource_limits().max_instances = kMaxInstances;
       qos.resource_limits().max_samples_per_instance = q.depth;
       qos.resource_limits().max_samples = kMaxInstances * q.depth;

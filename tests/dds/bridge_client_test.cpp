@@ -293,6 +293,18 @@ TEST(DdsBridge, CommandWaitsForTheGatewaysOwnEndpointsNotAnotherParticipants) {
   EXPECT_EQ(result->outcome, Outcome::Completed) << result->reason;
 }
 
+// Every axis' state reaches the client, also beyond Fast DDS's default of 10 instances per topic.
+TEST(DdsBridge, StatesOfMoreThanTenAxesAllArrive) {
+  std::vector<std::string> names;
+  for (int i = 0; i < 24; ++i) names.push_back("a" + std::to_string(i));
+  FakeRuntime rt("gw1", names);
+  daemon::DdsBridge bridge(rt, bridge_options());
+  bridge.start();
+  Client c(client_options());
+  EXPECT_TRUE(c.wait_until([&] { return c.states().size() == names.size(); }, kTimeout)) << c.states().size();
+  EXPECT_TRUE(c.wait_until([&] { return c.links().size() == names.size(); }, kTimeout)) << c.links().size();
+}
+
 // The first read right after construction, before any gateway was discovered, waits for discovery
 // and the gateway's data: not an empty answer that later reads would never correct by waiting.
 TEST(DdsBridge, FirstReadRightAfterConstructionWaitsForTheGateway) {
