@@ -142,6 +142,23 @@ TEST_F(DdsIo, RefusalsSayWhy) {
   EXPECT_NE(r.error.find("no gateway publishes an I/O slave 'nope'"), std::string::npos) << r.error;
 }
 
+// A write the Runtime cannot queue waits in the bridge, then is answered busy (after 2 s).
+TEST_F(DdsIo, AWriteThatFindsNoRoomIsAnsweredBusy) {
+  client::Client c(client_options());
+  ASSERT_TRUE(c.wait_until([&] { return c.io_states().size() == 2; }, kTimeout));
+  rt_.set_busy(true);
+  client::IoWriteRequest w;
+  w.slave = "panel";
+  w.data = {0x01};
+  const auto r = c.io_write(w, kTimeout);
+  EXPECT_FALSE(r.ok);
+  EXPECT_EQ(r.status, "busy");
+  EXPECT_EQ(r.error, "busy: the gateway's I/O queue of bus ec0 stayed full for 2000 ms; send it again");
+  rt_.set_busy(false);
+  EXPECT_TRUE(c.io_write(w, kTimeout).ok);
+  EXPECT_EQ(rt_.io_outputs(0), (std::vector<std::uint8_t>{0x01, 0x00}));
+}
+
 TEST_F(DdsIo, DrivegatectlListsShowsAndWrites) {
   auto r = ctl("io");
   EXPECT_EQ(r.status, 0) << r.output;

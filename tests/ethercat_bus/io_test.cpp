@@ -90,18 +90,30 @@ TEST(EthercatBusIo, WritesReachTheSlaveAndItsInputsComeBack) {
   EXPECT_EQ(bytes(h.panel->outputs()), (std::vector<std::uint8_t>{0x12, 0x34}));
 }
 
-TEST(EthercatBusIo, ALostSlavesInputsAreStaleAndWritesRefused) {
+TEST(EthercatBusIo, ALostSlavesInputsAreStaleWritesRefusedAndItComesBackWithZeroOutputs) {
   EcatHarness h;
   ASSERT_TRUE(h.run_until([&] { return h.all_up() && h.runner->io_snapshot(0).valid; }, 5s)) << h.details();
   h.panel->inputs()[0] = 0x5A;
+  ASSERT_EQ(write(h, io_write(1, 0, 0, {0x77, 0x66})), IoWriteStatus::Ok);
   h.run_until([] { return false; }, 5ms);
+  EXPECT_EQ(bytes(h.panel->outputs()), (std::vector<std::uint8_t>{0x77, 0x66}));
   h.line->power_off(1);  // the panel (0-based line index 1)
   ASSERT_TRUE(h.run_until([&] { return !h.runner->io_snapshot(0).valid; }, 100ms));
   const core::IoSnapshot s = h.runner->io_snapshot(0);
   EXPECT_EQ(s.inputs[0], 0x5A);  // the last good inputs, marked stale
   h.run_until([] { return false; }, 10ms);  // lost after lost_cycles
-  EXPECT_EQ(write(h, io_write(1, 0, 0, {0x01})), IoWriteStatus::SlaveLost);
+  EXPECT_EQ(write(h, io_write(2, 0, 0, {0x01})), IoWriteStatus::SlaveLost);
   EXPECT_EQ(h.bus->link_state(h.axis("esr")), core::LinkState::Operational);  // the drives keep cycling
+
+  // Back: restarted and reconfigured with its outputs zero (ethercat_bus.cpp configure()), then
+  // writable again.
+  h.line->power_on(1);
+  ASSERT_TRUE(h.run_until([&] { return h.runner->io_snapshot(0).valid; }, 5s)) << h.details();
+  EXPECT_EQ(h.bus->restarts(1), 1U);
+  EXPECT_EQ(bytes(h.runner->io_snapshot(0).outputs, 2), (std::vector<std::uint8_t>{0x00, 0x00}));
+  EXPECT_EQ(write(h, io_write(3, 0, 1, {0x42})), IoWriteStatus::Ok);
+  h.run_until([] { return false; }, 5ms);
+  EXPECT_EQ(bytes(h.panel->outputs()), (std::vector<std::uint8_t>{0x00, 0x42}));
 }
 
 }  // namespace
