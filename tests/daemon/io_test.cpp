@@ -1,6 +1,6 @@
-// The real drivegated with an EtherCAT bus (`transport: sim`: the line inside the gateway) whose
-// only slave is an `io:` panel: its bytes on io_state, a write through the client library reaches
-// the bus and comes back as the outputs the gateway holds.
+// The real drivegated with the demo's EtherCAT bus (`transport: sim`: the line inside the gateway)
+// and its `io:` panel: its bytes on io_state, a write through the client library reaches the bus
+// and comes back as the outputs the gateway holds.
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -16,20 +16,8 @@ using namespace std::chrono_literals;
 
 TEST(DaemonIo, EthercatIoSlaveIsReadAndWrittenOverDds) {
   const auto dds = test::unique_dds("io");
-  const std::string config = test::write_demo_config("iotest", dds, [](YAML::Node& root) {
-    YAML::Node bus;
-    bus["name"] = "ec0";
-    bus["type"] = "ethercat";
-    bus["cycle_time"] = "1ms";
-    bus["options"]["transport"] = "sim";
-    YAML::Node io;
-    io["name"] = "panel";
-    io["position"] = 1;
-    io["inputs"] = 2;
-    io["outputs"] = 3;
-    bus["io"].push_back(io);
-    root["buses"].push_back(bus);
-  });
+  // config/demo.yaml: bus ec0 (EtherCAT, transport sim) has `panel` at position 2, 2 bytes each way.
+  const std::string config = test::write_demo_config("iotest", dds);
   test::NotifySocket notify;
   test::DaemonProcess process(config, notify.path());
   ASSERT_TRUE(notify.wait_for("READY=1", 20s)) << process.log();
@@ -39,19 +27,19 @@ TEST(DaemonIo, EthercatIoSlaveIsReadAndWrittenOverDds) {
   auto st = *c.io_state("panel");
   EXPECT_EQ(st.gateway, "iotest");
   EXPECT_EQ(st.bus, "ec0");
-  EXPECT_EQ(st.address, 1U);
+  EXPECT_EQ(st.address, 2U);
   EXPECT_EQ(st.inputs, (std::vector<std::uint8_t>{0x00, 0x00}));
-  EXPECT_EQ(st.outputs, (std::vector<std::uint8_t>{0x00, 0x00, 0x00}));
+  EXPECT_EQ(st.outputs, (std::vector<std::uint8_t>{0x00, 0x00}));
 
   client::IoWriteRequest w;
   w.slave = "panel";
   w.offset = 1;
-  w.data = {0xC3, 0x5A};
+  w.data = {0xC3};
   const auto r = c.io_write(w, 10s);
   ASSERT_TRUE(r.ok) << r.status << ": " << r.error << "\n" << process.log();
-  EXPECT_TRUE(c.wait_until([&] { return c.io_state("panel")->outputs == std::vector<std::uint8_t>{0x00, 0xC3, 0x5A}; },
+  EXPECT_TRUE(c.wait_until([&] { return c.io_state("panel")->outputs == std::vector<std::uint8_t>{0x00, 0xC3}; },
                            10s));
-  w.offset = 2;
+  w.data = {0x01, 0x02};
   const auto refused = c.io_write(w, 10s);
   EXPECT_FALSE(refused.ok);
   EXPECT_EQ(refused.status, "out_of_range") << refused.error;
