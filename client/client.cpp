@@ -12,7 +12,9 @@
 #include <cstdlib>
 #include <optional>
 #include <random>
+#include <set>
 #include <stdexcept>
+#include <tuple>
 
 #include <fastdds/dds/core/status/PublicationMatchedStatus.hpp>
 #include <fastdds/dds/core/status/SubscriptionMatchedStatus.hpp>
@@ -169,6 +171,17 @@ class Client::Impl : public dds::DataReaderListener, public dds::DataWriterListe
     param_w_ = optional_writer(msg::TopicId::ParamRequest, parameter_refusal_);
     if (param_w_ != nullptr) param_r_ = listened_reader(msg::TopicId::ParamReply, parameter_refusal_);
   }
+  void ensure_io_endpoints() {
+    std::lock_guard lock(endpoints_mutex_);
+    if (io_endpoints_tried_) return;
+    io_endpoints_tried_ = true;
+    io_w_ = optional_writer(msg::TopicId::IoWrite, io_refusal_);
+    if (io_w_ != nullptr) io_r_ = listened_reader(msg::TopicId::IoWriteReply, io_refusal_);
+  }
+  std::string io_refusal() {
+    ensure_io_endpoints();
+    return io_refusal_;
+  }
   // A reply reader: its matches are followed from creation on (ensure_matched asks whose writers
   // matched); its data once it is known as reply_r_/param_r_ (replies come only after a request).
   dds::DataReader* listened_reader(msg::TopicId t, std::string& refusal) {
@@ -197,6 +210,8 @@ class Client::Impl : public dds::DataReaderListener, public dds::DataWriterListe
     if (reader == info_r_) info_take_.run([&] { take_infos(); });
     else if (reader == reply_r_) take_replies();
     else if (reader == param_r_) take_param_replies();
+    else if (reader == io_r_) take_io_replies();
+    else if (reader == io_state_r_.reader.load()) io_state_r_.take.run([&] { take_io_states(*reader); });
     else if (reader == state_r_.reader.load()) state_r_.take.run([&] { take_states(*reader); });
     else if (reader == event_r_.reader.load()) event_r_.take.run([&] { take_events(*reader); });
     else if (reader == bus_r_.reader.load()) bus_r_.take.run([&] { take_buses(*reader); });
@@ -424,6 +439,107 @@ class Client::Impl : public dds::DataReaderListener, public dds::DataWriterListe
     }
     const ParamResult reply = *param_replies_[id];
     param_replies_.erase(id);
+    return reply;
+  }
+
+  // io_state: gateways that have no I/O slaves publish none, and nobody says how many a gateway
+  // has. So the first read waits until every known gateway's states came and no new slave showed
+  // up for 100 ms (a gateway writes all of its slaves together, daemon/dds_bridge.cpp), or for
+  // 600 ms (a keep-alive period, 250 ms by default, past the match), whichever comes first.
+  void subscribe_io() {
+    const auto start = SteadyClock::now();
+    subscribe(io_state_r_, msg::TopicId::IoState, [&] {
+      std::set<std::string> seen;
+      for (const auto& [key, st] : io_states_) seen.insert(st.gateway);
+      const auto now = SteadyClock::now();
+      return (seen.size() >= gateways_.size() && now - last_io_instance_ > std::chrono::milliseconds(100)) ||
+             now - start > std::chrono::milliseconds(600);
+    });
+  }
+  std::vector<IoState> io_states() {
+    subscribe_io();
+    std::lock_guard lock(mutex_);
+    std::vector<IoState> v;
+    for (const auto& [key, st] : io_states_) v.push_back(st);
+    return v;
+  }
+  std::optional<IoState> io_state(std::string_view slave, std::string_view bus, std::string_view gateway) {
+    subscribe_io();
+    std::lock_guard lock(mutex_);
+    for (const auto& [key, st] : io_states_)
+      if (st.slave == slave && (bus.empty() || st.bus == bus) && (gateway.empty() || st.gateway == gateway)) return st;
+    return std::nullopt;
+  }
+
+  IoWriteResult io_write(const IoWriteRequest& req, Millis timeout) {
+    const auto deadline = SteadyClock::now() + timeout;
+    IoWriteResult result;
+    ensure_io_endpoints();
+    if (io_w_ == nullptr || io_r_ == nullptr) {
+      result.error = io_refusal_;
+      return result;
+    }
+    // The owner: the gateway named, else the one whose io_state names the slave (on the bus).
+    std::string gateway = req.gateway;
+    if (gateway.empty()) {
+      subscribe_io();
+      std::set<std::string> owners;
+      std::string list;
+      {
+        std::unique_lock lock(mutex_);
+        cv_.wait_until(lock, deadline, [&] {
+          owners.clear();
+          for (const auto& [key, st] : io_states_)
+            if (st.slave == req.slave && (req.bus.empty() || st.bus == req.bus)) owners.insert(st.gateway);
+          return !owners.empty();
+        });
+        for (const auto& [key, st] : io_states_) list += (list.empty() ? "" : ", ") + st.slave + " (" + st.gateway + "/" + st.bus + ")";
+      }
+      if (owners.empty()) {
+        result.error = "no gateway publishes an I/O slave '" + req.slave + "'" +
+                       (req.bus.empty() ? std::string() : " on bus " + req.bus) + "; I/O slaves: " +
+                       (list.empty() ? "(none)" : list);
+        return result;
+      }
+      if (owners.size() > 1) {
+        result.error = "I/O slave '" + req.slave + "' is on more than one gateway: name the gateway";
+        return result;
+      }
+      gateway = *owners.begin();
+    }
+    result.gateway = gateway;
+    result.bus = req.bus;
+    ensure_matched(deadline, gateway, *io_w_, *io_r_);
+    msg::IoWrite out;
+    out.gateway(gateway);
+    out.bus(req.bus);
+    out.slave(req.slave);
+    out.client(opt_.name);
+    const std::uint64_t id = next_id_++;
+    out.id(id);
+    out.offset(req.offset);
+    out.data(req.data);
+    {
+      std::lock_guard lock(mutex_);
+      io_replies_[id];
+    }
+    if (const auto busy = write_in_window(*io_w_, &out, deadline)) {
+      std::lock_guard lock(mutex_);
+      io_replies_.erase(id);
+      result.status = "busy";
+      result.error = *busy;
+      return result;
+    }
+    std::unique_lock lock(mutex_);
+    const bool got = cv_.wait_until(lock, deadline, [&] { return io_replies_[id].has_value(); });
+    release_window_locked();
+    if (!got) {
+      io_replies_.erase(id);
+      result.error = "no I/O write reply from gateway '" + gateway + "' in time";
+      return result;
+    }
+    const IoWriteResult reply = *io_replies_[id];
+    io_replies_.erase(id);
     return reply;
   }
 
@@ -758,6 +874,33 @@ class Client::Impl : public dds::DataReaderListener, public dds::DataWriterListe
     });
   }
 
+  void take_io_states(dds::DataReader& reader) {
+    const auto now = SteadyClock::now();
+    msg::take_valid<msg::IoState>(reader, [&](const msg::IoState& in) {
+      IoState st{in.gateway(), in.bus(), in.slave(), in.address(), in.inputs(), in.outputs(), in.valid(),
+                 in.stamp(), in.seq(), now};
+      std::lock_guard lock(mutex_);
+      const bool added = io_states_.insert_or_assign({st.gateway, st.bus, st.slave}, st).second;
+      if (added) last_io_instance_ = now;
+    });
+  }
+
+  void take_io_replies() {
+    msg::take_valid<msg::IoWriteReply>(*io_r_, [&](const msg::IoWriteReply& in) {
+      if (in.client() != opt_.name) return;
+      std::lock_guard lock(mutex_);
+      const auto it = io_replies_.find(in.id());
+      if (it == io_replies_.end()) return;
+      IoWriteResult r;
+      r.ok = in.ok();
+      r.gateway = in.gateway();
+      r.bus = in.bus();
+      r.status = in.status();
+      r.error = in.reason();
+      it->second = std::move(r);
+    });
+  }
+
   void take_param_replies() {
     msg::take_valid<msg::ParameterReply>(*param_r_, [&](const msg::ParameterReply& in) {
       if (in.client() != opt_.name) return;
@@ -786,18 +929,23 @@ class Client::Impl : public dds::DataReaderListener, public dds::DataWriterListe
   dds::DataReader* info_r_ = nullptr;
   dds::DataReader* reply_r_ = nullptr;
   dds::DataReader* param_r_ = nullptr;
+  dds::DataWriter* io_w_ = nullptr;
+  dds::DataReader* io_r_ = nullptr;
   SerialTake info_take_;
   // Made on first use (subscribe()); read by the listener thread.
   LazyReader state_r_;
   LazyReader event_r_;
   LazyReader bus_r_;
   LazyReader link_r_;
+  LazyReader io_state_r_;
   std::mutex subscribe_mutex_;
   std::atomic<unsigned> subscribed_{0};  // bit(topic): subscribe() done for that topic
 
   std::mutex endpoints_mutex_;
   bool command_endpoints_tried_ = false;
   bool param_endpoints_tried_ = false;
+  bool io_endpoints_tried_ = false;
+  std::string io_refusal_;
   std::string command_refusal_;    // why this identity may not command (empty: it may)
   std::string parameter_refusal_;  // likewise for parameter requests
   std::size_t in_flight_ = 0;      // requests written and waiting for their first reply (mutex_)
@@ -820,6 +968,9 @@ class Client::Impl : public dds::DataReaderListener, public dds::DataWriterListe
   std::uint64_t events_end_ = 0;  // number of events ever received
   std::map<std::uint64_t, std::deque<ReplyRecord>> replies_;
   std::map<std::uint64_t, std::optional<ParamResult>> param_replies_;
+  std::map<std::tuple<std::string, std::string, std::string>, IoState> io_states_;
+  std::map<std::uint64_t, std::optional<IoWriteResult>> io_replies_;
+  SteadyClock::time_point last_io_instance_{};  // a new I/O slave's first state arrived
 };
 
 Client::Client(ClientOptions options) : impl_(std::make_unique<Impl>(std::move(options))) {}
@@ -851,5 +1002,11 @@ std::string Client::stream_setpoint(std::string_view axis, std::string_view gate
   return impl_->stream_setpoint(axis, gateway, position, velocity, torque);
 }
 ParamResult Client::param(const ParamRequest& request, Millis timeout) { return impl_->param(request, timeout); }
+std::vector<IoState> Client::io_states() const { return impl_->io_states(); }
+std::optional<IoState> Client::io_state(std::string_view slave, std::string_view bus, std::string_view gateway) const {
+  return impl_->io_state(slave, bus, gateway);
+}
+std::string Client::io_refusal() { return impl_->io_refusal(); }
+IoWriteResult Client::io_write(const IoWriteRequest& request, Millis timeout) { return impl_->io_write(request, timeout); }
 
 }  // namespace drivegate::client

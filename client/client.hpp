@@ -197,6 +197,36 @@ struct ParamResult {
   [[nodiscard]] std::optional<std::int64_t> integer() const noexcept { return core::param_as_signed(type, data); }
 };
 
+// A bus' generic I/O slave (topic io_state; an EtherCAT bus' `io:` slaves).
+struct IoState {
+  std::string gateway;
+  std::string bus;
+  std::string slave;
+  std::uint32_t address = 0;          // on its bus (EtherCAT: the 1-based position)
+  std::vector<std::uint8_t> inputs;   // the last good inputs
+  std::vector<std::uint8_t> outputs;  // the outputs the gateway holds for the slave
+  bool valid = false;                 // false: the inputs are stale (the slave is not exchanging)
+  std::int64_t stamp_ns = 0;
+  std::uint64_t seq = 0;
+  std::chrono::steady_clock::time_point received;
+};
+
+struct IoWriteRequest {
+  std::string slave;
+  std::string bus;      // empty: the one bus with an I/O slave of that name
+  std::string gateway;  // empty: the gateway that publishes the slave
+  std::uint32_t offset = 0;
+  std::vector<std::uint8_t> data;
+};
+
+struct IoWriteResult {
+  bool ok = false;
+  std::string gateway;
+  std::string bus;
+  std::string status;  // ok, unknown_slave, out_of_range, slave_lost, busy; "" when no gateway answered
+  std::string error;   // the gateway's reason, or ours (no gateway, timeout, denied)
+};
+
 // Which gateway a request goes to, or why none.
 struct Route {
   std::string gateway;
@@ -257,6 +287,16 @@ class Client {
                               double torque);
 
   ParamResult param(const ParamRequest& request, Millis timeout);
+
+  // I/O slaves, sorted by gateway, bus, slave. The io_state reader is made on the first call,
+  // which waits (up to 1.5 s) for the gateways' next publication.
+  [[nodiscard]] std::vector<IoState> io_states() const;
+  [[nodiscard]] std::optional<IoState> io_state(std::string_view slave, std::string_view bus = {},
+                                                std::string_view gateway = {}) const;
+  // Why this client may not write I/O outputs (DDS access control); empty when it may.
+  [[nodiscard]] std::string io_refusal();
+  // Writes output bytes at an offset and waits for the gateway's reply, within `timeout`.
+  IoWriteResult io_write(const IoWriteRequest& request, Millis timeout);
 
   class Impl;
 

@@ -63,6 +63,11 @@ constexpr CommandHelp kCommands[] = {
      "  string, unicode, octets, domain (VALUE: decimal or 0x hex, a real, text, hex bytes \"01 02 0a\")",
      "read/write a drive object; INDEX is hex (0x optional), SUB decimal or 0x-hex", 3, 4},
     {"buses", "buses", "bus status: cycle timing, lateness, frame counters", 0, 0},
+    {"io",
+     "io [NAME] [--bus BUS]\n"
+     "  io NAME write OFFSET BYTES... [--bus BUS]\n"
+     "  BYTES are hex bytes (\"01 ff\", 0x01, or 01ff); OFFSET is the first output byte (decimal or 0x hex)",
+     "generic I/O slaves (EtherCAT io:): their input and output bytes; write output bytes", 0, kAny},
 };
 
 void print_usage(std::ostream& os) {
@@ -625,6 +630,114 @@ int cmd_buses(Context& ctx) {
   return 0;
 }
 
+// "01 ff", "0x01", "01ff" (any mix over several words) as bytes.
+std::vector<std::uint8_t> parse_hex_bytes(const std::vector<std::string>& words) {
+  std::vector<std::uint8_t> out;
+  for (const auto& w : words) {
+    std::size_t at = 0;
+    while (at < w.size()) {
+      if (w[at] == ' ' || w[at] == ',') {
+        ++at;
+        continue;
+      }
+      std::size_t end = w.find_first_of(" ,", at);
+      if (end == std::string::npos) end = w.size();
+      std::string token = w.substr(at, end - at);
+      at = end;
+      if (token.size() > 2 && token[0] == '0' && (token[1] == 'x' || token[1] == 'X')) token = token.substr(2);
+      if (token.empty() || token.size() % 2 != 0 ||
+          token.find_first_not_of("0123456789abcdefABCDEF") != std::string::npos)
+        throw UsageError("io write: '" + w + "' is not hex bytes (e.g. 01 ff, 0x01, 01ff)");
+      for (std::size_t i = 0; i < token.size(); i += 2)
+        out.push_back(static_cast<std::uint8_t>(std::stoul(token.substr(i, 2), nullptr, 16)));
+    }
+  }
+  if (out.empty()) throw UsageError("io write: no bytes given");
+  return out;
+}
+
+void print_io_json(const IoState& st) {
+  JsonWriter w;
+  w.begin_object()
+      .field("gateway", std::string_view(st.gateway))
+      .field("bus", std::string_view(st.bus))
+      .field("slave", std::string_view(st.slave))
+      .field("address", static_cast<std::uint64_t>(st.address))
+      .field("valid", st.valid)
+      .field("input_size", static_cast<std::uint64_t>(st.inputs.size()))
+      .field("output_size", static_cast<std::uint64_t>(st.outputs.size()))
+      .field("inputs", std::string_view(core::hex_bytes(st.inputs)))
+      .field("outputs", std::string_view(core::hex_bytes(st.outputs)))
+      .field("stamp_ns", st.stamp_ns)
+      .end_object();
+  std::cout << w.str() << "\n";
+}
+
+int cmd_io(Context& ctx) {
+  const std::string bus = ctx.args.option_or("bus", "");
+  const auto selected = [&](const IoState& st) {
+    return (ctx.gateway.empty() || st.gateway == ctx.gateway) && (bus.empty() || st.bus == bus);
+  };
+  if (ctx.words.size() >= 2) {
+    if (ctx.words[1] != "write") throw UsageError("io: expected 'write' after the slave's name, got '" + ctx.words[1] + "'");
+    IoWriteRequest req;
+    req.slave = ctx.words[0];
+    req.bus = bus;
+    req.gateway = ctx.gateway;
+    req.offset = static_cast<std::uint32_t>(parse_integer("OFFSET", word(ctx, 2, "OFFSET"), 0, 65535));
+    req.data = parse_hex_bytes({ctx.words.begin() + 3, ctx.words.end()});
+    const IoWriteResult r = ctx.client.io_write(req, ctx.timeout);
+    if (ctx.json) {
+      JsonWriter w;
+      w.begin_object()
+          .field("slave", std::string_view(req.slave))
+          .field("gateway", std::string_view(r.gateway))
+          .field("bus", std::string_view(r.bus))
+          .field("offset", static_cast<std::uint64_t>(req.offset))
+          .field("bytes", std::string_view(core::hex_bytes(req.data)))
+          .field("ok", r.ok)
+          .field("status", std::string_view(r.status))
+          .field("error", std::string_view(r.error))
+          .end_object();
+      std::cout << w.str() << std::endl;
+    } else if (r.ok) {
+      std::cout << "io " << req.slave << " (" << r.gateway << "/" << r.bus << "): " << req.data.size()
+                << " byte(s) at offset " << req.offset << " written: " << core::hex_bytes(req.data) << std::endl;
+    }
+    if (r.ok) return 0;
+    return fail("io " + req.slave + " write: " + (r.status.empty() ? "" : r.status + ": ") + r.error);
+  }
+  auto states = ctx.client.io_states();
+  std::erase_if(states, [&](const IoState& st) { return !selected(st); });
+  if (ctx.words.size() == 1) {
+    std::erase_if(states, [&](const IoState& st) { return st.slave != ctx.words[0]; });
+    if (states.empty()) {
+      std::string known;
+      for (const auto& st : ctx.client.io_states()) known += (known.empty() ? "" : ", ") + st.slave;
+      return fail("no I/O slave '" + ctx.words[0] + "'" + (bus.empty() ? "" : " on bus " + bus) +
+                  "; I/O slaves: " + (known.empty() ? "(none)" : known));
+    }
+  }
+  for (const auto& st : states) {
+    if (ctx.json) {
+      print_io_json(st);
+      continue;
+    }
+    const std::string validity = st.valid ? "valid" : "STALE";
+    if (ctx.words.empty()) {
+      std::cout << st.slave << "  " << st.gateway << "/" << st.bus << "  address=" << st.address << "  " << validity
+                << "  in=[" << core::hex_bytes(st.inputs) << "]  out=[" << core::hex_bytes(st.outputs) << "]\n";
+    } else {
+      std::cout << st.slave << " (" << st.gateway << "/" << st.bus << ", address " << st.address << "): "
+                << (st.valid ? "inputs valid" : "inputs STALE (the slave is not exchanging process data)") << "\n"
+                << "  inputs  (" << st.inputs.size() << " bytes): " << core::hex_bytes(st.inputs) << "\n"
+                << "  outputs (" << st.outputs.size() << " bytes): " << core::hex_bytes(st.outputs) << "\n";
+    }
+  }
+  if (states.empty() && !ctx.json) std::cout << "no I/O slaves\n";
+  return 0;
+}
+
 const StringSet kGlobal{"domain", "namespace", "gateway", "identity", "interfaces", "json", "timeout", "help"};
 
 StringSet options_of(std::string_view command) {
@@ -637,6 +750,7 @@ StringSet options_of(std::string_view command) {
   if (command == "home") add({"method", "offset"});
   if (command == "events") add({"follow"});
   if (command == "param") add({"type"});
+  if (command == "io") add({"bus"});
   return s;
 }
 
@@ -693,6 +807,7 @@ int run(int argc, char** argv) {
   if (command == "home") return cmd_home(ctx);
   if (command == "events") return cmd_events(ctx);
   if (command == "param") return cmd_param(ctx);
+  if (command == "io") return cmd_io(ctx);
   return cmd_buses(ctx);
 }
 

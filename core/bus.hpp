@@ -8,6 +8,7 @@
 // deadline.
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -15,6 +16,7 @@
 #include "core/axis_controller.hpp"
 #include "core/command.hpp"
 #include "core/clock.hpp"
+#include "core/io.hpp"
 
 namespace drivegate::core {
 
@@ -64,6 +66,19 @@ class Bus {
   // an axis index it is about that axis' device (a CANopen EMCY) and the runner adds the axis'
   // state. The runner stamps them with the cycle's time. A bus bounds how many it holds.
   virtual bool next_event(Event& /*out*/) noexcept { return false; }
+
+  // Generic I/O slaves (core/io.hpp); the default has none. io_count() and io_info() are fixed
+  // from construction on and may be called from any thread. io_read() and io_write() are the
+  // cyclic path (the runner calls them between receive() and transmit()): io_read() fills `out`
+  // with the slave's inputs, its outputs and whether the inputs are fresh (the runner stamps it);
+  // io_write() changes the outputs the bus sends from now on.
+  [[nodiscard]] virtual std::size_t io_count() const noexcept { return 0; }
+  [[nodiscard]] virtual IoInfo io_info(std::size_t /*k*/) const noexcept { return {}; }
+  virtual void io_read(std::size_t /*k*/, IoSnapshot& out) noexcept { out = IoSnapshot{}; }
+  virtual IoWriteStatus io_write(std::size_t /*k*/, std::size_t /*offset*/,
+                                 std::span<const std::uint8_t> /*bytes*/) noexcept {
+    return IoWriteStatus::UnknownSlave;
+  }
 
   // May be called from any thread while the bus runs (implementations keep relaxed atomics).
   [[nodiscard]] virtual BusCounters counters() const noexcept = 0;

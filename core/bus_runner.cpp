@@ -3,7 +3,10 @@
 namespace drivegate::core {
 
 BusRunner::BusRunner(Bus& bus, const std::vector<AxisSpec>& specs)
-    : bus_(bus), snapshots_(std::make_unique<Seqlock<AxisSnapshot>[]>(specs.size())) {
+    : bus_(bus),
+      snapshots_(std::make_unique<Seqlock<AxisSnapshot>[]>(specs.size())),
+      io_count_(bus.io_count()),
+      io_snapshots_(std::make_unique<Seqlock<IoSnapshot>[]>(io_count_)) {
   if (specs.size() != bus.axis_count()) throw BusError("bus runner: axis specs do not match the bus' axes");
   axes_.reserve(specs.size());
   for (std::size_t i = 0; i < specs.size(); ++i)
@@ -53,9 +56,34 @@ bool BusRunner::cycle(TimePoint now) noexcept {
     }
   }
 
+  // I/O writes: taken only while their replies have room (one reply each, never dropped).
+  IoWrite w;
+  for (std::size_t n = 0; n < kMaxIoWritesPerCycle && io_replies_.size_approx() < io_replies_.capacity() &&
+                          io_writes_.pop(w);
+       ++n) {
+    IoWriteReply r;
+    r.id = w.id;
+    r.slave = w.slave;
+    if (w.slave >= io_count_)
+      r.status = IoWriteStatus::UnknownSlave;
+    else if (w.size == 0 || w.size > w.data.size())
+      r.status = IoWriteStatus::OutOfRange;
+    else
+      r.status = bus_.io_write(w.slave, w.offset, std::span<const std::uint8_t>(w.data.data(), w.size));
+    queued_ = true;
+    if (!io_replies_.push(r)) dropped_.fetch_add(1, std::memory_order_relaxed);
+  }
+
   for (std::size_t i = 0; i < axes_.size(); ++i) {
     axes_[i].update(now, *this);
     snapshots_[i].store(axes_[i].snapshot());
+  }
+  ++cycles_;
+  for (std::size_t k = 0; k < io_count_; ++k) {
+    bus_.io_read(k, io_scratch_);
+    io_scratch_.stamp_ns = to_ns(now);
+    io_scratch_.cycle = cycles_;
+    io_snapshots_[k].store(io_scratch_);
   }
   bus_.transmit(now);
   return queued_;

@@ -103,6 +103,9 @@ std::string hex_object(std::uint16_t index, std::uint8_t sub) {
   return buf.data();
 }
 
+// The reply topics whose readers the gateway waits for (write_replies()).
+enum class ReplyTopic : std::uint8_t { Command, Param, Io };
+
 struct Pending {
   std::string client;
   std::uint64_t client_id = 0;
@@ -148,6 +151,21 @@ struct OutReply {
   Prefix prefix;
   Clock::time_point since;
 };
+
+// Why the bus refused an I/O write, in words.
+std::string io_refusal_text(const IoSlaveInfo& io, core::IoWriteStatus status, const core::IoSnapshot& s) {
+  const std::string who = "I/O slave '" + io.name + "' on bus " + io.bus;
+  switch (status) {
+    case core::IoWriteStatus::Ok: return {};
+    case core::IoWriteStatus::UnknownSlave: return who + " is not known to its bus";
+    case core::IoWriteStatus::OutOfRange:
+      return "out of range: " + who + " has " + std::to_string(s.output_size) + " output bytes";
+    case core::IoWriteStatus::SlaveLost:
+      return who + " is not exchanging process data (booting, lost or recovering): outputs not written";
+    case core::IoWriteStatus::Busy: return "busy: " + who + "'s queue stayed full";
+  }
+  return who + ": refused";
+}
 
 std::int64_t wall_clock_ns() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
@@ -217,6 +235,23 @@ class DdsBridge::Impl : private dds::DataWriterListener, private dds::DataReader
   // axis_link of the axis whose snapshot is `s`, when its link state or detail changed.
   void publish_link(std::size_t axis_id, const core::AxisSnapshot& s);
   void publish_bus_status();
+  // io_state of every I/O slave whose bytes or validity changed, or whose keep-alive is due.
+  void publish_io_states(Clock::time_point now);
+  bool take_io_writes(Clock::time_point now);
+  void handle_io_write(const msg::IoWrite& in, const Prefix& from, Clock::time_point now);
+  void refuse_io(const msg::IoWrite& in, const Prefix& from, core::IoWriteStatus status, const std::string& reason,
+                 Clock::time_point now);
+  void retry_io(Clock::time_point now);
+  [[nodiscard]] std::string io_list() const;
+  [[nodiscard]] msg::IoWriteReply io_reply(const Pending& p, std::size_t io_id) const {
+    msg::IoWriteReply out;
+    out.gateway(gateway_);
+    out.bus(rt_.io_slaves()[io_id].bus);
+    out.slave(p.axis);
+    out.client(p.client);
+    out.id(p.client_id);
+    return out;
+  }
   void publish_gateway_info();
   // An event of this gateway (not of a bus); `axis` when it is about one of its axes.
   void publish_gateway_event(core::EventKind kind, const std::string& text, const std::string& axis = {});
@@ -227,12 +262,12 @@ class DdsBridge::Impl : private dds::DataWriterListener, private dds::DataReader
   // would otherwise grow with every client that ever connected).
   void forget_gone_clients();
   [[nodiscard]] bool busy() const noexcept {
-    return !deferred_commands_.empty() || !deferred_params_.empty() ||
-           replies_.size() + param_replies_.size() >= kMaxReplyBacklog;
+    return !deferred_commands_.empty() || !deferred_params_.empty() || !deferred_io_.empty() ||
+           replies_.size() + param_replies_.size() + io_replies_.size() >= kMaxReplyBacklog;
   }
   [[nodiscard]] std::optional<std::size_t> find_axis(std::string_view name) const;
   [[nodiscard]] std::string axis_list() const;
-  [[nodiscard]] bool reader_matched(const Prefix& p, bool param) const;
+  [[nodiscard]] bool reader_matched(const Prefix& p, ReplyTopic topic) const;
   template <typename F>
   void count(F&& f) {
     std::lock_guard lock(stats_mutex_);
@@ -262,6 +297,10 @@ class DdsBridge::Impl : private dds::DataWriterListener, private dds::DataReader
   dds::DataReader* sp_r_ = nullptr;
   dds::DataReader* param_r_ = nullptr;
   dds::DataReader* info_r_ = nullptr;
+  // The I/O topics; null when DDS access control refused them (permissions older than the topics).
+  dds::DataWriter* io_state_w_ = nullptr;
+  dds::DataWriter* io_reply_w_ = nullptr;
+  dds::DataReader* io_write_r_ = nullptr;
 
   std::thread thread_;
   std::atomic<bool> running_{false};
@@ -294,6 +333,17 @@ class DdsBridge::Impl : private dds::DataWriterListener, private dds::DataReader
     core::LinkDetail detail;
   };
   std::vector<PublishedLink> links_;
+  // I/O slaves: writes in flight, waiting for room, replies waiting; what io_state last carried.
+  // (Pending::axis holds the slave's name, Deferred::axis_id its I/O id.)
+  std::map<core::CommandId, std::pair<std::size_t, Pending>> pending_io_;
+  std::deque<Deferred<core::IoWrite>> deferred_io_;
+  std::deque<OutReply<msg::IoWriteReply>> io_replies_;
+  struct PublishedIo {
+    bool written = false;
+    core::IoSnapshot snapshot;
+    Clock::time_point at{};
+  };
+  std::vector<PublishedIo> io_states_;
 
   // Traffic summary (instead of a line per command) and rate-limited warnings.
   LogLimiter warn_limit_;
@@ -307,7 +357,8 @@ class DdsBridge::Impl : private dds::DataWriterListener, private dds::DataReader
   mutable std::mutex match_mutex_;
   std::map<Prefix, int> reply_readers_;
   std::map<Prefix, int> param_reply_readers_;
-  std::vector<std::pair<Prefix, bool>> gone_;  // (participant, param writer) whose last reader left
+  std::map<Prefix, int> io_reply_readers_;
+  std::vector<std::pair<Prefix, ReplyTopic>> gone_;  // (participant, reply topic) whose last reader left
 
   // Bridge thread: requests per client without a final reply, and the clients of each participant.
   std::map<std::string, int> unanswered_;
@@ -349,6 +400,20 @@ void DdsBridge::Impl::start() {
     spdlog::warn("dds: axis_link is not published ({}); scripts/make-pki.sh makes permissions that allow it",
                  e.what());
   }
+  try {
+    io_state_w_ = &node_->writer(msg::TopicId::IoState);
+    io_reply_w_ = &node_->writer(msg::TopicId::IoWriteReply, this, dds::StatusMask::publication_matched());
+    io_write_r_ = &node_->reader(msg::TopicId::IoWrite, this, dds::StatusMask::data_available());
+  } catch (const std::runtime_error& e) {
+    // Permissions made before the I/O topics existed: the gateway runs, without them.
+    if (!node_->secure()) throw;
+    io_state_w_ = nullptr;
+    io_reply_w_ = nullptr;
+    io_write_r_ = nullptr;
+    spdlog::warn("dds: the I/O topics are not served ({}); scripts/make-pki.sh makes permissions that allow them",
+                 e.what());
+  }
+  io_states_.assign(rt_.io_slaves().size(), PublishedIo{});
   links_.assign(rt_.axes().size(), PublishedLink{});
   states_.assign(rt_.axes().size(), PublishedState{});
   const auto arrival = dds::StatusMask::data_available();
@@ -379,7 +444,12 @@ void DdsBridge::Impl::stop() {
 
 void DdsBridge::Impl::on_publication_matched(dds::DataWriter* writer, const dds::PublicationMatchedStatus& info) {
   std::lock_guard lock(match_mutex_);
-  auto& readers = writer == param_w_ ? param_reply_readers_ : reply_readers_;
+  const ReplyTopic topic = writer == param_w_     ? ReplyTopic::Param
+                           : writer == io_reply_w_ ? ReplyTopic::Io
+                                                   : ReplyTopic::Command;
+  auto& readers = topic == ReplyTopic::Param ? param_reply_readers_
+                  : topic == ReplyTopic::Io  ? io_reply_readers_
+                                             : reply_readers_;
   const Prefix p = prefix_of(info.last_subscription_handle);
   if (info.current_count_change > 0) {
     ++readers[p];
@@ -387,15 +457,17 @@ void DdsBridge::Impl::on_publication_matched(dds::DataWriter* writer, const dds:
     const auto it = readers.find(p);
     if (it != readers.end() && --it->second <= 0) {
       readers.erase(it);
-      gone_.emplace_back(p, writer == param_w_);
+      gone_.emplace_back(p, topic);
     }
   }
   rt_.output_signal().notify();  // replies may wait for this reader
 }
 
-bool DdsBridge::Impl::reader_matched(const Prefix& p, bool param) const {
+bool DdsBridge::Impl::reader_matched(const Prefix& p, ReplyTopic topic) const {
   std::lock_guard lock(match_mutex_);
-  const auto& readers = param ? param_reply_readers_ : reply_readers_;
+  const auto& readers = topic == ReplyTopic::Param ? param_reply_readers_
+                        : topic == ReplyTopic::Io  ? io_reply_readers_
+                                                   : reply_readers_;
   return readers.count(p) > 0;
 }
 
@@ -411,7 +483,7 @@ void DdsBridge::Impl::run() {
     auto until = std::min({next_state, next_bus, next_summary_});
     if (more) {
       until = Clock::now();
-    } else if (busy() || !replies_.empty() || !param_replies_.empty()) {
+    } else if (busy() || !replies_.empty() || !param_replies_.empty() || !io_replies_.empty()) {
       until = std::min(until, Clock::now() + kBusyPoll);
     }
     rt_.output_signal().wait_until(until);
@@ -422,12 +494,15 @@ void DdsBridge::Impl::run() {
     more = take_commands(t);
     take_setpoints();
     more = take_params(t) || more;
+    retry_io(t);
+    more = take_io_writes(t) || more;
     take_gateway_infos();
     collect_outbox(t);
     write_replies(t);
     forget_gone_clients();
     if (t >= next_state) {
       publish_states(t);
+      publish_io_states(t);
       next_state += state_period;
       if (next_state < t) next_state = t + state_period;  // fell behind: do not burst to catch up
     }
@@ -778,6 +853,20 @@ void DdsBridge::Impl::collect_outbox(Clock::time_point now) {
     event_w_->write(&out);
   }
 
+  for (const auto& r : outbox_.io_replies) {
+    const auto it = pending_io_.find(r.reply.id);
+    if (it == pending_io_.end()) continue;
+    const auto& [io_id, pending] = it->second;
+    auto out = io_reply(pending, io_id);
+    const auto ios = rt_.io_slaves();
+    out.ok(r.reply.status == core::IoWriteStatus::Ok);
+    out.status(std::string(core::to_string(r.reply.status)));
+    if (!out.ok()) out.reason(io_refusal_text(ios[io_id], r.reply.status, rt_.io_snapshot(io_id)));
+    io_replies_.push_back({std::move(out), pending.prefix, now});
+    answered(pending.client);
+    pending_io_.erase(it);
+  }
+
   for (const auto& p : outbox_.param_replies) {
     const auto it = pending_params_.find(p.reply.id);
     if (it == pending_params_.end()) {
@@ -804,14 +893,14 @@ void DdsBridge::Impl::collect_outbox(Clock::time_point now) {
 // Replies go out in order per client once that client's reply reader is matched (or after the hold
 // time).
 void DdsBridge::Impl::write_replies(Clock::time_point now) {
-  const auto flush = [&](auto& queue, dds::DataWriter* writer, bool param) {
+  const auto flush = [&](auto& queue, dds::DataWriter* writer, ReplyTopic topic) {
     std::set<Prefix> blocked;  // clients whose earlier reply is still waiting: keep their order
     for (auto it = queue.begin(); it != queue.end();) {
       if (blocked.count(it->prefix) > 0) {
         ++it;
         continue;
       }
-      const bool matched = reader_matched(it->prefix, param);
+      const bool matched = reader_matched(it->prefix, topic);
       if (!matched && now - it->since < kReplyHold) {
         blocked.insert(it->prefix);
         ++it;
@@ -825,8 +914,9 @@ void DdsBridge::Impl::write_replies(Clock::time_point now) {
       it = queue.erase(it);
     }
   };
-  flush(replies_, reply_w_, false);
-  flush(param_replies_, param_w_, true);
+  flush(replies_, reply_w_, ReplyTopic::Command);
+  flush(param_replies_, param_w_, ReplyTopic::Param);
+  if (io_reply_w_ != nullptr) flush(io_replies_, io_reply_w_, ReplyTopic::Io);
 }
 
 void DdsBridge::Impl::answered(const std::string& client) {
@@ -835,18 +925,21 @@ void DdsBridge::Impl::answered(const std::string& client) {
 }
 
 void DdsBridge::Impl::forget_gone_clients() {
-  std::vector<std::pair<Prefix, bool>> gone;
+  std::vector<std::pair<Prefix, ReplyTopic>> gone;
   {
     std::lock_guard lock(match_mutex_);
     gone.swap(gone_);
   }
-  for (const auto& [prefix, param] : gone) {
+  for (const auto& [prefix, topic] : gone) {
     const auto it = clients_of_.find(prefix);
     if (it == clients_of_.end()) continue;
     for (const auto& name : it->second) {
-      if (param) {
+      if (topic == ReplyTopic::Param) {
         auto key = instance_key<msg::ParameterReply>(gateway_, name);
         param_w_->unregister_instance(&key, dds::HANDLE_NIL);
+      } else if (topic == ReplyTopic::Io) {
+        auto key = instance_key<msg::IoWriteReply>(gateway_, name);
+        io_reply_w_->unregister_instance(&key, dds::HANDLE_NIL);
       } else {
         auto key = instance_key<msg::CommandReply>(gateway_, name);
         reply_w_->unregister_instance(&key, dds::HANDLE_NIL);
@@ -854,7 +947,9 @@ void DdsBridge::Impl::forget_gone_clients() {
     }
     // Both reply readers gone: the participant is done with this gateway.
     std::lock_guard lock(match_mutex_);
-    if (reply_readers_.count(prefix) == 0 && param_reply_readers_.count(prefix) == 0) clients_of_.erase(it);
+    if (reply_readers_.count(prefix) == 0 && param_reply_readers_.count(prefix) == 0 &&
+        io_reply_readers_.count(prefix) == 0)
+      clients_of_.erase(it);
   }
 }
 
@@ -934,6 +1029,163 @@ void DdsBridge::Impl::publish_link(std::size_t axis_id, const core::AxisSnapshot
   out.detail(s.link_detail.str());
   out.since(s.link_since_ns);
   if (link_w_->write(&out)) last = {true, s.link, s.link_detail};
+}
+
+std::string DdsBridge::Impl::io_list() const {
+  std::string s;
+  for (const auto& io : rt_.io_slaves()) {
+    if (!s.empty()) s += ", ";
+    s += io.name + " (bus " + io.bus + ")";
+  }
+  return s.empty() ? "(none)" : s;
+}
+
+bool DdsBridge::Impl::take_io_writes(Clock::time_point now) {
+  if (io_write_r_ == nullptr) return false;
+  msg::IoWrite in;
+  dds::SampleInfo info;
+  for (std::size_t n = 0; n < kTakePerPass; ++n) {
+    if (busy() || io_write_r_->take_next_sample(&in, &info) != ReturnCode_t::RETCODE_OK) return false;
+    if (!info.valid_data || in.gateway() != gateway_) continue;
+    handle_io_write(in, prefix_of(info.publication_handle), now);
+  }
+  return true;
+}
+
+void DdsBridge::Impl::refuse_io(const msg::IoWrite& in, const Prefix& from, core::IoWriteStatus status,
+                                const std::string& reason, Clock::time_point now) {
+  if (warn_limit_.allow(now))
+    spdlog::warn("dds: I/O write to '{}' from '{}' id {} refused: {}", in.slave(), in.client(), in.id(), reason);
+  msg::IoWriteReply out;
+  out.gateway(gateway_);
+  out.bus(in.bus());
+  out.slave(in.slave());
+  out.client(in.client());
+  out.id(in.id());
+  out.ok(false);
+  out.status(std::string(core::to_string(status)));
+  out.reason(reason);
+  io_replies_.push_back({std::move(out), from, now});
+}
+
+void DdsBridge::Impl::handle_io_write(const msg::IoWrite& in, const Prefix& from, Clock::time_point now) {
+  summary_clients_.insert(in.client());
+  const auto ios = rt_.io_slaves();
+  std::optional<std::size_t> found;
+  std::size_t matches = 0;
+  for (std::size_t i = 0; i < ios.size(); ++i)
+    if (ios[i].name == in.slave() && (in.bus().empty() || ios[i].bus == in.bus())) {
+      found = i;
+      ++matches;
+    }
+  if (!found)
+    return refuse_io(in, from, core::IoWriteStatus::UnknownSlave,
+                     "unknown I/O slave '" + in.slave() + "'" + (in.bus().empty() ? "" : " on bus " + in.bus()) +
+                         " on gateway '" + gateway_ + "'; I/O slaves here: " + io_list(),
+                     now);
+  if (matches > 1)
+    return refuse_io(in, from, core::IoWriteStatus::UnknownSlave,
+                     "I/O slave '" + in.slave() + "' is on more than one bus of gateway '" + gateway_ +
+                         "': name the bus; I/O slaves here: " + io_list(),
+                     now);
+  const IoSlaveInfo& io = ios[*found];
+  // The bus checks the range against the slave's actual image; the size known here (from the
+  // latest snapshot, else the configuration) gives the early answer.
+  const core::IoSnapshot snap = rt_.io_snapshot(*found);
+  const std::size_t outputs = snap.output_size != 0 ? snap.output_size : io.output_size;
+  const std::size_t n = in.data().size();
+  if (n == 0 || n > core::kMaxIoBytes || in.offset() > core::kMaxIoBytes ||
+      ((snap.output_size != 0 || io.sized) && (in.offset() > outputs || n > outputs - in.offset())))
+    return refuse_io(in, from, core::IoWriteStatus::OutOfRange,
+                     n == 0 ? "nothing to write (no bytes)"
+                            : "out of range: " + std::to_string(n) + " byte(s) at offset " +
+                                  std::to_string(in.offset()) + ", but I/O slave '" + io.name + "' on bus " + io.bus +
+                                  " has " + std::to_string(outputs) + " output bytes",
+                     now);
+  if (unanswered_[in.client()] >= kClientLimit)
+    return refuse_io(in, from, core::IoWriteStatus::Busy,
+                     "busy: client '" + in.client() + "' has " + std::to_string(kClientLimit) +
+                         " requests without a final reply; wait for replies before sending more",
+                     now);
+  core::IoWrite w;
+  w.id = next_id_++;
+  w.offset = static_cast<std::uint16_t>(in.offset());
+  w.size = static_cast<std::uint16_t>(n);
+  std::copy(in.data().begin(), in.data().end(), w.data.begin());
+  ++unanswered_[in.client()];
+  clients_of_[from].insert(in.client());
+  Pending p{in.client(), in.id(), in.slave(), from, 0, 0};
+  spdlog::debug("dds: I/O write of {} byte(s) at {} to '{}' from '{}' id {} -> request {}", n, in.offset(),
+                in.slave(), in.client(), in.id(), w.id);
+  if (!rt_.submit_io_write(*found, w)) {
+    deferred_io_.push_back({*found, w, std::move(p), now});
+    return;
+  }
+  pending_io_.emplace(w.id, std::make_pair(*found, std::move(p)));
+  count([](Stats& s) { ++s.io_writes_routed; });
+}
+
+void DdsBridge::Impl::retry_io(Clock::time_point now) {
+  while (!deferred_io_.empty()) {
+    auto& d = deferred_io_.front();
+    if (rt_.submit_io_write(d.axis_id, d.request)) {
+      pending_io_.emplace(d.request.id, std::make_pair(d.axis_id, std::move(d.pending)));
+      count([](Stats& s) { ++s.io_writes_routed; });
+    } else if (now - d.since >= kBusyAfter) {
+      auto out = io_reply(d.pending, d.axis_id);
+      out.ok(false);
+      out.status(std::string(core::to_string(core::IoWriteStatus::Busy)));
+      out.reason("busy: the gateway's I/O queue of bus " + rt_.io_slaves()[d.axis_id].bus + " stayed full for " +
+                 std::to_string(std::chrono::duration_cast<std::chrono::milliseconds>(kBusyAfter).count()) +
+                 " ms; send it again");
+      io_replies_.push_back({std::move(out), d.pending.prefix, now});
+      answered(d.pending.client);
+    } else {
+      break;
+    }
+    deferred_io_.pop_front();
+  }
+}
+
+void DdsBridge::Impl::publish_io_states(Clock::time_point now) {
+  if (io_state_w_ == nullptr) return;
+  const auto ios = rt_.io_slaves();
+  msg::IoState out;
+  out.gateway(gateway_);
+  std::size_t written = 0;
+  // Every slave goes out whenever one changed or the keep-alive is due: a reader that got one of
+  // this gateway's slaves has them all (the client's first read relies on it), and the samples
+  // are small.
+  std::vector<core::IoSnapshot> snaps;
+  snaps.reserve(ios.size());
+  bool due = false;
+  for (std::size_t i = 0; i < ios.size() && i < io_states_.size(); ++i) {
+    snaps.push_back(rt_.io_snapshot(i));
+    const core::IoSnapshot& s = snaps.back();
+    const PublishedIo& last = io_states_[i];
+    const auto& a = last.snapshot;
+    const bool same = a.valid == s.valid && a.input_size == s.input_size && a.output_size == s.output_size &&
+                      std::equal(a.inputs.begin(), a.inputs.begin() + a.input_size, s.inputs.begin()) &&
+                      std::equal(a.outputs.begin(), a.outputs.begin() + a.output_size, s.outputs.begin());
+    due = due || !last.written || now - last.at >= opt_.status_keepalive || !same;
+  }
+  if (!due) return;
+  for (std::size_t i = 0; i < snaps.size(); ++i) {
+    const core::IoSnapshot& s = snaps[i];
+    PublishedIo& last = io_states_[i];
+    out.bus(ios[i].bus);
+    out.slave(ios[i].name);
+    out.address(ios[i].address);
+    out.inputs(std::vector<std::uint8_t>(s.inputs.begin(), s.inputs.begin() + s.input_size));
+    out.outputs(std::vector<std::uint8_t>(s.outputs.begin(), s.outputs.begin() + s.output_size));
+    out.valid(s.valid);
+    out.stamp(s.stamp_ns);
+    out.seq(state_seq_);
+    if (!io_state_w_->write(&out)) continue;
+    last = {true, s, now};
+    ++written;
+  }
+  count([&](Stats& st) { st.io_states_published += written; });
 }
 
 void DdsBridge::Impl::publish_bus_status() {

@@ -73,6 +73,8 @@ class DdsBridge {
     std::uint64_t replies_written = 0;
     std::uint64_t replies_unmatched = 0;  // written after the hold time without a matched reader of the client
     std::uint64_t states_published = 0;
+    std::uint64_t io_writes_routed = 0;
+    std::uint64_t io_states_published = 0;
     std::uint64_t wakeups = 0;  // passes of the bridge loop: it runs on work and publication deadlines, not a poll
   };
   // Safe from any thread.

@@ -54,6 +54,12 @@ Gateway::Gateway(const config::Plan& plan) : name_(plan.gateway.name) {
     }
     slot.bus = make_bus(bp);
     slot.runner = std::make_unique<core::BusRunner>(*slot.bus, slot.specs);
+    slot.first_io = io_.size();
+    for (std::size_t k = 0; k < slot.bus->io_count(); ++k) {
+      const core::IoInfo i = slot.bus->io_info(k);
+      io_.push_back(IoSlaveInfo{std::string(i.name), bp.name, bp.type, buses_.size(), i.address, i.input_size,
+                                i.output_size, i.sized});
+    }
     buses_.push_back(std::move(slot));
   }
 }
@@ -145,6 +151,21 @@ core::AxisSnapshot Gateway::snapshot(std::size_t axis_id) const {
   return buses_[refs_[axis_id].bus].runner->snapshot(refs_[axis_id].axis);
 }
 
+core::IoSnapshot Gateway::io_snapshot(std::size_t io_id) const {
+  if (io_id >= io_.size()) return {};
+  const auto& b = buses_[io_[io_id].bus_index];
+  return b.runner->io_snapshot(io_id - b.first_io);
+}
+
+bool Gateway::submit_io_write(std::size_t io_id, const core::IoWrite& w) {
+  if (io_id >= io_.size()) return false;
+  std::lock_guard lock(submit_mutex_);
+  auto& b = buses_[io_[io_id].bus_index];
+  core::IoWrite local = w;
+  local.slave = static_cast<std::uint16_t>(io_id - b.first_io);
+  return b.runner->push_io_write(local);
+}
+
 BusStatus Gateway::bus_status(std::size_t bus) const {
   BusStatus s;
   if (bus >= buses_.size()) return s;
@@ -195,6 +216,11 @@ void Gateway::drain(Outbox& out) {
     while (b.runner->pop_parameter_reply(p.reply)) {
       p.axis_id = b.first_axis + p.reply.axis;
       out.param_replies.push_back(p);
+    }
+    GlobalIoReply io;
+    while (b.runner->pop_io_reply(io.reply)) {
+      io.io_id = b.first_io + io.reply.slave;
+      out.io_replies.push_back(io);
     }
   }
   std::lock_guard lock(submit_mutex_);

@@ -55,6 +55,9 @@ class Gateway final : public Runtime {
   ParameterLookup lookup_parameter(std::size_t axis_id, std::string_view name, std::uint16_t index,
                                    std::uint8_t sub) const override;
   core::AxisSnapshot snapshot(std::size_t axis_id) const override;
+  std::span<const IoSlaveInfo> io_slaves() const noexcept override { return io_; }
+  core::IoSnapshot io_snapshot(std::size_t io_id) const override;
+  bool submit_io_write(std::size_t io_id, const core::IoWrite& w) override;
   std::size_t bus_count() const noexcept override { return buses_.size(); }
   BusStatus bus_status(std::size_t bus) const override;
   void drain(Outbox& out) override;
@@ -69,6 +72,7 @@ class Gateway final : public Runtime {
     std::unique_ptr<core::BusRunner> runner;
     std::unique_ptr<CycleThread> thread;
     std::size_t first_axis = 0;  // global id of its axis 0
+    std::size_t first_io = 0;    // global id of its I/O slave 0
     bool open = false;
   };
   struct AxisRef {
@@ -83,6 +87,7 @@ class Gateway final : public Runtime {
   std::string name_;
   std::vector<AxisInfo> axes_;
   std::vector<AxisRef> refs_;
+  std::vector<IoSlaveInfo> io_;
   std::vector<BusSlot> buses_;
   // The bus runners' inbound queues are single-producer; the bridge thread and the shutdown
   // sequence both submit, so submissions are serialised here (control plane only).

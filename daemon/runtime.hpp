@@ -14,6 +14,7 @@
 #include "core/axis_types.hpp"
 #include "core/bus.hpp"
 #include "core/command.hpp"
+#include "core/io.hpp"
 #include "daemon/wake_signal.hpp"
 
 namespace drivegate::daemon {
@@ -26,6 +27,18 @@ struct AxisInfo {
   std::string device;
   std::string unit;  // user unit of positions
   core::ModeSet modes;
+};
+
+// A generic I/O slave of a bus (core/io.hpp), by global id (index into io_slaves()).
+struct IoSlaveInfo {
+  std::string name;
+  std::string bus;
+  std::string bus_type;
+  std::size_t bus_index = 0;   // index into the gateway's buses (bus_status())
+  std::uint32_t address = 0;   // on its bus (EtherCAT: the 1-based position)
+  std::size_t input_size = 0;  // configured sizes (0 with sized false: the device's, known after boot)
+  std::size_t output_size = 0;
+  bool sized = false;
 };
 
 struct BusStatus {
@@ -57,14 +70,20 @@ struct GlobalParamReply {
   std::size_t axis_id = 0;
   core::ParamReply reply;
 };
+struct GlobalIoReply {
+  std::size_t io_id = 0;
+  core::IoWriteReply reply;
+};
 struct Outbox {
   std::vector<GlobalReply> replies;
   std::vector<GlobalEvent> events;
   std::vector<GlobalParamReply> param_replies;
+  std::vector<GlobalIoReply> io_replies;
   void clear() {
     replies.clear();
     events.clear();
     param_replies.clear();
+    io_replies.clear();
   }
 };
 
@@ -96,6 +115,12 @@ class Runtime {
                                                          std::uint16_t index, std::uint8_t sub) const = 0;
 
   [[nodiscard]] virtual core::AxisSnapshot snapshot(std::size_t axis_id) const = 0;
+
+  // Generic I/O slaves (none by default). A write's reply (with the IoWrite's id) comes through
+  // drain(); false when the slave's bus queue is full (the caller retries or answers busy).
+  [[nodiscard]] virtual std::span<const IoSlaveInfo> io_slaves() const noexcept { return {}; }
+  [[nodiscard]] virtual core::IoSnapshot io_snapshot(std::size_t /*io_id*/) const { return {}; }
+  virtual bool submit_io_write(std::size_t /*io_id*/, const core::IoWrite& /*w*/) { return false; }
   [[nodiscard]] virtual std::size_t bus_count() const noexcept = 0;
   [[nodiscard]] virtual BusStatus bus_status(std::size_t bus) const = 0;
 

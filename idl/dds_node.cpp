@@ -38,7 +38,8 @@ namespace {
 // durability, so the gateway holds a client's replies until its reader is matched. State and
 // set-points are best effort, newest only; events transient-local so a late joiner sees recent
 // faults; gateway_info, bus_status and axis_link transient-local so a CLI started now sees them at
-// once.
+// once. The I/O topics go as their axis counterparts: io_state as axis_state, io_write as the
+// parameter requests, io_write_reply as their replies.
 constexpr std::array<TopicQos, kTopicCount> kQos{{
     {TopicId::AxisState, false, false, false, 1, "gateway, axis"},
     {TopicId::AxisCommand, true, false, true, 1024, ""},
@@ -50,6 +51,9 @@ constexpr std::array<TopicQos, kTopicCount> kQos{{
     {TopicId::ParamReply, true, false, false, 1024, "gateway, client"},
     {TopicId::GatewayInfo, true, true, false, 1, "gateway"},
     {TopicId::AxisLink, true, true, false, 1, "gateway, axis"},
+    {TopicId::IoState, false, false, false, 1, "gateway, bus, slave"},
+    {TopicId::IoWrite, true, false, true, 1024, ""},
+    {TopicId::IoWriteReply, true, false, false, 1024, "gateway, client"},
 }};
 
 // Instances (axes, buses, clients) a topic keeps apart at once; memory grows with use, not up front.
@@ -104,6 +108,9 @@ dds::TopicDataType* make_type(TopicId t) {
     case TopicId::ParamReply: return new ParameterReplyPubSubType();
     case TopicId::GatewayInfo: return new GatewayInfoPubSubType();
     case TopicId::AxisLink: return new AxisLinkPubSubType();
+    case TopicId::IoState: return new IoStatePubSubType();
+    case TopicId::IoWrite: return new IoWritePubSubType();
+    case TopicId::IoWriteReply: return new IoWriteReplyPubSubType();
   }
   return nullptr;
 }
@@ -122,6 +129,9 @@ std::string_view topic_suffix(TopicId t) noexcept {
     case TopicId::ParamReply: return "param_reply";
     case TopicId::GatewayInfo: return "gateway_info";
     case TopicId::AxisLink: return "axis_link";
+    case TopicId::IoState: return "io_state";
+    case TopicId::IoWrite: return "io_write";
+    case TopicId::IoWriteReply: return "io_write_reply";
   }
   return "unknown";
 }

@@ -48,8 +48,11 @@ enum class TopicId : std::uint8_t {
   ParamReply,
   GatewayInfo,
   AxisLink,
+  IoState,
+  IoWrite,
+  IoWriteReply,
 };
-inline constexpr std::size_t kTopicCount = 10;
+inline constexpr std::size_t kTopicCount = 13;
 
 // "axis_state", "axis_command", ... (the part after "<namespace>/").
 std::string_view topic_suffix(TopicId t) noexcept;

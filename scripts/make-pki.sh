@@ -223,17 +223,17 @@ fi
 topics_publish() {
   case $1 in
     observer) ;;
-    operator) echo axis_command setpoint ;;
-    engineer) echo axis_command setpoint param_request ;;
-    gateway) echo axis_state command_reply axis_event bus_status param_reply gateway_info axis_link ;;
+    operator) echo axis_command setpoint io_write ;;
+    engineer) echo axis_command setpoint param_request io_write ;;
+    gateway) echo axis_state command_reply axis_event bus_status param_reply gateway_info axis_link io_state io_write_reply ;;
   esac
 }
 topics_subscribe() {
   case $1 in
-    observer) echo axis_state axis_event bus_status gateway_info axis_link ;;
-    operator) echo axis_state axis_event bus_status gateway_info axis_link command_reply ;;
-    engineer) echo axis_state axis_event bus_status gateway_info axis_link command_reply param_reply ;;
-    gateway) echo axis_command setpoint param_request gateway_info ;;
+    observer) echo axis_state axis_event bus_status gateway_info axis_link io_state ;;
+    operator) echo axis_state axis_event bus_status gateway_info axis_link command_reply io_state io_write_reply ;;
+    engineer) echo axis_state axis_event bus_status gateway_info axis_link command_reply param_reply io_state io_write_reply ;;
+    gateway) echo axis_command setpoint param_request gateway_info io_write ;;
   esac
 }
 # The <topic> patterns for one topic. Fast DDS 2.9 matches with fnmatch(pattern, name,
@@ -299,14 +299,14 @@ EOF
       <topic_access_rules>
 EOF
   # Commands, set-points, parameters and their replies move machines and change drives:
-  # confidential and tamper-proof, data and metadata.
-  for t in axis_command setpoint command_reply param_request param_reply; do
+  # confidential and tamper-proof, data and metadata; so do the output bytes of I/O slaves.
+  for t in axis_command setpoint command_reply param_request param_reply io_write io_write_reply; do
     topic_rule "$t" ENCRYPT ENCRYPT
   done
-  # State, events, bus status, gateway info, link details: nothing secret, but nobody may forge
+  # State, events, bus status, gateway info, link details, I/O bytes: nothing secret, but nobody may forge
   # them. Signing the submessage covers its serialized payload too, so data protection on top adds
   # nothing.
-  for t in axis_state axis_event bus_status gateway_info axis_link; do
+  for t in axis_state axis_event bus_status gateway_info axis_link io_state; do
     topic_rule "$t" SIGN NONE
   done
   cat <<EOF

@@ -143,6 +143,7 @@ EthercatBus::EthercatBus(const config::BusPlan& plan, std::unique_ptr<Link> link
     }
     const SiiIdentity first = s->identities.empty() ? SiiIdentity{} : s->identities.front();
     expected_.push_back(ExpectedSlave{first.vendor_id, first.product_code, first.revision, s->plan.name});
+    if (s->plan.io != nullptr) io_.add(slaves_.size(), s->plan);
     slaves_.push_back(std::move(s));
   }
   LineBootConfig lb;

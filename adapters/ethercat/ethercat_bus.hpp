@@ -50,6 +50,7 @@
 #include <vector>
 
 #include "adapters/ethercat/bus_dc.hpp"
+#include "adapters/ethercat/bus_io.hpp"
 #include "adapters/ethercat/link/link.hpp"
 #include "adapters/ethercat/master/coe_sdo_client.hpp"
 #include "adapters/ethercat/master/cyclic_exchange.hpp"
@@ -121,6 +122,11 @@ class EthercatBus final : public core::Bus, private EmergencySink, private Datag
   void transmit(core::TimePoint now) noexcept override;
   bool next_event(core::Event& out) noexcept override;
   core::BusCounters counters() const noexcept override;
+  // The `io:` slaves (bus_io.hpp; defined in bus_io.cpp).
+  std::size_t io_count() const noexcept override { return io_.count(); }
+  core::IoInfo io_info(std::size_t k) const noexcept override;
+  void io_read(std::size_t k, core::IoSnapshot& out) noexcept override;
+  core::IoWriteStatus io_write(std::size_t k, std::size_t offset, std::span<const std::uint8_t> bytes) noexcept override;
 
   static constexpr std::size_t kMaxEvents = 32;
   // A drive out of the gateway's control gets this long on its quick-stop ramp.
@@ -223,6 +229,7 @@ class EthercatBus final : public core::Bus, private EmergencySink, private Datag
   std::optional<CyclicExchange> cx_;
   std::vector<std::unique_ptr<Slave>> slaves_;
   std::vector<Axis> axes_;
+  BusIo io_;
   std::array<FrameBuffer, 8> rx_{};
   std::unique_ptr<BusDc> dc_;
 

@@ -40,6 +40,58 @@ bool FakeRuntime::submit_command(std::size_t axis_id, const core::Command& cmd) 
   return true;
 }
 
+void FakeRuntime::add_io(std::string name, std::size_t inputs, std::size_t outputs) {
+  std::lock_guard lock(mutex_);
+  io_.push_back(daemon::IoSlaveInfo{std::move(name), "ec0", "ethercat", 0, static_cast<std::uint32_t>(2 + io_.size()),
+                                    inputs, outputs, true});
+  core::IoSnapshot s;
+  s.valid = true;
+  s.input_size = static_cast<std::uint16_t>(inputs);
+  s.output_size = static_cast<std::uint16_t>(outputs);
+  s.stamp_ns = kStampNs;
+  io_data_.push_back(s);
+}
+
+void FakeRuntime::set_io_inputs(std::size_t io_id, std::vector<std::uint8_t> inputs) {
+  std::lock_guard lock(mutex_);
+  std::copy(inputs.begin(), inputs.end(), io_data_.at(io_id).inputs.begin());
+}
+
+void FakeRuntime::set_io_lost(std::size_t io_id, bool lost) {
+  std::lock_guard lock(mutex_);
+  io_data_.at(io_id).valid = !lost;
+}
+
+std::vector<std::uint8_t> FakeRuntime::io_outputs(std::size_t io_id) const {
+  std::lock_guard lock(mutex_);
+  const auto& s = io_data_.at(io_id);
+  return {s.outputs.begin(), s.outputs.begin() + s.output_size};
+}
+
+core::IoSnapshot FakeRuntime::io_snapshot(std::size_t io_id) const {
+  std::lock_guard lock(mutex_);
+  return io_id < io_data_.size() ? io_data_[io_id] : core::IoSnapshot{};
+}
+
+bool FakeRuntime::submit_io_write(std::size_t io_id, const core::IoWrite& w) {
+  std::lock_guard lock(mutex_);
+  if (busy_) return false;
+  daemon::GlobalIoReply r;
+  r.io_id = io_id;
+  r.reply.id = w.id;
+  r.reply.slave = static_cast<std::uint16_t>(io_id);
+  auto& s = io_data_.at(io_id);
+  if (!s.valid)
+    r.reply.status = core::IoWriteStatus::SlaveLost;
+  else if (w.size == 0 || w.offset + w.size > s.output_size)
+    r.reply.status = core::IoWriteStatus::OutOfRange;
+  else
+    std::copy_n(w.data.begin(), w.size, s.outputs.begin() + w.offset);
+  pending_.io_replies.push_back(r);
+  signal_.notify();
+  return true;
+}
+
 bool FakeRuntime::submit_setpoint(std::size_t axis_id, const core::Setpoint& sp) {
   std::lock_guard lock(mutex_);
   if (busy_) return false;
@@ -154,6 +206,7 @@ void FakeRuntime::drain(daemon::Outbox& out) {
   out.replies.insert(out.replies.end(), pending_.replies.begin(), pending_.replies.end());
   out.events.insert(out.events.end(), pending_.events.begin(), pending_.events.end());
   out.param_replies.insert(out.param_replies.end(), pending_.param_replies.begin(), pending_.param_replies.end());
+  out.io_replies.insert(out.io_replies.end(), pending_.io_replies.begin(), pending_.io_replies.end());
   pending_.clear();
 }
 

@@ -27,9 +27,18 @@ class FakeRuntime final : public daemon::Runtime {
   [[nodiscard]] std::size_t bus_count() const noexcept override { return 1; }
   [[nodiscard]] daemon::BusStatus bus_status(std::size_t bus) const override;
   void drain(daemon::Outbox& out) override;
+  [[nodiscard]] std::span<const daemon::IoSlaveInfo> io_slaves() const noexcept override { return io_; }
+  [[nodiscard]] core::IoSnapshot io_snapshot(std::size_t io_id) const override;
+  bool submit_io_write(std::size_t io_id, const core::IoWrite& w) override;
   [[nodiscard]] daemon::WakeSignal& output_signal() noexcept override { return signal_; }
 
   // Test controls and observations.
+  // An I/O slave on bus "ec0" with these sizes, inputs zero, outputs zero, valid (before start()).
+  void add_io(std::string name, std::size_t inputs, std::size_t outputs);
+  void set_io_inputs(std::size_t io_id, std::vector<std::uint8_t> inputs);
+  // A lost slave: inputs stale, writes refused with slave_lost (as the EtherCAT bus does).
+  void set_io_lost(std::size_t io_id, bool lost);
+  [[nodiscard]] std::vector<std::uint8_t> io_outputs(std::size_t io_id) const;
   void set_busy(bool busy);
   void set_complete_commands(bool complete);  // false: reply Accepted only
   // An object and its type as the axis' EDS would give it (Unknown: the gateway would not know it);
@@ -72,6 +81,8 @@ class FakeRuntime final : public daemon::Runtime {
   daemon::WakeSignal signal_;  // notified whenever pending_ grows, as the gateway's cycle threads do
   std::map<std::size_t, core::AxisSnapshot> links_;  // link, link_detail, link_since_ns per axis
   std::map<std::size_t, double> positions_;
+  std::vector<daemon::IoSlaveInfo> io_;
+  std::vector<core::IoSnapshot> io_data_;
 };
 
 }  // namespace drivegate::dds_test

@@ -66,7 +66,8 @@ TEST(QosTable, KeysMatchTheIdl) {
       {"axis_state", "AxisState"},       {"axis_command", "AxisCommand"}, {"command_reply", "CommandReply"},
       {"setpoint", "Setpoint"},          {"axis_event", "AxisEvent"},     {"bus_status", "BusStatus"},
       {"param_request", "ParameterRequest"},  {"param_reply", "ParameterReply"},   {"gateway_info", "GatewayInfo"},
-      {"axis_link", "AxisLink"}};
+      {"axis_link", "AxisLink"}, {"io_state", "IoState"}, {"io_write", "IoWrite"},
+      {"io_write_reply", "IoWriteReply"}};
   for (const auto& q : msg::qos_table()) {
     const std::string type = type_of.at(std::string(msg::topic_suffix(q.topic)));
     const auto at = idl.find("struct " + type + " {");

@@ -122,6 +122,9 @@ TEST_F(Security, AnEngineerReadsAndWritesParameters) {
   ASSERT_TRUE(r.ok) << r.error;
   EXPECT_EQ(r.integer(), 12345);
   EXPECT_EQ(eng.send(request("x", "enable"), true, 10s).outcome, client::Outcome::Completed);
+  // The I/O topics are the engineer's (and the gateway serves them: its permissions allow them).
+  EXPECT_EQ(eng.io_refusal(), "");
+  EXPECT_EQ(daemon_->log().find("I/O topics are not served"), std::string::npos) << daemon_->log();
 }
 
 // observer: reads state, cannot create a command writer; drivegatectl says why.
@@ -144,6 +147,18 @@ TEST_F(Security, AnObserverReadsStateButCannotCommand) {
   EXPECT_NE(status.find("x: link operational for "), std::string::npos) << status;
   ASSERT_TRUE(obs.wait_until([&] { return obs.link("x").has_value(); }, 5s));
   EXPECT_EQ(obs.link("x")->link, "operational");
+  // I/O: the observer reads io_state but may not write outputs.
+  EXPECT_NE(obs.io_refusal().find("io_write"), std::string::npos) << obs.io_refusal();
+  client::IoWriteRequest w;
+  w.gateway = "gw";
+  w.slave = "panel";
+  w.data = {0x01};
+  const auto io = obs.io_write(w, 2s);
+  EXPECT_FALSE(io.ok);
+  EXPECT_NE(io.error.find("access control"), std::string::npos) << io.error;
+  // ...and reads them (the demo's EtherCAT panel, signed not encrypted).
+  ASSERT_TRUE(obs.wait_until([&] { return obs.io_state("panel").has_value(); }, 5s));
+  EXPECT_EQ(obs.io_state("panel")->inputs.size(), 2U);
 }
 
 // No identity, a certificate of another CA, an expired one: nothing to see, nothing to command.
