@@ -1,0 +1,147 @@
+// Frames written by the codecs dissect cleanly in Debian's tshark: no "Malformed", no expert
+// warnings or errors, and the fields filled. The frames go through a classic pcap file (link type
+// 1 = Ethernet, tests/support/pcap.hpp) to `tshark -r FILE -V`, one file per frame so that each
+// dissection is judged on its own. Skipped when tshark is not installed (scripts/install-deps.sh).
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdlib>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "adapters/profinet/wire/dcp.hpp"
+#include "adapters/profinet/wire/ethernet.hpp"
+#include "tests/support/pcap.hpp"
+#include "tests/support/run_program.hpp"
+
+namespace drivegate::profinet {
+namespace {
+
+using Bytes = std::vector<std::uint8_t>;
+
+constexpr MacAddress kController{0x02, 0x00, 0x00, 0x00, 0x00, 0x01};
+constexpr MacAddress kDevice{0x00, 0x1B, 0x1B, 0x12, 0x34, 0x56};
+
+bool have_tshark() { return test::run_program({"tshark", "--version"}).status != 127; }
+
+// `tshark -V` (plus `extra` options) of one frame, with expert infos listed (-z expert).
+std::string dissect(const Bytes& frame, const std::vector<std::string>& extra = {}) {
+  static int serial = 0;
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("drivegate-pn-tshark-" + std::to_string(::getpid()) + "-" + std::to_string(serial++) + ".pcap");
+  test::write_pcap(path, {frame});
+  std::vector<std::string> argv{"tshark", "-r", path.string(), "-V", "-z", "expert,note"};
+  argv.insert(argv.end(), extra.begin(), extra.end());
+  const test::RunResult r = test::run_program(argv);
+  if (std::getenv("KEEP_PCAP") == nullptr) std::filesystem::remove(path);
+  return r.output;
+}
+
+// An Ethernet frame around a PDU written by `encode` into the buffer after the header.
+template <typename Encode>
+Bytes frame(const EthernetHeader& h, Encode encode) {
+  std::array<std::uint8_t, kMaxFrameSize> buf{};
+  const std::size_t at = encode_ethernet_header(h, buf);
+  EXPECT_NE(at, 0U);
+  const std::size_t n = encode(std::span<std::uint8_t>(buf).subspan(at));
+  EXPECT_NE(n, 0U);
+  const std::size_t size = pad_frame(buf, at + n);
+  return Bytes(buf.begin(), buf.begin() + static_cast<std::ptrdiff_t>(size));
+}
+
+EthernetHeader header(const MacAddress& dst, const MacAddress& src, std::uint16_t id) {
+  EthernetHeader h;
+  h.dst = dst;
+  h.src = src;
+  h.frame_id = id;
+  return h;
+}
+
+void expect_clean(const std::string& out, std::initializer_list<const char*> fields) {
+  ASSERT_FALSE(out.empty());
+  EXPECT_EQ(out.find("Malformed"), std::string::npos) << out;
+  EXPECT_EQ(out.find("Exception"), std::string::npos) << out;
+  // `-z expert,note` prints a table of warnings and errors when there are any.
+  EXPECT_EQ(out.find("Errors ("), std::string::npos) << out;
+  EXPECT_EQ(out.find("Warns ("), std::string::npos) << out;
+  EXPECT_EQ(out.find("Expert Info (Error"), std::string::npos) << out;
+  EXPECT_EQ(out.find("Expert Info (Warning"), std::string::npos) << out;
+  for (const char* f : fields) EXPECT_NE(out.find(f), std::string::npos) << "missing: " << f << "\n" << out;
+}
+
+IpSuite suite() {
+  IpSuite s;
+  s.address = {192, 168, 0, 10};
+  s.netmask = {255, 255, 255, 0};
+  s.gateway = {192, 168, 0, 1};
+  return s;
+}
+
+TEST(PnTshark, DcpIdentifyAll) {
+  if (!have_tshark()) GTEST_SKIP() << "tshark not installed (scripts/install-deps.sh)";
+  const Bytes f = frame(header(kDcpIdentifyMulticast, kController, frame_id::kDcpIdentifyRequest),
+                        [](std::span<std::uint8_t> out) { return encode_identify_all_request(out, 0x1001, 1); });
+  expect_clean(dissect(f), {"PROFINET DCP", "ServiceID: Identify (5)", "ServiceType: Request (0)", "Xid: 0x00001001", "All"});
+}
+
+TEST(PnTshark, DcpIdentifyByName) {
+  if (!have_tshark()) GTEST_SKIP() << "tshark not installed";
+  const Bytes f = frame(header(kDcpIdentifyMulticast, kController, frame_id::kDcpIdentifyRequest),
+                        [](std::span<std::uint8_t> out) { return encode_identify_name_request(out, 0x1002, 1, "akd-1"); });
+  expect_clean(dissect(f), {"PROFINET DCP", "Identify", "NameOfStation: akd-1"});
+}
+
+TEST(PnTshark, DcpIdentifyResponse) {
+  if (!have_tshark()) GTEST_SKIP() << "tshark not installed";
+  static constexpr std::array<std::uint8_t, 6> kOptions{0x01, 0x02, 0x02, 0x02, 0x05, 0x03};
+  DcpDeviceInfo d;
+  d.has_type_of_station = true;
+  d.type_of_station = "AKD";
+  d.has_name_of_station = true;
+  d.name_of_station = "akd-1";
+  d.has_device_id = true;
+  d.vendor_id = 0x002A;
+  d.device_id = 0x0301;
+  d.has_device_role = true;
+  d.device_role = device_role::kIoDevice;
+  d.has_device_options = true;
+  d.device_options = kOptions;
+  d.has_device_instance = true;
+  d.instance_low = 1;
+  d.has_ip = true;
+  d.ip_block_info = ip_block_info::kSet;
+  d.ip = suite();
+  const Bytes f = frame(header(kController, kDevice, frame_id::kDcpIdentifyResponse),
+                        [&d](std::span<std::uint8_t> out) { return encode_identify_response(out, 0x1001, d); });
+  expect_clean(dissect(f), {"PROFINET DCP", "Identify", "Response Success", "NameOfStation: akd-1",
+                            "DeviceVendorValue: AKD", "VendorID: 0x002a", "DeviceID: 0x0301", "IO-Device",
+                            "IPaddress: 192.168.0.10", "Subnetmask: 255.255.255.0", "StandardGateway: 192.168.0.1",
+                            "DeviceInstanceLow: 0x01", "Dev-Options(3)"});
+}
+
+TEST(PnTshark, DcpSetNameIpSignal) {
+  if (!have_tshark()) GTEST_SKIP() << "tshark not installed";
+  const EthernetHeader h = header(kDevice, kController, frame_id::kDcpGetSet);
+  expect_clean(dissect(frame(h, [](std::span<std::uint8_t> out) {
+                 return encode_set_name_request(out, 0x2001, "akd-1", DcpQualifier::Permanent);
+               })),
+               {"PROFINET DCP", "Set", "NameOfStation: akd-1", "BlockQualifier: Save the value permanent (1)"});
+  expect_clean(dissect(frame(h, [](std::span<std::uint8_t> out) {
+                 return encode_set_ip_request(out, 0x2002, suite(), DcpQualifier::Temporary);
+               })),
+               {"PROFINET DCP", "Set", "IPaddress: 192.168.0.10", "BlockQualifier: Use the value temporary (0)"});
+  expect_clean(dissect(frame(h, [](std::span<std::uint8_t> out) { return encode_set_signal_request(out, 0x2003); })),
+               {"PROFINET DCP", "Set Req", "Control/Signal", "SignalValue: Flash Once (0x0100)"});
+  const std::array<DcpSetResult, 1> ok{{{dcp_option::kNameOfStation, DcpBlockError::NoError}}};
+  expect_clean(dissect(frame(header(kController, kDevice, frame_id::kDcpGetSet),
+                             [&ok](std::span<std::uint8_t> out) { return encode_set_response(out, 0x2001, ok); })),
+               {"PROFINET DCP", "Set Ok", "Control/Response", "Name of Station", "BlockError: Ok (0)"});
+  const std::array<std::uint16_t, 2> opts{dcp_option::kNameOfStation, dcp_option::kIpParameter};
+  expect_clean(dissect(frame(h, [&opts](std::span<std::uint8_t> out) { return encode_get_request(out, 0x2004, opts); })),
+               {"PROFINET DCP", "Get Req", "Suboption: Name of Station (2)", "Suboption: IP parameter (2)"});
+}
+
+}  // namespace
+}  // namespace drivegate::profinet
