@@ -13,6 +13,7 @@
 
 #include "adapters/profinet/wire/dcp.hpp"
 #include "adapters/profinet/wire/ethernet.hpp"
+#include "adapters/profinet/wire/rt.hpp"
 #include "tests/support/pcap.hpp"
 #include "tests/support/run_program.hpp"
 
@@ -141,6 +142,33 @@ TEST(PnTshark, DcpSetNameIpSignal) {
   const std::array<std::uint16_t, 2> opts{dcp_option::kNameOfStation, dcp_option::kIpParameter};
   expect_clean(dissect(frame(h, [&opts](std::span<std::uint8_t> out) { return encode_get_request(out, 0x2004, opts); })),
                {"PROFINET DCP", "Get Req", "Suboption: Name of Station (2)", "Suboption: IP parameter (2)"});
+}
+
+TEST(PnTshark, RtCyclicFrame) {
+  if (!have_tshark()) GTEST_SKIP() << "tshark not installed";
+  // An output CR of a DAP and one telegram-1-like submodule (4 octets each way), priority tagged.
+  const std::array<IoSubmodule, 2> subs{{{IoKind::NoIo, 0, 0}, {IoKind::InputOutput, 4, 4}}};
+  std::array<IoPlacement, 2> p{};
+  const CsduLayout l = compute_csdu_layout(CrDirection::Output, subs, p);
+  ASSERT_TRUE(l.ok());
+  std::array<std::uint8_t, kMaxCsduLength> c_sdu{};
+  c_sdu[p[1].data_offset] = 0x04;
+  c_sdu[p[1].data_offset + 1] = 0x7F;
+  c_sdu[p[1].iops_offset] = iox_status::kGood;
+  c_sdu[p[0].iocs_offset] = iox_status::kGood;
+  c_sdu[p[1].iocs_offset] = iox_status::kGood;
+  EthernetHeader h = header(kDevice, kController, 0x8001);
+  h.vlan = true;
+  h.priority = kPriorityRtCyclic;
+  ApduStatus s;
+  s.cycle_counter = 0x1234;
+  const Bytes f = frame(h, [&](std::span<std::uint8_t> out) {
+    return encode_rt_cyclic(out, std::span(c_sdu).first(l.used), l.length, s);
+  });
+  EXPECT_EQ(f.size(), 64U);
+  expect_clean(dissect(f), {"PROFINET cyclic Real-Time, RTC1, ID:0x8001, Len:  40, Cycle: 4660 (Valid,Primary,Ok,Run)",
+                            "DataStatus: 0x35", "TransferStatus: 0x00 (OK)",
+                            "PROFINET IO Cyclic Service Data Unit: 40 bytes"});
 }
 
 }  // namespace
