@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "adapters/profinet/wire/alarm.hpp"
 #include "adapters/profinet/wire/dcp.hpp"
 #include "adapters/profinet/wire/ethernet.hpp"
 #include "adapters/profinet/wire/rt.hpp"
@@ -169,6 +170,92 @@ TEST(PnTshark, RtCyclicFrame) {
   expect_clean(dissect(f), {"PROFINET cyclic Real-Time, RTC1, ID:0x8001, Len:  40, Cycle: 4660 (Valid,Primary,Ok,Run)",
                             "DataStatus: 0x35", "TransferStatus: 0x00 (OK)",
                             "PROFINET IO Cyclic Service Data Unit: 40 bytes"});
+}
+
+EthernetHeader alarm_header(const MacAddress& dst, const MacAddress& src, AlarmPriority p) {
+  EthernetHeader h = header(dst, src, p == AlarmPriority::High ? frame_id::kAlarmHigh : frame_id::kAlarmLow);
+  h.vlan = true;
+  h.priority = p == AlarmPriority::High ? kPriorityAlarmHigh : kPriorityAlarmLow;
+  return h;
+}
+
+TEST(PnTshark, AlarmExchange) {
+  if (!have_tshark()) GTEST_SKIP() << "tshark not installed";
+  static constexpr std::array<std::uint8_t, 6> kChannel{0x80, 0x00, 0x08, 0x00, 0x00, 0x01};
+  AlarmNotification n;
+  n.alarm_type = alarm_type::kDiagnosis;
+  n.api = 0x3A00;
+  n.slot = 1;
+  n.subslot = 1;
+  n.module_ident = 0x10;
+  n.submodule_ident = 0x01;
+  n.specifier.sequence = 5;
+  n.specifier.channel_diagnosis = true;
+  n.specifier.submodule_diagnosis = true;
+  n.specifier.ar_diagnosis = true;
+  n.has_user_structure = true;
+  n.user_structure_id = user_structure::kChannelDiagnosis;
+  n.user_data = kChannel;
+  RtaHeader device;  // device -> controller
+  device.dst_endpoint = 0x0001;
+  device.src_endpoint = 0x0003;
+  device.tack = true;
+  device.send_seq = 0;
+  device.ack_seq = 0xFFFF;
+  RtaHeader controller;  // controller -> device
+  controller.dst_endpoint = 0x0003;
+  controller.src_endpoint = 0x0001;
+
+  const Bytes data = frame(alarm_header(kController, kDevice, AlarmPriority::High), [&](std::span<std::uint8_t> out) {
+    const std::size_t block = encode_alarm_notification(out.subspan(kRtaHeaderSize), n);
+    return block == 0 ? 0 : encode_rta(out, device, out.subspan(kRtaHeaderSize, block));
+  });
+  expect_clean(dissect(data), {"PROFINET acyclic Real-Time, Alarm High, ID:0xfc01", "Type: Data-RTA-PDU (0x1)",
+                               "TACK: 0x1", "SendSeqNum: 0x0000", "AckSeqNum: 0xffff", "VarPartLen: 0x0022",
+                               "BlockType: Alarm Notification High (0x0001)", "AlarmType: Diagnosis (0x0001)",
+                               "API: 0x00003a00", "ModuleIdentNumber: 0x00000010",
+                               "AlarmSpecifier, Sequence: 5, Channel: 1, Manuf: 0, Submodule: 1 AR: 1",
+                               "UserStructureIdentifier: ChannelDiagnosis (0x8000)",
+                               "ChannelErrorType: short circuit (0x0001)"});
+
+  RtaHeader ack = controller;
+  ack.type = RtaPduType::Ack;
+  ack.send_seq = 0xFFFF;
+  ack.ack_seq = 0;
+  expect_clean(dissect(frame(alarm_header(kDevice, kController, AlarmPriority::High),
+                             [&](std::span<std::uint8_t> out) { return encode_rta(out, ack, {}); })),
+               {"Type: ACK-RTA-PDU (0x3)", "SendSeqNum: 0xffff", "AckSeqNum: 0x0000", "VarPartLen: 0x0000"});
+
+  RtaHeader ack_data = controller;
+  ack_data.tack = true;
+  const Bytes alarm_ack = frame(alarm_header(kDevice, kController, AlarmPriority::High), [&](std::span<std::uint8_t> out) {
+    const std::size_t block = encode_alarm_ack(out.subspan(kRtaHeaderSize), ack_for(n));
+    return block == 0 ? 0 : encode_rta(out, ack_data, out.subspan(kRtaHeaderSize, block));
+  });
+  expect_clean(dissect(alarm_ack), {"Type: Data-RTA-PDU (0x1)", "BlockType: Alarm Ack High (0x8001)",
+                                    "AlarmType: Diagnosis (0x0001)", "Status: OK"});
+
+  RtaHeader err = controller;
+  err.send_seq = 0xFFFF;
+  err.ack_seq = 0xFFFE;
+  expect_clean(dissect(frame(alarm_header(kDevice, kController, AlarmPriority::High), [&](std::span<std::uint8_t> out) {
+                 return encode_rta_error(out, err, RtaPnioStatus{0xCF, 0x81, 0xFD, 0x06});
+               })),
+               {"Type: ERR-RTA-PDU (0x4)", "ErrorCode: RTA error (0xcf)"});
+
+  // A low-priority pull alarm without an AlarmItem on FE01h, priority 5.
+  AlarmNotification pull;
+  pull.priority = AlarmPriority::Low;
+  pull.alarm_type = alarm_type::kPull;
+  pull.slot = 1;
+  pull.subslot = 1;
+  RtaHeader low = device;
+  const Bytes pull_frame = frame(alarm_header(kController, kDevice, AlarmPriority::Low), [&](std::span<std::uint8_t> out) {
+    const std::size_t block = encode_alarm_notification(out.subspan(kRtaHeaderSize), pull);
+    return block == 0 ? 0 : encode_rta(out, low, out.subspan(kRtaHeaderSize, block));
+  });
+  expect_clean(dissect(pull_frame), {"PRI: 5", "Alarm Low, ID:0xfe01", "BlockType: Alarm Notification Low (0x0002)",
+                                     "AlarmType: Pull (0x0003)"});
 }
 
 }  // namespace
