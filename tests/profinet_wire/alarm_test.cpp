@@ -167,7 +167,8 @@ TEST(PnAlarm, ErrBytes) {
   h.src_endpoint = 0x0001;
   h.send_seq = 0xFFFF;
   h.ack_seq = 0xFFFE;
-  // ErrorCode CFh (RTA error), ErrorDecode 81h (PNIO), ErrorCode1 FDh, ErrorCode2 06h.
+  // ErrorCode CFh (RTA error), ErrorDecode 81h (PNIO), ErrorCode1 FDh (RTA_ERR_CLS_PROTOCOL),
+  // ErrorCode2 06h (tshark: "AR cmi timeout").
   const std::size_t n = encode_rta_error(buf, h, RtaPnioStatus{0xCF, 0x81, 0xFD, 0x06});
   EXPECT_EQ(Bytes(buf.begin(), buf.begin() + static_cast<std::ptrdiff_t>(n)),
             hex("00 03 00 01 14 01 FF FF FF FE 00 04 CF 81 FD 06"));

@@ -1,6 +1,6 @@
-// PN-DCP [IEC 61158-6-10 §4.3.1]: byte-exact PDUs (the PDU after the FrameID) built from the
-// standard's layouts (§4.3.1.3 DCP-PDU header: ServiceID, ServiceType, Xid, ResponseDelay,
-// DCPDataLength; §4.3.1.4 blocks: Option, Suboption, DCPBlockLength, BlockQualifier/BlockInfo,
+// PN-DCP [IEC 61158-6-10 §4.3]: byte-exact PDUs (the PDU after the FrameID) built from the
+// standard's layouts (the DCP-PDU header: ServiceID, ServiceType, Xid, ResponseDelay,
+// DCPDataLength; the blocks: Option, Suboption, DCPBlockLength, BlockQualifier/BlockInfo,
 // pad octet after an odd block), and malformed input for every decoder. Vendor and device IDs are
 // illustrative values, not a real device's.
 #include "adapters/profinet/wire/dcp.hpp"
@@ -85,7 +85,7 @@ DcpDeviceInfo akd_like() {
   return d;
 }
 
-// The Identify response of §4.3.1.3.5 with the blocks a device answers an Identify-All with.
+// An Identify response with the blocks a device answers an Identify-All with.
 const Bytes kIdentifyResponse = hex(
     "05 01 01 02 03 04 00 00 00 4C"
     "02 01 00 05 00 00 41 4B 44 00"                             // TypeOfStation "AKD" + pad
@@ -250,6 +250,23 @@ TEST(PnDcp, GetResponseReadsLikeIdentify) {
   const DcpDeviceInfoView v = decode_device_info(decode_dcp(get_rsp));
   ASSERT_EQ(v.error, DcpError::None);
   EXPECT_EQ(v.info.name_of_station, "akd-1");
+}
+
+TEST(PnDcp, HelloBytes) {
+  DcpDeviceInfo d;
+  d.has_name_of_station = true;
+  d.name_of_station = "akd-1";
+  d.has_device_initiative = true;
+  d.device_initiative = 1;
+  std::array<std::uint8_t, 1500> buf{};
+  const std::size_t n = encode_hello(buf, 9, d);
+  // Hello(6) request with response blocks (BlockInfo 0).
+  EXPECT_EQ(encoded(n, buf), hex("06 00 00 00 00 09 00 00 00 14  02 02 00 07 00 00 61 6B 64 2D 31 00  06 01 00 04 00 00 00 01"));
+  const Bytes frame = encoded(n, buf);
+  const DcpDeviceInfoView v = decode_device_info(decode_dcp(frame));
+  ASSERT_EQ(v.error, DcpError::None);
+  EXPECT_EQ(v.info.name_of_station, "akd-1");
+  EXPECT_EQ(v.info.device_initiative, 1);
 }
 
 TEST(PnDcp, WriterRefusesWhatDoesNotFit) {

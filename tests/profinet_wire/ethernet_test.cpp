@@ -1,4 +1,4 @@
-// Ethernet II + FrameID [IEC 61158-6-10 §4.1, §4.2.2 Table "FrameID"; IEEE 802.1Q].
+// Ethernet II + FrameID [IEC 61158-6-10: the RT frame and the coding of the field FrameID; IEEE 802.1Q].
 #include "adapters/profinet/wire/ethernet.hpp"
 
 #include <gtest/gtest.h>

@@ -1,5 +1,5 @@
-// RT class 1 cyclic frames [IEC 61158-6-10 §4.2.3 (C_SDU, APDU_Status: CycleCounter, DataStatus,
-// TransferStatus), §4.7.2.1 (PPM/CPM: cycle counter, receive checks)].
+// RT class 1 cyclic frames [IEC 61158-6-10: the RT frame's C_SDU and APDU_Status (CycleCounter,
+// DataStatus, TransferStatus); §4.7.2.1.2, the CPM's cycle counter and receive checks].
 #include "adapters/profinet/wire/rt.hpp"
 
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// NameOfStation rules [IEC 61158-6-10 §4.3.1.4.16].
+// NameOfStation rules [IEC 61158-6-10 §4.3, coding of the field NameOfStation].
 #include "adapters/profinet/wire/station_name.hpp"
 
 #include <gtest/gtest.h>

@@ -123,6 +123,22 @@ TEST(PnTshark, DcpIdentifyResponse) {
                             "DeviceInstanceLow: 0x01", "Dev-Options(3)"});
 }
 
+TEST(PnTshark, DcpHello) {
+  if (!have_tshark()) GTEST_SKIP() << "tshark not installed";
+  DcpDeviceInfo d;
+  d.has_name_of_station = true;
+  d.name_of_station = "akd-1";
+  d.has_ip = true;
+  d.ip_block_info = ip_block_info::kSet;
+  d.ip = suite();
+  d.has_device_initiative = true;
+  d.device_initiative = 1;
+  const Bytes f = frame(header(kDcpHelloMulticast, kDevice, frame_id::kDcpHello),
+                        [&d](std::span<std::uint8_t> out) { return encode_hello(out, 0x3001, d); });
+  expect_clean(dissect(f), {"PROFINET DCP", "ServiceID: Hello (6)", "NameOfStation: akd-1", "IPaddress: 192.168.0.10",
+                            "DeviceInitiative"});
+}
+
 TEST(PnTshark, DcpSetNameIpSignal) {
   if (!have_tshark()) GTEST_SKIP() << "tshark not installed";
   const EthernetHeader h = header(kDevice, kController, frame_id::kDcpGetSet);

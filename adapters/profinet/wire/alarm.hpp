@@ -1,7 +1,7 @@
 #pragma once
-// Alarms over RTA, the acyclic real-time transport [IEC 61158-6-10 §4.6 "Alarm" (ALPMI/ALPMR,
-// APMS/APMR), RTA-PDU §4.6.x; AlarmNotification-PDU and AlarmAck-PDU §5.2.x with the BlockHeader
-// of §5.2.1]. The RTA-PDU follows FrameID FC01h (alarm high) or FE01h (alarm low):
+// Alarms over RTA, the acyclic real-time transport [IEC 61158-6-10: the RTA-PDU and its protocol
+// machines APMS/APMR, the AlarmNotification-PDU and AlarmAck-PDU with their BlockHeader; field
+// order and masks cross-checked with Wireshark's PNIO alarm dissector]. The RTA-PDU follows FrameID FC01h (alarm high) or FE01h (alarm low):
 //
 //   RTA header (12)   AlarmDstEndpoint u16 | AlarmSrcEndpoint u16 (the alarm references of the
 //                     AlarmCR blocks) | PDUType u8: bits 0-3 type (1 DATA, 2 NACK, 3 ACK, 4 ERR),
@@ -32,7 +32,7 @@ inline constexpr std::uint8_t kRtaVersion = 1;
 inline constexpr std::uint8_t kRtaWindowSize = 1;  // the only window size RTA uses
 // Sequence numbers count 0..7FFFh and wrap; before the first DATA a sender's SendSeqNum is FFFFh
 // and its AckSeqNum FFFEh, so the first DATA goes out with SendSeqNum 0 and AckSeqNum FFFFh
-// [IEC 61158-6-10 §4.6, APMS/APMR initial values].
+// [IEC 61158-6-10, APMS/APMR initial values].
 inline constexpr std::uint16_t kRtaSeqMax = 0x7FFF;
 inline constexpr std::uint16_t kRtaInitialSendSeq = 0xFFFF;
 inline constexpr std::uint16_t kRtaInitialAckSeq = 0xFFFE;
@@ -59,7 +59,8 @@ struct RtaHeader {
 };
 
 // The four octets of a PNIOStatus (ErrorCode, ErrorDecode, ErrorCode1, ErrorCode2) as AlarmAck
-// and ERR-RTA-PDU carry them [IEC 61158-6-10 §5.2.6]; the texts live with the RPC codecs.
+// and ERR-RTA-PDU carry them [IEC 61158-6-10, coding of the field PNIOStatus]; the texts live with
+// the RPC codecs.
 struct RtaPnioStatus {
   std::uint8_t code = 0;
   std::uint8_t decode = 0;
@@ -115,7 +116,7 @@ inline constexpr std::uint16_t kAckLow = 0x8002;
 
 enum class AlarmPriority : std::uint8_t { High, Low };
 
-// AlarmType [IEC 61158-6-10 §5.2.x, Table "AlarmType"].
+// AlarmType [IEC 61158-6-10, coding of the field AlarmType].
 namespace alarm_type {
 inline constexpr std::uint16_t kDiagnosis = 0x0001;
 inline constexpr std::uint16_t kProcess = 0x0002;
@@ -143,7 +144,7 @@ inline constexpr std::uint16_t kPullModule = 0x001F;
 // "reserved for profiles" (0080h-00FFh), "reserved".
 std::string_view alarm_type_name(std::uint16_t type) noexcept;
 
-// UserStructureIdentifier [IEC 61158-6-10, Table "UserStructureIdentifier"].
+// UserStructureIdentifier [IEC 61158-6-10, coding of the field UserStructureIdentifier].
 namespace user_structure {
 inline constexpr std::uint16_t kChannelDiagnosis = 0x8000;
 inline constexpr std::uint16_t kMultiple = 0x8001;

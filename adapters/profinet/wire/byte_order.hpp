@@ -1,8 +1,8 @@
 #pragma once
 // Big-endian field access for the PROFINET Ethernet protocols: DCP, the RT APDU status, RTA and
-// the alarm blocks carry every multi-octet number most significant octet first [IEC 61158-6-10
-// §4.1: "the octets of a multi-octet value are transferred in network byte order"], unlike the
-// little-endian fieldbus numbers core/bytes.hpp serves. Callers check the span size first.
+// the alarm blocks carry every multi-octet number most significant octet first (IEC 61158-6-10
+// codes them as Unsigned16/32 in network byte order; Wireshark's PN dissectors read them so),
+// unlike the little-endian fieldbus numbers core/bytes.hpp serves. Callers check the span size first.
 #include <cstddef>
 #include <cstdint>
 #include <span>

@@ -152,7 +152,7 @@ bool DcpBlockReader::next(DcpBlock& out) noexcept {
   out.option = data_[pos_];
   out.suboption = data_[pos_ + 1];
   out.value = data_.subspan(value_at, length);
-  // The pad octet after an odd block [IEC 61158-6-10 §4.3.1.4: blocks start on even offsets].
+  // The pad octet after an odd block [IEC 61158-6-10 §4.3: blocks start on even offsets].
   pos_ = std::min(data_.size(), value_at + length + (length & 1U));
   return true;
 }
@@ -280,9 +280,12 @@ std::uint16_t DcpDeviceInfo::device_option(std::size_t i) const noexcept {
   return 2 * i + 1 < device_options.size() ? get_be16(device_options, 2 * i) : 0;
 }
 
-std::size_t encode_identify_response(std::span<std::uint8_t> out, std::uint32_t xid, const DcpDeviceInfo& info) noexcept {
+namespace {
+
+std::size_t encode_device_info(std::span<std::uint8_t> out, DcpService service, DcpServiceType type, std::uint32_t xid,
+                               const DcpDeviceInfo& info) noexcept {
   if (info.device_options.size() % 2 != 0) return 0;
-  DcpWriter w(out, DcpService::Identify, DcpServiceType::ResponseSuccess, xid, 0);
+  DcpWriter w(out, service, type, xid, 0);
   if (info.has_type_of_station) w.add(dcp_option::kTypeOfStation, 0, info.type_of_station);
   if (info.has_name_of_station) w.add(dcp_option::kNameOfStation, 0, info.name_of_station);
   if (info.has_device_id) {
@@ -323,6 +326,16 @@ std::size_t encode_identify_response(std::span<std::uint8_t> out, std::uint32_t 
   return w.finish();
 }
 
+}  // namespace
+
+std::size_t encode_identify_response(std::span<std::uint8_t> out, std::uint32_t xid, const DcpDeviceInfo& info) noexcept {
+  return encode_device_info(out, DcpService::Identify, DcpServiceType::ResponseSuccess, xid, info);
+}
+
+std::size_t encode_hello(std::span<std::uint8_t> out, std::uint32_t xid, const DcpDeviceInfo& info) noexcept {
+  return encode_device_info(out, DcpService::Hello, DcpServiceType::Request, xid, info);
+}
+
 DcpError read_ip_suite(std::span<const std::uint8_t> data, IpSuite& out) noexcept {
   if (data.size() != 12) return DcpError::BadBlockLength;
   std::copy(data.begin(), data.begin() + 4, out.address.begin());
@@ -337,8 +350,10 @@ DcpDeviceInfoView decode_device_info(const DcpPdu& pdu) noexcept {
     v.error = pdu.error;
     return v;
   }
-  if ((pdu.header.service != DcpService::Identify && pdu.header.service != DcpService::Get) ||
-      pdu.header.type != DcpServiceType::ResponseSuccess) {
+  const bool response = (pdu.header.service == DcpService::Identify || pdu.header.service == DcpService::Get) &&
+                        pdu.header.type == DcpServiceType::ResponseSuccess;
+  const bool hello = pdu.header.service == DcpService::Hello && pdu.header.type == DcpServiceType::Request;
+  if (!response && !hello) {
     v.error = DcpError::UnexpectedService;
     return v;
   }

@@ -1,6 +1,6 @@
 #pragma once
-// PN-DCP, the Discovery and basic Configuration Protocol [IEC 61158-6-10 §4.3.1 "DCP"; PDU layout
-// §4.3.1.3, blocks §4.3.1.4]. The PDU follows the FrameID (FEFCh hello, FEFDh get/set, FEFEh
+// PN-DCP, the Discovery and basic Configuration Protocol [IEC 61158-6-10 §4.3: the DCP-PDU
+// header and the DCP blocks]. The PDU follows the FrameID (FEFCh hello, FEFDh get/set, FEFEh
 // identify request, FEFFh identify response; wire/ethernet.hpp):
 //
 //   header (10)   ServiceID u8 (3 Get, 4 Set, 5 Identify, 6 Hello) | ServiceType u8 (0 request,
@@ -30,7 +30,8 @@ inline constexpr std::size_t kDcpBlockHeaderSize = 4;
 // Largest DCPDataLength: 1500 payload octets - FrameID - header.
 inline constexpr std::size_t kDcpMaxDataLength = kMaxPayloadSize - kFrameIdSize - kDcpHeaderSize;
 // ResponseDelayFactor of an Identify request: a device answers after a random 0..factor × 10 ms;
-// 1 is "no spread", the largest allowed value is 1900h [IEC 61158-6-10 §4.3.1.3.5].
+// 1 is "no spread", the largest allowed value is 1900h [IEC 61158-6-10 §4.3, coding of the field
+// ResponseDelayFactor].
 inline constexpr std::uint16_t kDcpMaxResponseDelayFactor = 0x1900;
 
 enum class DcpService : std::uint8_t { Get = 3, Set = 4, Identify = 5, Hello = 6 };
@@ -38,7 +39,7 @@ enum class DcpServiceType : std::uint8_t { Request = 0, ResponseSuccess = 1, Res
 std::string_view to_string(DcpService s) noexcept;      // "Get", "Set", "Identify", "Hello", "?"
 std::string_view to_string(DcpServiceType t) noexcept;  // "request", "response success", ...
 
-// Option << 8 | Suboption [IEC 61158-6-10 §4.3.1.4, Table "Option and Suboption"].
+// Option << 8 | Suboption [IEC 61158-6-10 §4.3, coding of the fields Option and Suboption].
 namespace dcp_option {
 inline constexpr std::uint16_t kMacAddress = 0x0101;
 inline constexpr std::uint16_t kIpParameter = 0x0102;  // IP address, netmask, gateway
@@ -75,12 +76,12 @@ constexpr std::uint8_t suboption_of(std::uint16_t id) noexcept { return static_c
 // "NameOfStation", "IP parameter", "DHCP client identifier", "Signal", ..., "unknown".
 std::string_view dcp_option_name(std::uint16_t id) noexcept;
 
-// BlockQualifier of a Set request [IEC 61158-6-10 §4.3.1.4.x]: bit 0 = save the value permanently.
+// BlockQualifier of a Set request [IEC 61158-6-10 §4.3, BlockQualifier]: bit 0 = save the value permanently.
 enum class DcpQualifier : std::uint16_t { Temporary = 0x0000, Permanent = 0x0001 };
-// SignalValue of Control/Signal: flash once (the device's LED or display blinks) [§4.3.1.4.x].
+// SignalValue of Control/Signal: flash once (the device's LED or display blinks) [§4.3, SignalValue].
 inline constexpr std::uint16_t kDcpSignalFlashOnce = 0x0100;
 
-// BlockInfo of the IP parameter in a response [IEC 61158-6-10, Table "BlockInfo for IP"]: bits
+// BlockInfo of the IP parameter in a response [IEC 61158-6-10 §4.3, BlockInfo of IP]: bits
 // 0-6 how the address was set, bit 7 an address conflict was detected.
 namespace ip_block_info {
 inline constexpr std::uint16_t kNotSet = 0x0000;
@@ -89,7 +90,7 @@ inline constexpr std::uint16_t kSetByDhcp = 0x0002;
 inline constexpr std::uint16_t kConflict = 0x0080;
 }  // namespace ip_block_info
 
-// DeviceRoleDetails bits [IEC 61158-6-10, DeviceRole block].
+// DeviceRoleDetails bits [IEC 61158-6-10 §4.3, DeviceRoleDetails].
 namespace device_role {
 inline constexpr std::uint8_t kIoDevice = 0x01;
 inline constexpr std::uint8_t kIoController = 0x02;
@@ -97,7 +98,7 @@ inline constexpr std::uint8_t kIoMultidevice = 0x04;
 inline constexpr std::uint8_t kSupervisor = 0x08;
 }  // namespace device_role
 
-// BlockError of a Control/Response block [IEC 61158-6-10, Table "BlockError"].
+// BlockError of a Control/Response block [IEC 61158-6-10 §4.3, BlockError].
 enum class DcpBlockError : std::uint8_t {
   NoError = 0,
   OptionNotSupported = 1,
@@ -200,7 +201,7 @@ class DcpWriter {
   bool failed_ = false;
 };
 
-// ---- Identify [IEC 61158-6-10 §4.3.1.3.5] -----------------------------------------------------
+// ---- Identify ----------------------------------------------------------------------------------
 
 // Identify request to kDcpIdentifyMulticast with the AllSelector (FFh/FFh, length 0).
 std::size_t encode_identify_all_request(std::span<std::uint8_t> out, std::uint32_t xid,
@@ -257,15 +258,18 @@ struct DcpDeviceInfo {
 // NameOfStation, DeviceID, DeviceRole, DeviceOptions, DeviceInstance, OEM DeviceID, IP, MAC,
 // DHCP, DeviceInitiative.
 std::size_t encode_identify_response(std::span<std::uint8_t> out, std::uint32_t xid, const DcpDeviceInfo& info) noexcept;
+// Hello request (FrameID FEFCh to kDcpHelloMulticast, ServiceID 6): a device with DeviceInitiative
+// announces itself at start-up with the same blocks as an Identify response.
+std::size_t encode_hello(std::span<std::uint8_t> out, std::uint32_t xid, const DcpDeviceInfo& info) noexcept;
 
 struct DcpDeviceInfoView {
   DcpError error = DcpError::None;
   DcpDeviceInfo info{};
 };
-// An Identify response or a Get response (ServiceType response success).
+// An Identify response, a Get response (ServiceType response success) or a Hello request.
 DcpDeviceInfoView decode_device_info(const DcpPdu& pdu) noexcept;
 
-// ---- Set / Get [IEC 61158-6-10 §4.3.1.3.3, §4.3.1.3.4] ----------------------------------------
+// ---- Set / Get ---------------------------------------------------------------------------------
 
 // Set requests (FrameID FEFDh, unicast). The name must be a valid NameOfStation.
 std::size_t encode_set_name_request(std::span<std::uint8_t> out, std::uint32_t xid, std::string_view name,

@@ -1,12 +1,13 @@
 #pragma once
-// PROFINET frames on Ethernet [IEC 61158-6-10 §4.1 (Ethernet II framing, FrameID), §4.2.2 (FrameID
-// ranges, Table "FrameID"); IEEE 802.3 §3.2; IEEE 802.1Q §9.6 (the tag)]:
+// PROFINET frames on Ethernet [IEC 61158-6-10: the RT frame (Ethernet II, EtherType 8892h,
+// FrameID) and the coding of the field FrameID; IEEE 802.3 §3.2; IEEE 802.1Q §9.6 (the tag)]:
 //
 //   destination(6) source(6) [TPID 8100h + TCI: PCP bits 13-15, DEI bit 12, VID bits 0-11]
 //   EtherType 8892h | FrameID u16 | the PDU of the FrameID's class | padding to 60 octets
 //
 // All numbers big-endian. A controller sends RT class 1 and alarm frames with a priority tag (VID
-// 0: PCP 6 for cyclic and alarm high, 5 for alarm low [IEC 61158-6-10 §4.2.2.2]); DCP goes untagged.
+// 0: PCP 6 for cyclic and alarm high, 5 for alarm low [IEC 61158-6-10, VLAN priorities of the RT
+// frames]); DCP goes untagged.
 // Receivers accept both. No allocation: the decoder returns views into the frame.
 #include <array>
 #include <cstddef>
@@ -18,7 +19,7 @@ namespace drivegate::profinet {
 
 using MacAddress = std::array<std::uint8_t, 6>;
 
-inline constexpr std::uint16_t kEtherType = 0x8892;  // PROFINET real-time [IEC 61158-6-10 §4.1]
+inline constexpr std::uint16_t kEtherType = 0x8892;  // PROFINET real-time (IEEE assignment)
 inline constexpr std::uint16_t kVlanTpid = 0x8100;   // IEEE 802.1Q
 inline constexpr std::size_t kEthernetHeaderSize = 14;
 inline constexpr std::size_t kVlanTagSize = 4;
@@ -27,18 +28,18 @@ inline constexpr std::size_t kMinFrameSize = 60;    // without FCS [IEEE 802.3 �
 inline constexpr std::size_t kMaxFrameSize = 1518;  // without FCS, with a tag: 1500 payload octets
 inline constexpr std::size_t kMaxPayloadSize = 1500;
 
-// Priorities of the tag [IEC 61158-6-10 §4.2.2.2 "VLAN priority"]: RT class 1 cyclic and alarm
-// high 6, alarm low 5.
+// Priorities of the tag [IEC 61158-6-10, VLAN priorities]: RT class 1 cyclic and alarm high 6,
+// alarm low 5.
 inline constexpr std::uint8_t kPriorityRtCyclic = 6;
 inline constexpr std::uint8_t kPriorityAlarmHigh = 6;
 inline constexpr std::uint8_t kPriorityAlarmLow = 5;
 
-// Multicast destinations of DCP [IEC 61158-6-10 §4.3.1.2]: Identify requests go to 01-0E-CF-00-00-00,
-// Hello to 01-0E-CF-00-00-01.
+// Multicast destinations of DCP [IEC 61158-6-10 §4.3, DCP multicast MAC addresses]: Identify
+// requests go to 01-0E-CF-00-00-00, Hello to 01-0E-CF-00-00-01.
 inline constexpr MacAddress kDcpIdentifyMulticast{0x01, 0x0E, 0xCF, 0x00, 0x00, 0x00};
 inline constexpr MacAddress kDcpHelloMulticast{0x01, 0x0E, 0xCF, 0x00, 0x00, 0x01};
 
-// FrameIDs [IEC 61158-6-10 §4.2.2, Table "FrameID"].
+// FrameIDs [IEC 61158-6-10, coding of the field FrameID].
 namespace frame_id {
 inline constexpr std::uint16_t kRtClass1First = 0x8000;  // RT class 1, 8000h-BFFFh unicast
 inline constexpr std::uint16_t kRtClass1Last = 0xBFFF;

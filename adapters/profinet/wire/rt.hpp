@@ -1,6 +1,6 @@
 #pragma once
-// RT class 1 cyclic frames [IEC 61158-6-10 §4.7 "Cyclic data exchange" (PPM/CPM), §4.2.3 the
-// C_SDU and APDU_Status]. The PDU behind the FrameID (8000h-FBFFh, wire/ethernet.hpp):
+// RT class 1 cyclic frames [IEC 61158-6-10: the C_SDU and APDU_Status of the RT frame, PPM/CPM
+// (cyclic provider and consumer) §4.7]. The PDU behind the FrameID (8000h-FBFFh, wire/ethernet.hpp):
 //
 //   C_SDU (40..1440 octets)   IO data objects in the order of the connect request: per
 //                             submodule its data and then its IOPS, plus an IOCS per submodule
@@ -9,8 +9,8 @@
 //
 // The C_SDU length is part of the IOCR (IOCRBlockReq DataLength), so a receiver passes it in; it
 // is at least 40 so that an untagged frame reaches the 60-octet Ethernet minimum without padding
-// behind the status [IEC 61158-6-10 §4.2.3.2]. IOPS/IOCS: bit 7 DataState (1 good), bits 5-6
-// Instance (where the status was detected), bit 0 Extension [§4.7.x "IOxS"].
+// behind the status. IOPS/IOCS: bit 7 DataState (1 good), bits 5-6 Instance (where the status was
+// detected), bit 0 Extension [IEC 61158-6-10, coding of the field IOxS].
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -25,7 +25,7 @@ inline constexpr std::uint16_t kMaxCsduLength = 1440;
 // 1..61440 [IEC 61158-6-10 §4.7.2.1.2, CPM]; 0 is a repeated frame, a larger step an old one.
 inline constexpr std::uint16_t kMaxCycleCounterStep = 61440;
 
-// DataStatus bits [IEC 61158-6-10 §4.2.3.3, Table "DataStatus"].
+// DataStatus bits [IEC 61158-6-10, coding of the field DataStatus].
 namespace data_status {
 inline constexpr std::uint8_t kStatePrimary = 0x01;   // 1 primary, 0 backup (system redundancy)
 inline constexpr std::uint8_t kRedundancy = 0x02;     // with State backup: 1 = no primary AR exists
@@ -39,7 +39,7 @@ inline constexpr std::uint8_t kIgnore = 0x80;         // 1 ignore the frame (not
 inline constexpr std::uint8_t kGood = kStatePrimary | kDataValid | kProviderRun | kStationOk;  // 35h
 }  // namespace data_status
 
-// IOPS/IOCS [IEC 61158-6-10, "IOxS"].
+// IOPS/IOCS [IEC 61158-6-10, IOxS].
 namespace iox_status {
 inline constexpr std::uint8_t kGood = 0x80;            // DataState good, detected by the subslot
 inline constexpr std::uint8_t kBadBySubslot = 0x00;
@@ -65,7 +65,7 @@ void encode_apdu_status(const ApduStatus& s, std::span<std::uint8_t, kApduStatus
 ApduStatus decode_apdu_status(std::span<const std::uint8_t, kApduStatusSize> in) noexcept;
 
 // Cycle counter of a frame sent at `time_ns` (any monotonic nanoseconds): the time in 31.25 µs
-// units, the unit of SendClockFactor, modulo 2^16 [IEC 61158-6-10 §4.7.2.1.1].
+// units, the unit of SendClockFactor, modulo 2^16 [IEC 61158-6-10, coding of the field CycleCounter].
 constexpr std::uint16_t cycle_counter_at(std::uint64_t time_ns) noexcept {
   return static_cast<std::uint16_t>((time_ns / 31250) & 0xFFFF);
 }

@@ -11,8 +11,7 @@ bool is_digit(char c) noexcept { return c >= '0' && c <= '9'; }
 
 bool all_digits(std::string_view s) noexcept { return !s.empty() && std::all_of(s.begin(), s.end(), is_digit); }
 
-// "port-xyz" or "port-xyz-abcde" [IEC 61158-6-10 §4.3.1.4.16: reserved for the port names the
-// LLDP/port-to-port checks use].
+// "port-xyz" or "port-xyz-abcde" (reserved for the port names the LLDP neighbourhood checks use).
 bool is_port_name(std::string_view label) noexcept {
   if (label.size() != 8 && label.size() != 14) return false;
   if (label.substr(0, 5) != "port-" || !all_digits(label.substr(5, 3))) return false;

@@ -1,6 +1,6 @@
 #pragma once
-// NameOfStation rules [IEC 61158-6-10 §4.3.1.4.16 "NameOfStation", coding by RFC 1035/5890 label
-// rules]: the name a controller addresses a device by, set with DCP and searched with Identify.
+// NameOfStation rules [IEC 61158-6-10 §4.3, coding of the field NameOfStation (DNS labels as in
+// RFC 1035, RFC 5890)]: the name a controller addresses a device by, set with DCP and searched with Identify.
 //
 //   1..240 octets; one or more labels separated by '.'; each label 1..63 octets of 'a'-'z',
 //   '0'-'9' and '-', not beginning or ending with '-'; the first label not "port-xyz" or
