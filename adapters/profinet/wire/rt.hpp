@@ -169,7 +169,7 @@ constexpr bool is_frame_error(RtCheck c) noexcept {
 
 struct RtInputCheck {
   RtCheck result = RtCheck::Ok;
-  RtCyclicView frame{};         // set when the structure was sound (result not a frame error or the counter checks)
+  RtCyclicView frame{};         // set once the FrameID and the length passed (every later result)
   bool station_problem = false; // StationProblemIndicator: the device has diagnosis to read
 };
 // Checks one received PDU of an input CR in the order frame ID, length, transfer status, cycle
