@@ -1,6 +1,7 @@
 // The RTA and alarm decoders (adapters/profinet/wire/alarm.hpp) on whatever arrives with
 // EtherType 8892h: decode_ethernet, decode_rta, rta_error_status, decode_alarm_notification,
-// decode_alarm_ack. Invariants: every view lies inside the input; a decoded RTA-PDU (no reserved
+// decode_alarm_ack, decode_channel_diagnosis. Invariants: every view lies inside the input; the
+// channel diagnosis entries cover the item's data exactly; a decoded RTA-PDU (no reserved
 // AddFlags bits) re-encodes byte for byte; a decoded AlarmNotification or AlarmAck (no reserved
 // AlarmSpecifier bit) re-encodes into the same block; ack_for() of a notification gives an ack
 // that decodes to itself.
@@ -53,6 +54,15 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (!reserved_specifier) {
       const std::size_t len = encode_alarm_notification(out, n.notification);
       if (len == 0 || !equal(std::span(out).first(len), r.var_part)) std::abort();
+    }
+    if (n.notification.has_user_structure) {
+      const ChannelDiagnosisList l = decode_channel_diagnosis(n.notification.user_structure_id, n.notification.user_data);
+      inside(l.data);
+      ChannelDiagnosis c;
+      std::size_t k = 0;
+      while (l.get(k, c)) ++k;
+      if (k != l.count() || (l.error == AlarmError::None && k * l.entry_size != l.data.size())) std::abort();
+      (void)channel_error_type_name(c.error_type);
     }
     const AlarmAck a = ack_for(n.notification);
     const std::size_t len = encode_alarm_ack(out, a);

@@ -178,6 +178,49 @@ TEST(PnAlarm, ErrBytes) {
   EXPECT_EQ(rta_error_status(r), (RtaPnioStatus{0xCF, 0x81, 0xFD, 0x06}));
 }
 
+TEST(PnAlarm, ChannelDiagnosisItems) {
+  const AlarmNotificationView v = decode_alarm_notification(std::span(kAlarmData).subspan(12));
+  ASSERT_TRUE(v.ok());
+  const ChannelDiagnosisList l = decode_channel_diagnosis(v.notification.user_structure_id, v.notification.user_data);
+  ASSERT_EQ(l.error, AlarmError::None);
+  ASSERT_EQ(l.count(), 1U);
+  ChannelDiagnosis c;
+  ASSERT_TRUE(l.get(0, c));
+  EXPECT_EQ(c.channel, kChannelWholeSubmodule);
+  EXPECT_TRUE(c.appears());
+  EXPECT_EQ(c.maintenance(), 0);
+  EXPECT_EQ(c.direction(), 0);
+  EXPECT_FALSE(c.accumulative());
+  EXPECT_EQ(channel_error_type_name(c.error_type), "short circuit");
+  EXPECT_FALSE(l.get(1, c));
+  // ExtChannelDiagnosis: two entries of 12 octets; channel 3, direction output, disappears, accumulative.
+  const Bytes ext = hex("0003 5101 0006 8000 00000001  8000 0800 0011 0000 00000000");
+  const ChannelDiagnosisList e = decode_channel_diagnosis(user_structure::kExtChannelDiagnosis, ext);
+  ASSERT_EQ(e.count(), 2U);
+  ASSERT_TRUE(e.get(0, c));
+  EXPECT_EQ(c.channel, 3);
+  EXPECT_EQ(c.direction(), 2);
+  EXPECT_EQ(c.specifier(), 2);
+  EXPECT_TRUE(c.accumulative());
+  EXPECT_EQ(c.error_type, 6);
+  EXPECT_EQ(c.ext_error_type, 0x8000);
+  EXPECT_EQ(c.ext_add_value, 1U);
+  ASSERT_TRUE(e.get(1, c));
+  EXPECT_EQ(channel_error_type_name(c.error_type), "power supply fault");
+  const Bytes q = hex("0001 0800 0002 0000 00000000 00000008");
+  ASSERT_TRUE(decode_channel_diagnosis(user_structure::kQualifiedChannelDiagnosis, q).get(0, c));
+  EXPECT_EQ(c.qualifier, 8U);
+  // Malformed: another USI, a partial entry, none at all.
+  EXPECT_EQ(decode_channel_diagnosis(user_structure::kMaintenance, ext).error, AlarmError::NotChannelDiagnosis);
+  EXPECT_EQ(decode_channel_diagnosis(user_structure::kExtChannelDiagnosis, std::span(ext).first(13)).error,
+            AlarmError::ChannelDiagnosisLength);
+  EXPECT_EQ(decode_channel_diagnosis(user_structure::kChannelDiagnosis, {}).error, AlarmError::ChannelDiagnosisLength);
+  EXPECT_EQ(decode_channel_diagnosis(user_structure::kChannelDiagnosis, {}).count(), 0U);
+  EXPECT_EQ(channel_error_type_name(0x0013), "reserved");
+  EXPECT_EQ(channel_error_type_name(0x0100), "manufacturer specific");
+  EXPECT_EQ(channel_error_type_name(0x8006), "reserved");
+}
+
 TEST(PnAlarm, Sequences) {
   EXPECT_EQ(next_rta_seq(kRtaInitialSendSeq), 0);
   EXPECT_EQ(next_rta_seq(kRtaInitialAckSeq), 0xFFFF);

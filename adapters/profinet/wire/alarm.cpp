@@ -61,6 +61,8 @@ std::string_view to_string(AlarmError e) noexcept {
     case AlarmError::BlockLengthMismatch: return "alarm BlockLength does not match the octets of the block";
     case AlarmError::BufferTooSmall: return "buffer too small for the alarm PDU";
     case AlarmError::DataTooLong: return "alarm data longer than one frame can carry";
+    case AlarmError::NotChannelDiagnosis: return "the alarm item is not channel diagnosis (USI 8000h, 8002h, 8003h)";
+    case AlarmError::ChannelDiagnosisLength: return "channel diagnosis data is not a whole number of entries";
   }
   return "?";
 }
@@ -300,6 +302,76 @@ AlarmAckView decode_alarm_ack(std::span<const std::uint8_t> in) noexcept {
   a.specifier = decode_alarm_specifier(get_be16(in, 16));
   a.status = RtaPnioStatus{in[18], in[19], in[20], in[21]};
   return v;
+}
+
+ChannelDiagnosisList decode_channel_diagnosis(std::uint16_t user_structure_id, std::span<const std::uint8_t> data) noexcept {
+  ChannelDiagnosisList l;
+  l.user_structure_id = user_structure_id;
+  switch (user_structure_id) {
+    case user_structure::kChannelDiagnosis: l.entry_size = 6; break;
+    case user_structure::kExtChannelDiagnosis: l.entry_size = 12; break;
+    case user_structure::kQualifiedChannelDiagnosis: l.entry_size = 16; break;
+    default: l.error = AlarmError::NotChannelDiagnosis; return l;
+  }
+  if (data.empty() || data.size() % l.entry_size != 0) {
+    l.error = AlarmError::ChannelDiagnosisLength;
+    l.entry_size = 0;
+    return l;
+  }
+  l.data = data;
+  return l;
+}
+
+bool ChannelDiagnosisList::get(std::size_t i, ChannelDiagnosis& out) const noexcept {
+  if (i >= count()) return false;
+  const auto e = data.subspan(i * entry_size, entry_size);
+  out = ChannelDiagnosis{};
+  out.channel = get_be16(e, 0);
+  out.properties = get_be16(e, 2);
+  out.error_type = get_be16(e, 4);
+  if (entry_size >= 12) {
+    out.ext_error_type = get_be16(e, 6);
+    out.ext_add_value = get_be32(e, 8);
+  }
+  if (entry_size >= 16) out.qualifier = get_be32(e, 12);
+  return true;
+}
+
+std::string_view channel_error_type_name(std::uint16_t type) noexcept {
+  // The codes public references agree on (0013h is named differently by them and left out).
+  switch (type) {
+    case 0x0001: return "short circuit";
+    case 0x0002: return "undervoltage";
+    case 0x0003: return "overvoltage";
+    case 0x0004: return "overload";
+    case 0x0005: return "overtemperature";
+    case 0x0006: return "line break";
+    case 0x0007: return "upper limit value exceeded";
+    case 0x0008: return "lower limit value exceeded";
+    case 0x0009: return "error";
+    case 0x000A: return "simulation active";
+    case 0x000F: return "parameter missing";
+    case 0x0010: return "parameterization fault";
+    case 0x0011: return "power supply fault";
+    case 0x0012: return "fuse blown / open";
+    case 0x0014: return "ground fault";
+    case 0x0015: return "reference point lost";
+    case 0x0016: return "process event lost / sampling error";
+    case 0x0017: return "threshold warning";
+    case 0x0018: return "output disabled";
+    case 0x0019: return "functional safety event";
+    case 0x001A: return "external fault";
+    case 0x001F: return "temporary fault";
+    case 0x8000: return "data transmission impossible";
+    case 0x8001: return "remote mismatch";
+    case 0x8002: return "media redundancy mismatch";
+    case 0x8003: return "sync mismatch";
+    case 0x8004: return "isochronous mode mismatch";
+    case 0x8005: return "multicast CR mismatch";
+    default: break;
+  }
+  if (type >= 0x0100 && type <= 0x7FFF) return "manufacturer specific";
+  return "reserved";
 }
 
 std::uint16_t alarm_block_type(std::span<const std::uint8_t> var_part) noexcept {

@@ -84,6 +84,8 @@ enum class AlarmError : std::uint8_t {
                           // running past VarPartLen, or octets left after the block)
   BufferTooSmall,         // encoder: the caller's span is too small
   DataTooLong,            // encoder: alarm data beyond one frame
+  NotChannelDiagnosis,    // a UserStructureIdentifier other than 8000h, 8002h, 8003h
+  ChannelDiagnosisLength, // channel diagnosis data not a whole number of entries
 };
 std::string_view to_string(AlarmError e) noexcept;
 
@@ -216,6 +218,47 @@ struct AlarmAckView {
   bool ok() const noexcept { return error == AlarmError::None; }
 };
 AlarmAckView decode_alarm_ack(std::span<const std::uint8_t> var_part) noexcept;
+
+// ---- Channel diagnosis in an AlarmItem [IEC 61158-6-10, ChannelDiagnosisData,
+// ExtChannelDiagnosisData, QualifiedChannelDiagnosisData] ------------------------------------------
+//
+//   ChannelDiagnosis (USI 8000h)           ChannelNumber u16 | ChannelProperties u16 | ChannelErrorType u16
+//   ExtChannelDiagnosis (8002h)            + ExtChannelErrorType u16 | ExtChannelAddValue u32
+//   QualifiedChannelDiagnosis (8003h)      + QualifiedChannelQualifier u32
+//
+// ChannelProperties: bits 0-7 Type (data width), 8 Accumulative, 9-10 Maintenance (0 fault,
+// 1 maintenance required, 2 maintenance demanded, 3 qualified), 11-12 Specifier (1 appears,
+// 2 disappears, 3 disappears but others remain, 0 all disappear), 13-15 Direction.
+
+inline constexpr std::uint16_t kChannelWholeSubmodule = 0x8000;  // ChannelNumber for the submodule as a whole
+
+struct ChannelDiagnosis {
+  std::uint16_t channel = 0;
+  std::uint16_t properties = 0;
+  std::uint16_t error_type = 0;
+  std::uint16_t ext_error_type = 0;  // 8002h/8003h only
+  std::uint32_t ext_add_value = 0;   // 8002h/8003h only
+  std::uint32_t qualifier = 0;       // 8003h only
+  std::uint8_t maintenance() const noexcept { return static_cast<std::uint8_t>((properties >> 9) & 3); }
+  std::uint8_t specifier() const noexcept { return static_cast<std::uint8_t>((properties >> 11) & 3); }
+  std::uint8_t direction() const noexcept { return static_cast<std::uint8_t>(properties >> 13); }
+  bool accumulative() const noexcept { return (properties & 0x0100) != 0; }
+  bool appears() const noexcept { return specifier() == 1; }
+  bool operator==(const ChannelDiagnosis&) const = default;
+};
+
+// The entries of an AlarmItem's data (a view; get() decodes one).
+struct ChannelDiagnosisList {
+  AlarmError error = AlarmError::None;
+  std::uint16_t user_structure_id = 0;
+  std::span<const std::uint8_t> data{};
+  std::size_t entry_size = 0;
+  std::size_t count() const noexcept { return entry_size == 0 ? 0 : data.size() / entry_size; }
+  bool get(std::size_t i, ChannelDiagnosis& out) const noexcept;  // false past the end
+};
+ChannelDiagnosisList decode_channel_diagnosis(std::uint16_t user_structure_id, std::span<const std::uint8_t> data) noexcept;
+// "short circuit", "undervoltage", ..., "manufacturer specific" (0100h-7FFFh), "reserved".
+std::string_view channel_error_type_name(std::uint16_t type) noexcept;
 
 // The BlockType of the block in a DATA var part (0 when shorter than 2 octets), to pick a decoder.
 std::uint16_t alarm_block_type(std::span<const std::uint8_t> var_part) noexcept;
