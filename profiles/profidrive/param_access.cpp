@@ -190,6 +190,43 @@ EncodeResult encode_change_request(std::span<std::uint8_t> out, std::uint8_t ref
   return {ParamError::None, at, 0};
 }
 
+EncodeResult encode_param_response(std::span<std::uint8_t> out, const ParamResponse& response) noexcept {
+  const std::uint8_t id = response.response_id;
+  if (id != response_id::kReadOk && id != response_id::kChangeOk && id != response_id::kReadFailed &&
+      id != response_id::kChangeFailed)
+    return {ParamError::UnknownId, 0, 0};
+  if (response.count == 0 || response.count > kMaxParameters) return {ParamError::BadCount, 0, 0};
+  if (response.block_count != response.count && !(response.block_count == 0 && id == response_id::kChangeOk))
+    return {ParamError::BadCount, 0, 0};
+  std::size_t size = kParamHeaderSize;
+  for (std::size_t i = 0; i < response.block_count; ++i) {
+    const ValueBlock& b = response.blocks[i];
+    if (b.format == format::kAkdNone || b.format == format::kZero) {
+      if (b.count != 0 || !b.data.empty()) return {ParamError::BadZeroBlock, 0, i};
+    } else if (format_size(b.format) == 0) {
+      return {ParamError::UnknownFormat, 0, i};
+    } else if (b.data.size() != format_size(b.format) * b.count) {
+      return {ParamError::CountBeyondData, 0, i};
+    }
+    size += 2 + padded(b.data.size());
+  }
+  if (size > kMaxParamRecord) return {ParamError::TooLong, 0, 0};
+  if (out.size() < size) return {ParamError::BufferTooSmall, 0, 0};
+  out[0] = response.reference;
+  out[1] = id;
+  out[2] = response.axis;
+  out[3] = response.count;
+  std::size_t at = kParamHeaderSize;
+  for (std::size_t i = 0; i < response.block_count; ++i) {
+    const ValueBlock& b = response.blocks[i];
+    out[at++] = b.format;
+    out[at++] = b.count;
+    for (const std::uint8_t byte : b.data) out[at++] = byte;
+    if ((b.data.size() & 1U) != 0) out[at++] = 0;
+  }
+  return {ParamError::None, at, 0};
+}
+
 std::uint32_t ValueBlock::value(std::size_t i) const noexcept {
   const std::size_t w = format_size(format);
   if (w == 0 || (i + 1) * w > data.size()) return 0;

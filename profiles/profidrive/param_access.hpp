@@ -152,6 +152,12 @@ struct ResponseResult {
 };
 ResponseResult decode_param_response(std::span<const std::uint8_t> in) noexcept;
 
+// The drive's side (the simulator): a response with its header and `response.values()`, each
+// block with `count` x format_size bytes of data (as the decoder returns them) and odd blocks padded
+// to a word. An empty values() with 02h is the standard 4-byte change reply. Refuses unknown IDs and
+// formats, blocks whose data does not match their count, and records over 240 bytes.
+EncodeResult encode_param_response(std::span<std::uint8_t> out, const ParamResponse& response) noexcept;
+
 // A request read back (the simulated drive's side, and the reference for check_response).
 struct ParamRequest {
   std::uint8_t reference = 0;

@@ -288,6 +288,40 @@ TEST(ProfidriveParam, RequestDecoderRefusesMalformedRequests) {
             ParamError::CountBeyondData);
 }
 
+TEST(ProfidriveParam, ResponseEncoderForTheDriveSide) {
+  // The §5.5 reply in its standard form, and a read reply with a padded Byte block, round trip.
+  ParamResponse change;
+  change.reference = 5;
+  change.response_id = response_id::kChangeOk;
+  change.count = 1;
+  std::array<std::uint8_t, kMaxParamRecord> out{};
+  EncodeResult e = encode_param_response(out, change);
+  ASSERT_EQ(e.error, ParamError::None);
+  EXPECT_EQ(Bytes(out.begin(), out.begin() + static_cast<std::ptrdiff_t>(e.size)), (Bytes{0x05, 0x02, 0x00, 0x01}));
+  change.block_count = 1;
+  change.blocks[0] = ValueBlock{format::kAkdNone, 0, {}};
+  e = encode_param_response(out, change);
+  EXPECT_EQ(Bytes(out.begin(), out.begin() + static_cast<std::ptrdiff_t>(e.size)),
+            (Bytes{0x05, 0x02, 0x00, 0x01, 0x00, 0x00}));  // the AKD's form
+
+  const Bytes reply = keep(Bytes{0x22, 0x01, 0x00, 0x02, 0x41, 0x01, 0x02, 0x00, 0x42, 0x01, 0x00, 0x05});
+  const ResponseResult r = decode_param_response(reply);
+  ASSERT_EQ(r.error, ParamError::None);
+  e = encode_param_response(out, r.response);
+  ASSERT_EQ(e.error, ParamError::None);
+  EXPECT_EQ(Bytes(out.begin(), out.begin() + static_cast<std::ptrdiff_t>(e.size)), reply);
+
+  ParamResponse bad = r.response;
+  bad.blocks[1].count = 2;  // the data holds one word
+  EXPECT_EQ(encode_param_response(out, bad).error, ParamError::CountBeyondData);
+  bad = r.response;
+  bad.response_id = 0x03;
+  EXPECT_EQ(encode_param_response(out, bad).error, ParamError::UnknownId);
+  bad = r.response;
+  bad.block_count = 1;
+  EXPECT_EQ(encode_param_response(out, bad).error, ParamError::BadCount);
+}
+
 TEST(ProfidriveParam, EncodeAndDecodeDoNotAllocate) {
   std::array<std::uint8_t, kMaxParamRecord> out{};
   const std::array<ParamAddress, 2> reads{ParamAddress{Attribute::Value, 1, 944, 0}, ParamAddress{Attribute::Value, 8, 947, 0}};
