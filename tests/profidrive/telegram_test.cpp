@@ -7,6 +7,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "profiles/profidrive/control_words.hpp"
+#include "profiles/profidrive/state_machine.hpp"
 #include "tests/support/alloc_counter.hpp"
 
 namespace drivegate::profidrive {
@@ -72,6 +74,35 @@ TEST(ProfidriveTelegram, Telegram1EnableSequenceOnTheWire) {
     sp.stw1 = stw1;
     ASSERT_EQ(encode_setpoints(t1, sp, out), TelegramError::None);
     EXPECT_EQ(out, bytes);
+  }
+}
+
+TEST(ProfidriveTelegram, EnableAndRunWithTelegram1) {
+  // §15.1 end to end: the enable walk with the ramp bits reads each ZSW1 from the input image and
+  // writes STW1 (and, from S4 on, NSOLL_A = 0x00A3) into the output image. The drive's replies are
+  // the standard patterns (§9.4), the last one the S7 example's 02 37 00 9E (§20.3).
+  const TelegramLayout t1 = layout(1);
+  const std::array<std::array<std::uint8_t, 4>, 4> inputs{{{0x02, 0x70, 0x00, 0x00},   // S1
+                                                           {0x02, 0x31, 0x00, 0x00},   // S2
+                                                           {0x02, 0x33, 0x00, 0x00},   // S3
+                                                           {0x02, 0x37, 0x00, 0x9E}}}; // S4, running
+  const std::array<std::array<std::uint8_t, 4>, 4> expected{{{0x04, 0x76, 0x00, 0x00},
+                                                             {0x04, 0x77, 0x00, 0x00},
+                                                             {0x04, 0x7F, 0x00, 0x00},
+                                                             {0x04, 0x7F, 0x00, 0xA3}}};
+  std::uint16_t last = 0x0470;  // §15.1 step 1
+  for (std::size_t i = 0; i < inputs.size(); ++i) {
+    Actuals a;
+    ASSERT_EQ(decode_actuals(t1, inputs[i], a), TelegramError::None);
+    const EnableStep step = enable_step(decode_state(a.zsw1, last), last, stw1::kSpeedRunBits);
+    Setpoints sp;
+    sp.stw1 = step.stw1;
+    sp.nsoll_a = step.done ? std::int16_t{0x00A3} : std::int16_t{0};  // the set-point counts from S4 on
+    std::array<std::uint8_t, 4> out{};
+    ASSERT_EQ(encode_setpoints(t1, sp, out), TelegramError::None);
+    EXPECT_EQ(out, expected[i]) << "step " << i;
+    EXPECT_EQ(step.done, i == 3);
+    last = step.stw1;
   }
 }
 
