@@ -11,6 +11,7 @@
 #include <cstdint>
 
 #include "core/axis_types.hpp"
+#include "profiles/profidrive/control_words.hpp"
 
 namespace drivegate::profidrive {
 
@@ -53,5 +54,12 @@ struct EnableStep {
 // dropped so S1 is reached with ON low. Unknown and NotReadyToSwitchOn send 0x0406 (S1 -> S2 once
 // the drive gets there).
 EnableStep enable_step(DriveState current, std::uint16_t last_stw1, std::uint16_t mode_bits = 0) noexcept;
+
+// A fault reset on its own (no enable): 0x0400 while the last word still has bit 7, then 0x0480,
+// the 0->1 edge with bits 0..3 low, so the drive lands in S1 and stays there [§8.1, §18.2].
+constexpr std::uint16_t fault_reset_stw1(std::uint16_t last_stw1) noexcept {
+  return (last_stw1 & stw1::kFaultAcknowledge) != 0 ? stw1_word::kIdle
+                                                     : static_cast<std::uint16_t>(stw1_word::kIdle | stw1::kFaultAcknowledge);
+}
 
 }  // namespace drivegate::profidrive

@@ -158,6 +158,15 @@ TEST(ProfidriveState, FaultAcknowledgeEdgeThenS1ThenOnAgain) {
   EXPECT_EQ(walk(again, 0x0486, 0), (std::vector<std::uint16_t>{0x0406, 0x0486, 0x0406, 0x0407, 0x040F, 0x040F}));
 }
 
+TEST(ProfidriveState, FaultResetAloneStaysInS1) {
+  EXPECT_EQ(fault_reset_stw1(0x047F), 0x0480);
+  EXPECT_EQ(fault_reset_stw1(0x0480), 0x0400);  // no edge possible: drop bit 7 first
+  EXPECT_EQ(fault_reset_stw1(0x0400), 0x0480);
+  // Bits 0..3 low: after the acknowledge the drive stays in S1 (S1 -> S2 needs bits 1 and 2).
+  EXPECT_EQ(fault_reset_stw1(0x0400) & stw1::kStateMask, 0);
+  EXPECT_NE(fault_reset_stw1(0x0400) & stw1::kControlByPlc, 0);
+}
+
 TEST(ProfidriveState, EnableWaitsForAStopToFinish) {
   // S5 after OFF1: keep sending the stop word; quick stop: hold OFF3 with bit 0 low.
   EXPECT_EQ(enable_step(decode_state(kS4, 0x0406), 0x0406).stw1, 0x0406);
