@@ -17,6 +17,13 @@ ethercat_frame:   EtherCAT frames (ETG.1000.4 §5 layout): one APRD, a multi-dat
 ethercat_mailbox: SM1 mailboxes: the digest's TV-6 SDO download, TV-4 emergencies, SDO responses
                   (expedited, normal, segments, abort), SDO information replies, a mailbox error.
 ethercat_sii:     SII images: a minimal one and one with every category the parser reads.
+profinet_dcp:     PROFINET frames with DCP (IEC 61158-6-10 §4.3.1): Identify all / by name, an Identify
+                  response with every block the decoder reads, Set name / IP / Signal, a Set
+                  response, Get request and response, and malformed ones (lying lengths, odd blocks).
+profinet_rt:      RT class 1 frames behind their C_SDU length and last cycle counter (mode byte 0),
+                  and submodule lists for the C_SDU layout (mode byte 1).
+profinet_alarm:   RTA frames: a diagnosis alarm (DATA), the RTA ACK, an AlarmAck, an ERR, a low
+                  pull alarm, and malformed ones.
 ethercat_sim:     operation scripts (format in fuzz_ethercat_sim.cpp): addressing and identity
                   reads, a bring-up to PRE-OP with an SDO upload through the mailbox, process data
                   to OP with LRW, a DC latch, faults.
@@ -262,7 +269,89 @@ def ethercat_sim_seeds():
     write("ethercat_sim", "faults", faults)
 
 
+PN_DEVICE = bytes([0x00, 0x1B, 0x1B, 0x12, 0x34, 0x56])
+PN_CONTROLLER = bytes([2, 0, 0, 0, 0, 1])
+
+
+def pn_frame(dst, src, frame_id, pdu, prio=None):
+    """Ethernet II (optionally priority tagged) + EtherType 8892h + FrameID, padded to 60."""
+    tag = b"" if prio is None else struct.pack(">HH", 0x8100, prio << 13)
+    f = dst + src + tag + struct.pack(">HH", 0x8892, frame_id) + pdu
+    return f + bytes(max(0, 60 - len(f)))
+
+
+def dcp_block(option, sub, value):
+    return struct.pack(">BBH", option, sub, len(value)) + value + (b"\0" if len(value) % 2 else b"")
+
+
+def dcp(service, stype, xid, blocks, delay=0):
+    body = b"".join(blocks)
+    return struct.pack(">BBIHH", service, stype, xid, delay, len(body)) + body
+
+
+def profinet_seeds():
+    ip = bytes([192, 168, 0, 10, 255, 255, 255, 0, 192, 168, 0, 1])
+    mc = bytes([1, 0x0E, 0xCF, 0, 0, 0])
+    info = [dcp_block(2, 1, b"\0\0AKD"), dcp_block(2, 2, b"\0\0akd-1"), dcp_block(2, 3, bytes.fromhex("0000002A0301")),
+            dcp_block(2, 4, bytes.fromhex("00000100")), dcp_block(2, 5, bytes.fromhex("000001020202")),
+            dcp_block(2, 7, bytes.fromhex("00000001")), dcp_block(2, 8, bytes.fromhex("000012345678")),
+            dcp_block(1, 2, b"\0\1" + ip), dcp_block(1, 1, b"\0\0" + PN_DEVICE), dcp_block(3, 61, b"\0\0\0akd1"),
+            dcp_block(6, 1, bytes.fromhex("00000001"))]
+    seeds = {
+        "identify_all": pn_frame(mc, PN_CONTROLLER, 0xFEFE, dcp(5, 0, 1, [dcp_block(255, 255, b"")], 1)),
+        "identify_name": pn_frame(mc, PN_CONTROLLER, 0xFEFE, dcp(5, 0, 2, [dcp_block(2, 2, b"akd-1")], 0x80)),
+        "identify_response": pn_frame(PN_CONTROLLER, PN_DEVICE, 0xFEFF, dcp(5, 1, 1, info)),
+        "set_name": pn_frame(PN_DEVICE, PN_CONTROLLER, 0xFEFD, dcp(4, 0, 3, [dcp_block(2, 2, b"\0\1akd-1")])),
+        "set_ip": pn_frame(PN_DEVICE, PN_CONTROLLER, 0xFEFD, dcp(4, 0, 4, [dcp_block(1, 2, b"\0\0" + ip)])),
+        "signal": pn_frame(PN_DEVICE, PN_CONTROLLER, 0xFEFD, dcp(4, 0, 5, [dcp_block(5, 3, bytes.fromhex("00000100"))])),
+        "set_response": pn_frame(PN_CONTROLLER, PN_DEVICE, 0xFEFD,
+                                 dcp(4, 1, 3, [dcp_block(5, 4, bytes([2, 2, 0])), dcp_block(5, 4, bytes([1, 2, 6]))])),
+        "get_request": pn_frame(PN_DEVICE, PN_CONTROLLER, 0xFEFD, dcp(3, 0, 6, [bytes([2, 2, 1, 2])])),
+        "get_response": pn_frame(PN_CONTROLLER, PN_DEVICE, 0xFEFD, dcp(3, 1, 6, [dcp_block(2, 2, b"\0\0akd-1")])),
+        "hello_tagged": pn_frame(bytes([1, 0x0E, 0xCF, 0, 0, 1]), PN_DEVICE, 0xFEFC, dcp(6, 0, 7, info[:3]), prio=0),
+    }
+    bad_len = bytearray(seeds["identify_name"])
+    bad_len[24] = 0x01  # DCPDataLength 010Ah: beyond the frame
+    odd_ip = pn_frame(PN_CONTROLLER, PN_DEVICE, 0xFEFF, dcp(5, 1, 1, [dcp_block(1, 2, b"\0\1" + ip[:11])]))
+    seeds.update({"lying_length": bytes(bad_len), "odd_ip_block": odd_ip, "truncated": seeds["identify_response"][:30]})
+    for name, data in seeds.items():
+        write("profinet_dcp", name, data)
+
+    out = bytes.fromhex("047F40008000000080808080") + bytes(28)
+    status = bytes.fromhex("12343500")
+    tagged = pn_frame(PN_DEVICE, PN_CONTROLLER, 0x8001, out + status, prio=6)
+    untagged = pn_frame(PN_CONTROLLER, PN_DEVICE, 0xC001, bytes(40) + bytes.fromhex("12403500"))
+    write("profinet_rt", "output_tagged", b"\0" + struct.pack(">HH", 40, 0x1200) + tagged)
+    write("profinet_rt", "input_untagged", b"\0" + struct.pack(">HH", 40, 0x1220) + untagged)
+    write("profinet_rt", "input_stop_problem", b"\0" + struct.pack(">HH", 40, 0x1200) + untagged[:-2] + b"\x05\x00")
+    write("profinet_rt", "length_lies", b"\0" + struct.pack(">HH", 44, 0x1200) + tagged)
+    subs = [(0, 0, 0), (3, 4, 4), (1, 2, 0), (2, 0, 3)]
+    write("profinet_rt", "layout", b"\1" + b"".join(struct.pack(">BHH", *s) for s in subs))
+    write("profinet_rt", "layout_full", b"\1" + struct.pack(">BHH", 1, 1439, 0) + struct.pack(">BHH", 2, 0, 1))
+
+    notif = bytes.fromhex("0001001E0100" "000100003A0000010001" "0000001000000001" "A805" "800080000800" "0001")
+    ack = bytes.fromhex("8001001201000001" "00003A0000010001A80500000000")
+    pull = bytes.fromhex("000200160100" "00030000000000010001" "0000000000000000" "0000")
+    seeds = {
+        "data_diagnosis": pn_frame(PN_CONTROLLER, PN_DEVICE, 0xFC01,
+                                   struct.pack(">HHBBHHH", 1, 3, 0x11, 0x11, 0, 0xFFFF, len(notif)) + notif, prio=6),
+        "rta_ack": pn_frame(PN_DEVICE, PN_CONTROLLER, 0xFC01, struct.pack(">HHBBHHH", 3, 1, 0x13, 0x01, 0xFFFF, 0, 0), prio=6),
+        "alarm_ack": pn_frame(PN_DEVICE, PN_CONTROLLER, 0xFC01,
+                              struct.pack(">HHBBHHH", 3, 1, 0x11, 0x11, 0, 0, len(ack)) + ack, prio=6),
+        "err": pn_frame(PN_DEVICE, PN_CONTROLLER, 0xFC01,
+                        struct.pack(">HHBBHHH", 3, 1, 0x14, 0x01, 0xFFFF, 0xFFFE, 4) + bytes.fromhex("CF81FD06"), prio=6),
+        "pull_low": pn_frame(PN_CONTROLLER, PN_DEVICE, 0xFE01,
+                             struct.pack(">HHBBHHH", 1, 3, 0x11, 0x01, 1, 0, len(pull)) + pull, prio=5),
+        "nack_untagged": pn_frame(PN_DEVICE, PN_CONTROLLER, 0xFE01, struct.pack(">HHBBHHH", 3, 1, 0x12, 0x01, 0, 0, 0)),
+        "var_part_lies": pn_frame(PN_CONTROLLER, PN_DEVICE, 0xFC01,
+                                  struct.pack(">HHBBHHH", 1, 3, 0x11, 0x11, 0, 0xFFFF, 0x0100) + notif, prio=6),
+    }
+    for name, data in seeds.items():
+        write("profinet_alarm", name, data)
+
+
 if __name__ == "__main__":
+    profinet_seeds()
     ethercat_sim_seeds()
     ethercat_frame_seeds()
     ethercat_mailbox_seeds()
