@@ -15,7 +15,7 @@ std::string_view block_type_name(std::uint16_t type) noexcept {
     case block_type::kExpectedSubmoduleBlockReq: return "ExpectedSubmoduleBlockReq";
     case block_type::kPrmEndReq: return "IODControlReq (PrmEnd)";
     case block_type::kApplicationReadyReq: return "IOXControlReq (ApplicationReady)";
-    case block_type::kReleaseReq: return "ReleaseBlockReq";
+    case block_type::kReleaseReq: return "IODReleaseReq";
     case block_type::kWriteResHeader: return "IODWriteResHeader";
     case block_type::kReadResHeader: return "IODReadResHeader";
     case block_type::kArBlockRes: return "ARBlockRes";
@@ -24,7 +24,7 @@ std::string_view block_type_name(std::uint16_t type) noexcept {
     case block_type::kModuleDiffBlock: return "ModuleDiffBlock";
     case block_type::kPrmEndRes: return "IODControlRes (PrmEnd)";
     case block_type::kApplicationReadyRes: return "IOXControlRes (ApplicationReady)";
-    case block_type::kReleaseRes: return "ReleaseBlockRes";
+    case block_type::kReleaseRes: return "IODReleaseRes";
     default: return "unknown block";
   }
 }
