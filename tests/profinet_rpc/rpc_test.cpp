@@ -148,7 +148,7 @@ TEST(PnRpc, NdrResponseBytesAndChecks) {
   const RpcHeader req = test::device_call(Opnum::Write, 7, ByteOrder::Big);
   const PnioStatus st{0xDF, 0x80, 0xB0, 0x00};
   ASSERT_EQ(finish_pnio_response(response_header_for(req, 9), st, 16696, 0, buf), kPnioBlocksOffset);
-  // PNIOStatus is four octets in wire order whatever the drep; then the counts big-endian here.
+  // PNIOStatus is an Unsigned32 in the NDR part, ErrorCode on top; big-endian drep here.
   EXPECT_EQ(test::bytes(std::span(buf).subspan(kRpcHeaderSize, kNdrHeaderSize)),
             hex("DF 80 B0 00 | 00 00 00 00 | 00 00 41 38 | 00 00 00 00 | 00 00 00 00"));
   EXPECT_EQ(buf[1], 2);      // response
@@ -167,6 +167,15 @@ TEST(PnRpc, NdrResponseBytesAndChecks) {
   EXPECT_EQ(decode_ndr_response(lying, ByteOrder::Big).error, WireError::ArgsLengthBeyondData);
   lying.push_back(0);
   EXPECT_EQ(decode_ndr_response(lying, ByteOrder::Big).error, WireError::NdrCountsInconsistent);
+
+  // A little-endian drep reverses the status octets (Wireshark's dissect_PNIO_status reads it so).
+  const RpcHeader le_req = test::device_call(Opnum::Write, 7, ByteOrder::Little);
+  ASSERT_EQ(finish_pnio_response(response_header_for(le_req, 9), st, 16696, 0, buf), kPnioBlocksOffset);
+  EXPECT_EQ(test::bytes(std::span(buf).subspan(kRpcHeaderSize, kNdrHeaderSize)),
+            hex("00 B0 80 DF | 00 00 00 00 | 38 41 00 00 | 00 00 00 00 | 00 00 00 00"));
+  EXPECT_EQ(decode_pnio_response(std::span(buf).first(kPnioBlocksOffset)).ndr.status, st);
+  EXPECT_EQ(status_to_u32(st), 0xDF80B000U);
+  EXPECT_EQ(status_from_u32(0xDB810104U), (PnioStatus{0xDB, 0x81, 0x01, 0x04}));
 }
 
 TEST(PnRpc, NotPnioRefused) {

@@ -162,6 +162,37 @@ TEST_P(PnTshark, ConnectToReleaseDissectsCleanly) {
   EXPECT_GE(count(out, "Status: OK"), 6U) << out;
 }
 
+// A refused write: the PNIOStatus in the NDR part (an Unsigned32 in the drep's byte order) and
+// in the IODWriteResHeader (big-endian like every block) must both read back as DF 80 B6 05.
+TEST_P(PnTshark, ErrorStatusReadsBack) {
+  const ByteOrder order = GetParam();
+  std::array<std::uint8_t, 512> buf{};
+  const PnioStatus denied{0xDF, 0x80, 0xB6, 0x05};
+  RecordReqHeader wr;
+  wr.type = block_type::kWriteReqHeader;
+  wr.ar_uuid = test::kArUuid;
+  wr.slot = 1;
+  wr.subslot = 1;
+  wr.index = 0x1000;  // a manufacturer record: index 47 would be dissected as a (short) PROFIdrive request
+  wr.record_data_length = 2;
+  const RpcHeader req = test::device_call(Opnum::Write, 9, order);
+  const std::array<std::uint8_t, 2> two{1, 2};
+  std::vector<Bytes> fs;
+  std::size_t n = encode_write_request(req, test::kArgsMaximum, wr, two, buf);
+  fs.push_back(test::udp_frame(kPlc, kDrive, std::span(buf).first(n), 1));
+  n = encode_write_response(response_header_for(req, 1), denied, test::kArgsMaximum, record_response_for(wr, 0, denied),
+                            buf);
+  fs.push_back(test::udp_frame(kDrive, kPlc, std::span(buf).first(n), 2));
+  const std::optional<std::string> dissected = drivegate::test::tshark_dissect(fs);
+  if (!dissected) GTEST_SKIP() << "tshark not installed (scripts/install-deps.sh)";
+  const std::string& out = *dissected;
+  EXPECT_EQ(out.find("Malformed"), std::string::npos) << out;
+  EXPECT_EQ(count(out, "ErrorCode: IODWriteRes (0xdf)"), 2U) << out;
+  EXPECT_EQ(count(out, "ErrorDecode: PNIORW (0x80)"), 2U) << out;
+  EXPECT_EQ(count(out, "ErrorCode1: access: access denied (182)"), 2U) << out;
+  EXPECT_EQ(out.find("Unknown ErrorDecode"), std::string::npos) << out;
+}
+
 INSTANTIATE_TEST_SUITE_P(Drep, PnTshark, ::testing::Values(ByteOrder::Little, ByteOrder::Big),
                          [](const ::testing::TestParamInfo<ByteOrder>& p) { return p.param == ByteOrder::Little ? "Little" : "Big"; });
 

@@ -180,11 +180,10 @@ NdrResponseView decode_ndr_response(std::span<const std::uint8_t> body, ByteOrde
   NdrResponseView v;
   Reader r(body, order);
   NdrResponse& n = v.ndr;
-  // PNIOStatus is four octets, not a number: no byte order [IEC 61158-6-10 §5.2.6].
-  n.status.code = r.u8();
-  n.status.decode = r.u8();
-  n.status.code1 = r.u8();
-  n.status.code2 = r.u8();
+  // In the NDR part PNIOStatus is marshalled as one Unsigned32 (ErrorCode in the most significant
+  // octet), so a little-endian drep reverses the four octets; inside the big-endian blocks it reads
+  // in field order [IEC 61158-6-10 §5.1.2 IDL "PNIOStatus", §5.2.6].
+  n.status = status_from_u32(r.u32());
   n.args_length = r.u32();
   n.maximum_count = r.u32();
   n.offset = r.u32();
@@ -229,10 +228,7 @@ std::size_t finish_pnio_response(RpcHeader h, const PnioStatus& status, std::uin
   if (encode_rpc_header(h, out) == 0) return 0;
   Writer w(out.subspan(kRpcHeaderSize, kNdrHeaderSize), h.order);
   const auto len = static_cast<std::uint32_t>(blocks_length);
-  w.u8(status.code);
-  w.u8(status.decode);
-  w.u8(status.code1);
-  w.u8(status.code2);
+  w.u32(status_to_u32(status));
   w.u32(len);
   w.u32(maximum_count);
   w.u32(0);

@@ -9,7 +9,7 @@
 //                    auth protocol u8 | serial_lo u8                    [DCE 1.1 RPC §12.5.1]
 //   NDR request (20) ArgsMaximum u32 | ArgsLength u32 | MaximumCount u32 | Offset u32 |
 //                    ActualCount u32, then ArgsLength bytes of PNIO blocks
-//   NDR response(20) PNIOStatus (4 octets) | ArgsLength | MaximumCount | Offset | ActualCount
+//   NDR response(20) PNIOStatus (u32) | ArgsLength | MaximumCount | Offset | ActualCount
 //                                                        [IEC 61158-6-10 §5.1.2 "IODConnectReq"...]
 //
 // The numbers of the RPC header and the NDR part are in the byte order drep names; the UUIDs'

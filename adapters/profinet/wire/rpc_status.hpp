@@ -24,6 +24,16 @@ struct PnioStatus {
   bool operator==(const PnioStatus&) const = default;
 };
 
+// PNIOStatus as one Unsigned32, ErrorCode in bits 24-31 ... ErrorCode2 in bits 0-7: how the NDR
+// part of a response carries it (in the drep byte order).
+constexpr std::uint32_t status_to_u32(const PnioStatus& s) noexcept {
+  return (std::uint32_t{s.code} << 24) | (std::uint32_t{s.decode} << 16) | (std::uint32_t{s.code1} << 8) | s.code2;
+}
+constexpr PnioStatus status_from_u32(std::uint32_t v) noexcept {
+  return {static_cast<std::uint8_t>(v >> 24), static_cast<std::uint8_t>((v >> 16) & 0xFF),
+          static_cast<std::uint8_t>((v >> 8) & 0xFF), static_cast<std::uint8_t>(v & 0xFF)};
+}
+
 namespace pnio_error_code {
 inline constexpr std::uint8_t kOk = 0x00;
 inline constexpr std::uint8_t kPnio = 0x81;
