@@ -1,6 +1,7 @@
 #include "adapters/profinet/wire/blocks.hpp"
 
 #include <algorithm>
+#include <array>
 
 namespace drivegate::profinet {
 
@@ -110,7 +111,7 @@ BlockBody open_block_of(std::span<const std::uint8_t> in, std::span<const std::u
 }
 
 BlockBody open_block(std::span<const std::uint8_t> in, std::uint16_t type, std::size_t body_min) noexcept {
-  const std::uint16_t types[] = {type};
+  const std::array<std::uint16_t, 1> types{type};
   return open_block_of(in, types, body_min);
 }
 
