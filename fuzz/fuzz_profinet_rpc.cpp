@@ -1,6 +1,7 @@
 // The PNIO RPC decoders (adapters/profinet/wire/rpc.hpp, rpc_calls.hpp, rpc_connect.hpp) on
 // whatever arrives on UDP port 34964: decode_rpc, decode_pnio_request/response, the NDR wrappers in
-// both byte orders, decode_rpc_fault, decode_connect_response with its ModuleDiff report.
+// both byte orders, decode_rpc_fault, decode_connect_request, decode_connect_response with its
+// ModuleDiff report.
 // Invariants: every view inside the input; a decoded header re-encodes to the same 80 bytes (but
 // the reserved drep octet); a decoded request or response whose counts are the ones the composer
 // writes is rebuilt byte for byte by finish_pnio_request/response; a Connect response holds at most
@@ -91,6 +92,16 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       const std::string_view r = module_diff_report(c.module_diff, {}, text);
       if (r.size() > text.size() || (!r.empty() && r.data() != text.data())) std::abort();
     }
+  }
+  const ConnectRequestView cr = decode_connect_request(input);
+  if (cr.error == WireError::None) {
+    if (cr.iocr_count == 0 || cr.iocr_count > kMaxConnectIocrs || cr.expected_count > kMaxConnectExpectedBlocks) {
+      std::abort();
+    }
+    inside(std::span<const std::uint8_t>(reinterpret_cast<const std::uint8_t*>(cr.ar.block.station_name.data()),
+                                         cr.ar.block.station_name.size()));
+    for (std::size_t i = 0; i < cr.iocr_count; ++i) inside(cr.iocrs[i].apis);
+    for (std::size_t i = 0; i < cr.expected_count; ++i) inside(cr.expected[i].apis);
   }
   std::array<char, 64> status_text{};
   if (describe(c.status, status_text).size() > status_text.size()) std::abort();

@@ -59,6 +59,47 @@ TEST(PnConnect, RequestIsHeaderNdrAndTheBlocks) {
   EXPECT_EQ(out.params.frame_id, 0xC002);
 }
 
+TEST(PnConnect, DeviceSideDecode) {
+  const test::Scenario s;
+  for (const ByteOrder order : {ByteOrder::Little, ByteOrder::Big}) {
+    const Bytes d = connect_request(order);
+    const ConnectRequestView v = decode_connect_request(d);
+    ASSERT_EQ(v.error, WireError::None) << to_string(v.error);
+    EXPECT_EQ(v.args_maximum, test::kArgsMaximum);
+    EXPECT_EQ(v.ar.block.station_name, "drivegate");
+    ASSERT_EQ(v.iocr_count, 2U);
+    EXPECT_EQ(v.iocrs[0].params.type, iocr_type::kInput);
+    EXPECT_EQ(v.iocrs[1].params.reduction_ratio, 16);
+    EXPECT_EQ(v.alarm_cr.block, AlarmCrBlockReq{});
+    ASSERT_EQ(v.expected_count, 2U);
+    ExpectedSubmoduleReader r(v.expected[1]);
+    ExpectedEntry e;
+    ASSERT_TRUE(r.next(e));
+    EXPECT_EQ(e.submodule, s.tg_subs[0]);
+  }
+  // Without its AlarmCRBlockReq (the last 26 + 78 bytes rebuilt without it): missing.
+  std::array<std::uint8_t, 1464> buf{};
+  const ConnectRequest c = s.connect();
+  auto area = pnio_blocks_area(buf);
+  std::size_t used = encode_ar_block_req(c.ar, area);
+  used += encode_iocr_block_req(c.input, c.input_apis, area.subspan(used));
+  std::size_t n = finish_pnio_request(test::device_call(Opnum::Connect, 1), test::kArgsMaximum, used, buf);
+  EXPECT_EQ(decode_connect_request(std::span(buf).first(n)).error, WireError::MissingBlock);
+  // A second AR block.
+  used += encode_ar_block_req(c.ar, area.subspan(used));
+  n = finish_pnio_request(test::device_call(Opnum::Connect, 1), test::kArgsMaximum, used, buf);
+  EXPECT_EQ(decode_connect_request(std::span(buf).first(n)).error, WireError::DuplicateBlock);
+  // A lying count inside the IOCR (NumberOfAPIs at block offset 45).
+  Bytes d = connect_request(ByteOrder::Little);
+  d[100 + 67 + 45] = 9;
+  EXPECT_EQ(decode_connect_request(d).error, WireError::CountBeyondData);
+  // Every cut.
+  const Bytes good = connect_request(ByteOrder::Big);
+  for (std::size_t k = 0; k < good.size(); ++k) {
+    EXPECT_NE(decode_connect_request(std::span(good).first(k)).error, WireError::None) << k;
+  }
+}
+
 TEST(PnConnect, RequestRefusals) {
   std::array<std::uint8_t, 1464> buf{};
   const test::Scenario s;

@@ -42,6 +42,55 @@ std::size_t encode_connect_request(const RpcHeader& h, std::uint32_t args_maximu
   return finish_pnio_request(h, args_maximum, used, out);
 }
 
+ConnectRequestView decode_connect_request(std::span<const std::uint8_t> datagram) noexcept {
+  ConnectRequestView v;
+  const PnioRequestView r = decode_pnio_request(datagram);
+  v.header = r.header;
+  v.args_maximum = r.ndr.args_maximum;
+  auto fail = [&v](WireError e) {
+    v.error = e;
+    return v;
+  };
+  if (r.error != WireError::None) return fail(r.error);
+  if (r.header.opnum != static_cast<std::uint16_t>(Opnum::Connect)) return fail(WireError::UnexpectedOpnum);
+  bool has_ar = false;
+  bool has_alarm = false;
+  BlockWalker walker(r.ndr.blocks);
+  BlockView b;
+  while (walker.next(b)) {
+    switch (b.header.type) {
+      case block_type::kArBlockReq:
+        if (has_ar) return fail(WireError::DuplicateBlock);
+        v.ar = decode_ar_block_req(b.block);
+        if (v.ar.error != WireError::None) return fail(v.ar.error);
+        has_ar = true;
+        break;
+      case block_type::kIocrBlockReq:
+        if (v.iocr_count == v.iocrs.size()) return fail(WireError::TooManyBlocks);
+        v.iocrs[v.iocr_count] = decode_iocr_block_req(b.block);
+        if (v.iocrs[v.iocr_count].error != WireError::None) return fail(v.iocrs[v.iocr_count].error);
+        ++v.iocr_count;
+        break;
+      case block_type::kAlarmCrBlockReq:
+        if (has_alarm) return fail(WireError::DuplicateBlock);
+        v.alarm_cr = decode_alarm_cr_block_req(b.block);
+        if (v.alarm_cr.error != WireError::None) return fail(v.alarm_cr.error);
+        has_alarm = true;
+        break;
+      case block_type::kExpectedSubmoduleBlockReq:
+        if (v.expected_count == v.expected.size()) return fail(WireError::TooManyBlocks);
+        v.expected[v.expected_count] = decode_expected_submodule_block(b.block);
+        if (v.expected[v.expected_count].error != WireError::None) return fail(v.expected[v.expected_count].error);
+        ++v.expected_count;
+        break;
+      default: ++v.other_blocks; break;
+    }
+  }
+  if (walker.error() != WireError::None) return fail(walker.error());
+  if (!has_ar || v.iocr_count == 0 || !has_alarm) return fail(WireError::MissingBlock);
+  return v;
+}
+
 const IocrBlockRes* ConnectResponseView::iocr(std::uint16_t type, std::uint16_t reference) const noexcept {
   for (std::size_t i = 0; i < iocr_count; ++i) {
     if (iocrs[i].type == type && iocrs[i].reference == reference) return &iocrs[i];

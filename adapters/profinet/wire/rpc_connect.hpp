@@ -35,6 +35,24 @@ std::size_t encode_connect_request(const RpcHeader& h, std::uint32_t args_maximu
                                    std::span<std::uint8_t> out) noexcept;
 
 inline constexpr std::size_t kMaxConnectIocrs = 8;
+inline constexpr std::size_t kMaxConnectExpectedBlocks = 32;
+
+// The device side (simulator): a Connect request datagram with each block decoded. Required: one
+// ARBlockReq, at least one IOCRBlockReq, one AlarmCRBlockReq [IEC 61158-6-10 §5.1.2, CMRPC
+// checks "IOCR Missing", "Wrong AlarmCRBlock count"]; other block types are counted and skipped.
+struct ConnectRequestView {
+  WireError error = WireError::None;
+  RpcHeader header{};
+  std::uint32_t args_maximum = 0;
+  ArBlockReqView ar{};
+  std::array<IocrBlockReqView, kMaxConnectIocrs> iocrs{};
+  std::size_t iocr_count = 0;
+  AlarmCrBlockReqView alarm_cr{};
+  std::array<ExpectedSubmoduleBlockView, kMaxConnectExpectedBlocks> expected{};
+  std::size_t expected_count = 0;
+  std::size_t other_blocks = 0;
+};
+ConnectRequestView decode_connect_request(std::span<const std::uint8_t> datagram) noexcept;
 
 struct ConnectResponseView {
   WireError error = WireError::None;
