@@ -311,7 +311,7 @@ def pn_control(btype, command):
     return pn_block(btype, b"\0\0" + PN_AR_UUID + struct.pack(">HHHH", 1, 0, command, 0))
 
 
-def profinet_seeds():
+def profinet_rpc_seeds():
     h = bytes.fromhex
     name = b"drivegate"
     ar_req = pn_block(0x0101, struct.pack(">H", 1) + PN_AR_UUID + struct.pack(">H", 1) + h("020000000001")
@@ -386,7 +386,7 @@ def profinet_seeds():
 
 
 if __name__ == "__main__":
-    profinet_seeds()
+    profinet_rpc_seeds()
     ethercat_sim_seeds()
     ethercat_frame_seeds()
     ethercat_mailbox_seeds()
