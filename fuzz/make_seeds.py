@@ -27,6 +27,11 @@ profinet_alarm:   RTA frames: a diagnosis alarm (DATA), the RTA ACK, an AlarmAck
 ethercat_sim:     operation scripts (format in fuzz_ethercat_sim.cpp): addressing and identity
                   reads, a bring-up to PRE-OP with an SDO upload through the mailbox, process data
                   to OP with LRW, a DC latch, faults.
+profinet_rpc:     PNIO DCE/RPC datagrams (UDP 34964) in both drep byte orders: Connect request and
+                  responses (OK with a ModuleDiffBlock, refused without blocks), record Write of
+                  index 47 (the AKD digest's PNU 930 request) and Read of I&M0 with responses,
+                  PrmEnd, ApplicationReady, Release, a fault, a ping, a truncated one.
+profinet_blocks:  the block lists (NDR args) of those datagrams, one file each.
 """
 import struct
 import pathlib
@@ -350,8 +355,127 @@ def profinet_seeds():
         write("profinet_alarm", name, data)
 
 
+# ---- PROFINET connection management (IEC 61158-6-10; DCE 1.1 RPC ch. 12) -------------------
+
+PN_AR_UUID = bytes.fromhex("112233445566778899AABBCCDDEEFF00")
+
+
+def pn_uuid(text, little):
+    """A UUID in DCE wire form: the first three fields in the drep byte order."""
+    b = bytes.fromhex(text.replace("-", ""))
+    if not little:
+        return b
+    return b[3::-1] + b[5:3:-1] + b[7:5:-1] + b[8:]
+
+
+def pn_rpc(ptype, opnum, body, little=True, seq=1, iface="DEA00001-6C97-11D1-8271-00A02442DF7D"):
+    e = "<" if little else ">"
+    head = bytes([4, ptype, 0x20 if ptype == 0 else 0x0A, 0, 0x10 if little else 0x00, 0, 0, 0])
+    head += pn_uuid("DEA00000-6C97-11D1-8271-000100021234", little)
+    head += pn_uuid(iface, little)
+    head += pn_uuid("01020304-0506-0708-090A-0B0C0D0E0F10", little)
+    head += struct.pack(e + "IIIHHHHHBB", 0, 1, seq, opnum, 0xFFFF, 0xFFFF, len(body), 0, 0, 0)
+    return head + body
+
+
+def pn_request(opnum, blocks, little=True, seq=1, iface="DEA00001-6C97-11D1-8271-00A02442DF7D"):
+    e = "<" if little else ">"
+    ndr = struct.pack(e + "IIIII", 16696, len(blocks), 16696, 0, len(blocks))
+    return pn_rpc(0, opnum, ndr + blocks, little, seq, iface)
+
+
+def pn_response(opnum, status, blocks, little=True, seq=1):
+    e = "<" if little else ">"
+    # PNIOStatus is an NDR Unsigned32 here: ErrorCode in the top octet, in the drep byte order.
+    ndr = struct.pack(e + "IIIII", int.from_bytes(bytes(status), "big"), len(blocks), 16696, 0, len(blocks))
+    return pn_rpc(2, opnum, ndr + blocks, little, seq)
+
+
+def pn_block(btype, body):
+    return struct.pack(">HHBB", btype, len(body) + 2, 1, 0) + body
+
+
+def pn_control(btype, command):
+    return pn_block(btype, b"\0\0" + PN_AR_UUID + struct.pack(">HHHH", 1, 0, command, 0))
+
+
+def profinet_rpc_seeds():
+    h = bytes.fromhex
+    name = b"drivegate"
+    ar_req = pn_block(0x0101, struct.pack(">H", 1) + PN_AR_UUID + struct.pack(">H", 1) + h("020000000001")
+                      + pn_uuid("DEA00000-6C97-11D1-8271-000100001234", False)
+                      + struct.pack(">IHHH", 0x11, 600, 0x8892, len(name)) + name)
+    iocr_fixed = ">HHHIHHHHHHIHHH6sH"
+    iocr_in = pn_block(0x0102, struct.pack(iocr_fixed, 1, 1, 0x8892, 1, 40, 0xC001, 32, 16, 1, 0, 0xFFFFFFFF, 3, 3,
+                                           0xC000, bytes(6), 2)
+                       + struct.pack(">IH3HH", 0, 1, 0, 1, 0, 0)
+                       + struct.pack(">IH3HH3H", 0x3A00, 1, 1, 1, 1, 1, 1, 1, 6))
+    iocr_out = pn_block(0x0102, struct.pack(iocr_fixed, 2, 2, 0x8892, 1, 40, 0xC002, 32, 16, 1, 0, 0xFFFFFFFF, 3, 3,
+                                            0xC000, bytes(6), 2)
+                        + struct.pack(">IHH3H", 0, 0, 1, 0, 1, 5)
+                        + struct.pack(">IH3HH3H", 0x3A00, 1, 1, 1, 0, 1, 1, 1, 6))
+    alarm_req = pn_block(0x0103, struct.pack(">HHIHHHHHH", 1, 0x8892, 0, 1, 3, 1, 200, 0xC000, 0xA000))
+    exp0 = pn_block(0x0104, struct.pack(">HIHIHH", 1, 0, 0, 1, 0, 1) + struct.pack(">HIH", 1, 1, 0) + h("000100000101"))
+    exp1 = pn_block(0x0104, struct.pack(">HIHIHH", 1, 0x3A00, 1, 0x101, 0, 1) + struct.pack(">HIH", 1, 1, 3)
+                    + h("000100040101") + h("000200040101"))
+    connect = ar_req + iocr_in + iocr_out + alarm_req + exp0 + exp1
+    ar_res = pn_block(0x8101, struct.pack(">H", 1) + PN_AR_UUID + struct.pack(">H", 1) + h("020000000002") + h("8892"))
+    iocr_res = pn_block(0x8102, struct.pack(">HHH", 1, 1, 0xC001)) + pn_block(0x8102, struct.pack(">HHH", 2, 2, 0xC002))
+    alarm_res = pn_block(0x8103, struct.pack(">HHH", 1, 1, 200))
+    # slot 1 wrong module 102h, subslot 1 wrong submodule; slot 2 no module
+    diff = pn_block(0x8104, struct.pack(">HIH", 1, 0x3A00, 2) + struct.pack(">HIHH", 1, 0x102, 1, 1)
+                    + struct.pack(">HIH", 1, 2, 0x9000) + struct.pack(">HIHH", 2, 0, 0, 0))
+    connect_res = ar_res + iocr_res + alarm_res + diff
+    pnu930 = h("05020001100103A20000420100 02".replace(" ", ""))
+    rec = PN_AR_UUID + struct.pack(">IHHHHI", 0x3A00, 1, 1, 0, 47, len(pnu930))
+    write_req = pn_block(0x0008, struct.pack(">H", 1) + rec + bytes(24)) + pnu930
+    write_res = pn_block(0x8008, struct.pack(">H", 1) + rec + struct.pack(">HH", 0, 0) + bytes(4) + bytes(16))
+    read_req = pn_block(0x0009, struct.pack(">H", 2) + PN_AR_UUID + struct.pack(">IHHHHI", 0, 0, 1, 0, 0xAFF0, 4096)
+                        + bytes(24))
+    im0 = pn_block(0x0020, struct.pack(">H", 0x1234) + b"AKD-P00306-NBPN-0000" + b"SN0000001".ljust(16)
+                   + struct.pack(">HcBBBHHHBBH", 3, b"V", 1, 18, 0, 0, 0x3A00, 0, 1, 1, 0x1E))
+    read_res = pn_block(0x8009, struct.pack(">H", 2) + PN_AR_UUID + struct.pack(">IHHHHIHH", 0, 0, 1, 0, 0xAFF0, 60, 0, 0)
+                        + bytes(20)) + im0
+    prm_end = pn_control(0x0110, 1)
+    ready = pn_control(0x0112, 2)
+    release_res = pn_control(0x8114, 8)
+    ok = [0, 0, 0, 0]
+    datagrams = {
+        "connect_request_le": pn_request(0, connect),
+        "connect_request_be": pn_request(0, connect, little=False),
+        "connect_response_diff": pn_response(0, ok, connect_res),
+        "connect_response_be": pn_response(0, ok, ar_res + iocr_res + alarm_res, little=False),
+        "connect_refused": pn_response(0, [0xDB, 0x81, 0x03, 0x07], b""),
+        "write_request_pnu930": pn_request(3, write_req, seq=2),
+        "write_response": pn_response(3, ok, write_res, seq=2),
+        "read_request_im0": pn_request(2, read_req, seq=3),
+        "read_response_im0": pn_response(2, ok, read_res, seq=3),
+        "control_prm_end": pn_request(4, prm_end, seq=4),
+        "application_ready": pn_request(4, ready, little=False, iface="DEA00002-6C97-11D1-8271-00A02442DF7D"),
+        "release_response": pn_response(1, ok, release_res, seq=5),
+        "fault_unknown_interface": pn_rpc(3, 0, struct.pack("<I", 0x1C010003)),
+        "ping": pn_rpc(1, 0, b""),
+        "truncated": pn_request(0, connect)[:150],
+    }
+    for n, d in datagrams.items():
+        write("profinet_rpc", n, d)
+    blocks = {
+        "connect_request": connect,
+        "connect_response": connect_res,
+        "write_request": write_req,
+        "write_response": write_res,
+        "read_request": read_req,
+        "read_response_im0": read_res,
+        "controls": prm_end + ready + release_res,
+        "module_diff": diff,
+    }
+    for n, d in blocks.items():
+        write("profinet_blocks", n, d)
+
+
 if __name__ == "__main__":
     profinet_seeds()
+    profinet_rpc_seeds()
     ethercat_sim_seeds()
     ethercat_frame_seeds()
     ethercat_mailbox_seeds()
