@@ -102,6 +102,7 @@ TEST_F(EthercatE2eFaults, CableBreakAndMend) {
 // drivegated killed with SIGKILL (no safe stop, no SAFE-OP): the process data stops, each drive's
 // SM watchdog runs out, the ESC leaves OP with AL status code 001Bh and the drive faults through
 // its 6007h reaction (1: fault, EMCY 8100h; the ESR's 6007h = 1 is the gateway's start-up write).
+// A gateway started again recovers them.
 TEST_F(EthercatE2eFaults, KilledGatewayFaultsTheDrivesThroughTheirWatchdog) {
   ASSERT_NO_FATAL_FAILURE(enable_both());
   const auto rc = daemon_->terminate(SIGKILL, 5s);
@@ -119,6 +120,18 @@ TEST_F(EthercatE2eFaults, KilledGatewayFaultsTheDrivesThroughTheirWatchdog) {
            s.find("ec0:2 generic-io station=0x1002 state=SAFE-OP+ERR code=0x001B") != std::string::npos &&
            s.find("ec0:3 generic-cia402 station=0x1003 state=SAFE-OP+ERR code=0x001B") != std::string::npos;
   }, 5s, last)) << last;
+
+  // A new gateway takes the line from there (the slaves in SAFE-OP with the error set): the drives
+  // come back operational in their fault, are reset and enable again.
+  ASSERT_NO_FATAL_FAILURE(start_gateway());
+  for (const char* axis : {"esr", "gen"}) {
+    ASSERT_TRUE(wait_link(axis, "operational", "fault", kStartUp)) << axis << diagnostics();
+    EXPECT_EQ(state(axis).fault_code, 0x8100U) << axis;
+    const auto reset = send(axis, "fault_reset");
+    ASSERT_EQ(reset.outcome, client::Outcome::Completed) << axis << ": " << reset.reason << diagnostics();
+    ASSERT_NO_FATAL_FAILURE(enable(axis));
+  }
+  EXPECT_NE(sim("status").find("ec0:2 generic-io station=0x1002 state=OP code=0x0000"), std::string::npos);
 }
 
 }  // namespace
