@@ -57,6 +57,12 @@ TEST_F(EthercatE2eFaults, SlavePowerLossAndReturn) {
   }, 5s, last)) << last;
   EXPECT_EQ(field(sim("drive 3"), "state"), "switch_on_disabled");
   EXPECT_EQ(state("esr").state, "operation_enabled");
+  // The drive is the line's DC reference clock: restarted, its ESC runs SYNC0 again (the drive
+  // reaches OP in SYNC0 mode only with it) and the pulses go on.
+  ASSERT_TRUE(wait_sim("drive 3", [](const std::string& d) {
+    const std::string n = field(d, "sync0");
+    return !n.empty() && n != "off" && std::stoull(n) > 100;
+  }, 5s, last)) << last << diagnostics();
   // It works again: enabled on command.
   ASSERT_NO_FATAL_FAILURE(enable("gen"));
 }
