@@ -17,9 +17,9 @@
 #include <fstream>
 #include <sstream>
 #include <string>
-#include <thread>
 
 #include "tests/support/netns.hpp"
+#include "tests/support/pipe_lines.hpp"
 
 extern char** environ;
 
@@ -72,6 +72,7 @@ TEST(EthercatScanProcess, ScansTheSimulatedLineAndWritesAConfigThatChecks) {
   std::ofstream(config) << line_config(veth.a());
   pid_t sim = -1;
   std::array<int, 2> console{-1, -1};
+  std::array<int, 2> out{-1, -1};
   {
     const NetnsScope in(ns_b);
     std::string exe = DRIVEGATE_SIM_EXE;
@@ -79,16 +80,23 @@ TEST(EthercatScanProcess, ScansTheSimulatedLineAndWritesAConfigThatChecks) {
     std::string flag = "--interface";
     std::string iface = veth.b();
     std::array<char*, 5> argv{exe.data(), cfg.data(), flag.data(), iface.data(), nullptr};
-    // stdin from /dev/null would end the console; keep it a pipe the test holds open.
+    // stdin from /dev/null would end the console; keep it a pipe the test holds open. stdout is
+    // read for the ready line.
     ASSERT_EQ(::pipe2(console.data(), O_CLOEXEC), 0);
+    ASSERT_EQ(::pipe2(out.data(), O_CLOEXEC), 0);
     posix_spawn_file_actions_t actions;
     posix_spawn_file_actions_init(&actions);
     posix_spawn_file_actions_adddup2(&actions, console[0], STDIN_FILENO);
+    posix_spawn_file_actions_adddup2(&actions, out[1], STDOUT_FILENO);
     ASSERT_EQ(posix_spawn(&sim, argv[0], &actions, nullptr, argv.data(), environ), 0);
     posix_spawn_file_actions_destroy(&actions);
     ::close(console[0]);
-    std::this_thread::sleep_for(500ms);  // the simulator opens its end
+    ::close(out[1]);
   }
+  // The simulator answers frames once it printed its ready line (its end is open then).
+  drivegate::test::PipeLines lines;
+  const auto ready = lines.next(out[0], 20s);
+  EXPECT_EQ(ready.value_or("(none)"), "drivegate-sim: 3 slaves on ethercat " + veth.b() + " (bus ec0)");
   std::pair<int, std::string> scan;
   {
     const NetnsScope in(ns_a);
@@ -98,6 +106,7 @@ TEST(EthercatScanProcess, ScansTheSimulatedLineAndWritesAConfigThatChecks) {
   ::kill(sim, SIGTERM);
   ::waitpid(sim, nullptr, 0);
   ::close(console[1]);
+  ::close(out[0]);
   EXPECT_EQ(scan.first, 0) << scan.second;
   EXPECT_NE(scan.second.find(": 3 devices"), std::string::npos) << scan.second;
   EXPECT_NE(scan.second.find("esr-triodrive"), std::string::npos) << scan.second;

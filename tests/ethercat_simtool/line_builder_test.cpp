@@ -218,3 +218,41 @@ TEST_F(EthercatLineConsole, BadCommandsAreAnsweredWithTheReason) {
 
 }  // namespace
 }  // namespace drivegate::ethercat::sim
+
+namespace drivegate::ethercat::sim {
+namespace {
+
+// `io K [BYTE...]`: the bytes the master wrote reach the slave's outputs, the inputs are set from
+// the console (the slave does not loop them back); `drive K` names what is not a drive.
+TEST_F(EthercatLineConsole, IoShowsAndSetsAGenericSlavesBytes) {
+  EXPECT_EQ(console_.command("io 1"), "io ec0:1 out=0000 in=0000");
+  EXPECT_EQ(console_.command("io 1 0x12 52"), "ok io ec0:1 out=0000 in=1234");
+  EXPECT_EQ(console_.command("io 3 0xAB"), "ok io ec0:3 out= in=ab000000");
+  EXPECT_EQ(console_.command("io 1"), "io ec0:1 out=0000 in=1234");
+  EXPECT_EQ(console_.command("io 2 1 2"), "error: io: ec0:2 has 1 input bytes");
+  EXPECT_EQ(console_.command("io 2 0x100"), "error: io: \"0x100\" is not a byte (0..255 or 0x00..0xFF)");
+  EXPECT_EQ(console_.command("io"), "error: io takes K [BYTE...]");
+  EXPECT_EQ(console_.command("drive 1"), "error: ec0:1 (generic-io) is not a CiA 402 drive");
+  EXPECT_EQ(console_.command("drive 1 2"), "error: drive takes K");
+}
+
+TEST(EthercatLineConsoleDrive, DriveShowsTheModel) {
+  const config::Plan plan = plan_of(R"(gateway: { name: simtool-test }
+buses:
+  - { name: ec0, type: ethercat, cycle_time: 1ms, options: { interface: eth1 } }
+axes:
+  - { name: x, bus: ec0, address: 1, device: generic-cia402, mechanics: { encoder_counts_per_rev: 4096 } }
+)");
+  const auto line = build_line(plan.buses.at(0));
+  LineConsole console;
+  console.add(*line);
+  const std::string d = console.command("drive 1");
+  EXPECT_EQ(d.rfind("drive ec0:1 generic-cia402 state=", 0), 0U) << d;
+  EXPECT_NE(d.find(" pos=0 error=0x0000 sync0=off"), std::string::npos) << d;
+  EXPECT_EQ(console.command("io 1"), "error: ec0:1 (generic-cia402) is not a generic I/O slave");
+  EXPECT_EQ(console.command("power-off 1"), "ok power-off ec0:1");
+  EXPECT_EQ(console.command("drive 1"), "drive ec0:1 generic-cia402 off");
+}
+
+}  // namespace
+}  // namespace drivegate::ethercat::sim

@@ -1,13 +1,19 @@
 #include "adapters/ethercat/sim/line_console.hpp"
 
+#include <algorithm>
 #include <array>
 #include <charconv>
+#include <cmath>
 #include <cstdio>
 #include <optional>
+#include <span>
 #include <sstream>
 
+#include "adapters/ethercat/sim/cia402_slave.hpp"
+#include "adapters/ethercat/sim/generic_io.hpp"
 #include "adapters/ethercat/wire/al_status.hpp"
 #include "adapters/ethercat/wire/registers.hpp"
+#include "core/axis_types.hpp"
 #include "core/bytes.hpp"
 
 namespace drivegate::ethercat::sim {
@@ -46,11 +52,54 @@ std::optional<AlState> parse_state(std::string_view s) {
 
 std::string name_of(const BuiltLine& line, std::size_t index) { return line.bus() + ":" + std::to_string(index + 1); }
 
+std::string hex_bytes(std::span<const std::uint8_t> bytes) {
+  std::string s;
+  for (const std::uint8_t b : bytes) {
+    std::array<char, 4> t{};
+    std::snprintf(t.data(), t.size(), "%02x", b);
+    s += t.data();
+  }
+  return s;
+}
+
+// `drive K`: what the drive model does, which the master sees only through the process data.
+std::string drive_detail(const SimSlave& slave, const std::string& id) {
+  const auto* drive = dynamic_cast<const Cia402Slave*>(slave.parts.app.get());
+  if (drive == nullptr) return "error: " + id + " (" + slave.persona + ") is not a CiA 402 drive";
+  if (!slave.powered) return "drive " + id + " " + slave.persona + " off";
+  const auto& m = drive->drive();
+  std::string s = "drive " + id + " " + slave.persona;
+  s += " state=" + std::string(core::to_string(m.state()));
+  s += " sw=" + hex4(m.statusword());
+  s += " mode=" + std::to_string(m.active_mode());
+  s += " pos=" + std::to_string(static_cast<long long>(std::llround(m.position())));
+  s += " error=" + hex4(static_cast<unsigned>(m.read_object({0x603F, 0}).value));
+  s += " sync0=" + (slave.esc->sync0_running() ? std::to_string(slave.esc->sync0_pulses()) : std::string("off"));
+  return s;
+}
+
+// `io K [BYTE...]`: a generic I/O slave's outputs as the master wrote them, and its inputs.
+std::string io_detail(SimSlave& slave, const std::string& id, const std::vector<std::string>& bytes) {
+  auto* io = dynamic_cast<GenericIoSlave*>(slave.parts.app.get());
+  if (io == nullptr) return "error: " + id + " (" + slave.persona + ") is not a generic I/O slave";
+  if (bytes.size() > io->inputs().size())
+    return "error: io: " + id + " has " + std::to_string(io->inputs().size()) + " input bytes";
+  std::vector<std::uint8_t> values;
+  for (const auto& b : bytes) {
+    const auto v = parse_number(b);
+    if (!v || *v > 0xFF) return "error: io: \"" + b + "\" is not a byte (0..255 or 0x00..0xFF)";
+    values.push_back(static_cast<std::uint8_t>(*v));
+  }
+  std::copy(values.begin(), values.end(), io->inputs().begin());
+  return std::string(values.empty() ? "" : "ok ") + "io " + id + " out=" + hex_bytes(io->outputs()) +
+         " in=" + hex_bytes(io->inputs());
+}
+
 }  // namespace
 
 bool LineConsole::handles(std::string_view verb) noexcept {
   for (const std::string_view v :
-       {"power-off", "power-on", "break-after", "mend", "drop", "corrupt", "stick", "unstick", "status"}) {
+       {"power-off", "power-on", "break-after", "mend", "drop", "corrupt", "stick", "unstick", "status", "drive", "io"}) {
     if (verb == v) return true;
   }
   return false;
@@ -148,6 +197,14 @@ std::string LineConsole::command(std::string_view text) {
       line->corrupt(*n);
     }
     return "ok " + verb + " " + line->bus() + " " + std::to_string(*n);
+  }
+  if (verb == "drive" || verb == "io") {
+    if (args.empty() || (verb == "drive" && args.size() != 1)) return "error: " + verb + " takes K" + (verb == "io" ? " [BYTE...]" : "");
+    Slot s;
+    if (!find(args[0], s, error)) return "error: " + error;
+    SimSlave& slave = s.line->slave(s.index);
+    const std::string id = name_of(*s.line, s.index);
+    return verb == "drive" ? drive_detail(slave, id) : io_detail(slave, id, {args.begin() + 1, args.end()});
   }
   // The commands on one slave.
   const std::size_t want = verb == "stick" ? 3 : 1;

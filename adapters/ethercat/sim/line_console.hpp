@@ -13,6 +13,11 @@
 //                      status code CODE; above it now, it drops there with the error set
 //   unstick K          lifts that
 //   status             per slave: BUS:K persona station=0x.... state=... code=0x.... frames=N
+//   drive K            a CiA 402 drive's model: BUS:K persona state=operation_enabled sw=0x0237
+//                      mode=7 pos=1234 error=0x0000 sync0=N (SYNC0 pulses so far, "off" when not running)
+//   io K [BYTE...]     a generic I/O slave's bytes: BUS:K out=00c3 in=0000 (the outputs the master
+//                      wrote, the inputs it reads); with bytes (decimal or 0x hex), sets the inputs
+//                      from the first on (the slave does not loop its outputs back)
 //
 // K is a position (1 = next to the master), or BUS:K when several lines have one; BUS may be left
 // out while there is one line. Numbers are decimal or 0x hex.
@@ -29,7 +34,7 @@ class LineConsole {
  public:
   static constexpr std::string_view kCommands =
       "power-off K, power-on K, break-after K, mend [BUS], drop N [BUS], corrupt N [BUS], stick K STATE CODE, "
-      "unstick K, status (K: a position 1.. or BUS:K)";
+      "unstick K, status, drive K, io K [BYTE...] (K: a position 1.. or BUS:K)";
 
   // The line must outlive the console; commands run on the thread that services it.
   void add(BuiltLine& line) { lines_.push_back(&line); }

@@ -116,7 +116,7 @@ constexpr std::string_view kCommands =
     "status";
 constexpr std::string_view kEthercatCommands =
     "power-off K, power-on K, break-after K, mend [BUS], drop N [BUS], corrupt N [BUS], stick K STATE CODE, unstick K, "
-    "status";
+    "drive K, io K [BYTE...], status";
 
 std::string usage_of(const std::string& verb) {
   if (verb == "fault") return "NODE CODE [CAUSE]";
