@@ -36,7 +36,11 @@ bool is_mode_object(cia402::ObjectId id) {
 // (ESR/Dunker: INTEGER16, dunker-ethercat-coe.md quirk 1).
 void check_entry_type(const YAML::Node& n, const std::string& path, const Source& src, PdoEntrySpec e,
                       const DeviceProfile& p, const EthercatDeviceSpec& spec) {
-  e.object = axis_object(spec, e.object).local;  // axis n's 6860h is a 6060h
+  // Axis n's 6860h is a 6060h: its type is checked as that, the message names the entry.
+  const AxisObject o = axis_object(spec, e.object);
+  const std::string axis_hint =
+      o.axis > 0 ? " (" + object_hex(e.object) + " is axis " + std::to_string(o.axis) + "'s " + object_hex(o.local) + ")" : "";
+  e.object = o.local;
   if (is_mode_object(e.object) && p.quirk("mode_objects_16bit")) {
     if (e.type != cia402::DataType::I16)
       src.error(n.Mark(), path, object_hex(e.object) + " is INTEGER16 on this device (quirk mode_objects_16bit), got " +
@@ -44,7 +48,7 @@ void check_entry_type(const YAML::Node& n, const std::string& path, const Source
     return;
   }
   check_known_type(n, path, src, e.object, e.type,
-                   is_mode_object(e.object) ? " (a device with 16-bit mode objects needs quirk mode_objects_16bit)" : "");
+                   axis_hint + (is_mode_object(e.object) ? " (a device with 16-bit mode objects needs quirk mode_objects_16bit)" : ""));
 }
 
 std::vector<std::uint16_t> read_indexes(const MapReader& m, const std::string& key, std::uint16_t lo, std::uint16_t hi) {
