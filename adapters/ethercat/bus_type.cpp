@@ -86,8 +86,14 @@ void describe_axis(const config::BusPlan& bus, const config::AxisPlan& axis, con
   const SlaveImage& s = image->slave(k);
   char station[8];
   std::snprintf(station, sizeof station, "0x%04X", s.station);
+  // Axis n of a multi-axis slave: its profile objects at + n x axis_offset [ETG.6010 §4].
+  const int n = axis.section<config::EthercatAxisSpec>().slave_axis;
+  char offset[32] = "";
+  if (n > 0)
+    std::snprintf(offset, sizeof offset, " (objects + %Xh)",
+                  static_cast<unsigned>(n) * axis.device.section<config::EthercatDeviceSpec>().axis_offset);
   rows.emplace_back("slave", "position " + std::to_string(axis.address) + ", station " + station + ", axis " +
-                                 std::to_string(axis.section<config::EthercatAxisSpec>().slave_axis) + ", outputs at " +
+                                 std::to_string(n) + offset + ", outputs at " +
                                  std::to_string(s.output_offset) + " (" + std::to_string(s.output_bytes) +
                                  " bytes), inputs at " + std::to_string(s.input_offset) + " (" +
                                  std::to_string(s.input_bytes) + " bytes)");

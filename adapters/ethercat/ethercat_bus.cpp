@@ -33,6 +33,11 @@ constexpr core::Duration kCloseBudget = 500ms;
 // CiA 402 device profile number in 1000h's low word [CiA 402-2 §6.2; digest "generic profile"].
 constexpr std::uint32_t kCia402Profile = 0x0192;
 
+bool claims_emergency(const SlaveAccess& io, std::uint16_t code) noexcept {
+  const cia402::ObjectId error_code = cia402::obj::kErrorCode.id;
+  return io.mapped(error_code) && static_cast<std::uint16_t>(io.read(error_code)) == code;
+}
+
 std::string drive_name(const config::AxisPlan& a) {
   const auto& dev = a.device.section<config::EthercatDeviceSpec>();
   if (!dev.identities.empty() && !dev.identities.front().name.empty()) return dev.identities.front().name;
@@ -320,7 +325,14 @@ bool EthercatBus::next_event(core::Event& out) noexcept {
 void EthercatBus::on_emergency(std::uint16_t station, const CoeEmergency& e) noexcept {
   if (station < kFirstStation || static_cast<std::size_t>(station - kFirstStation) >= slaves_.size()) return;
   Slave& s = *slaves_[station - kFirstStation];
+  // A CoE emergency names no axis [ETG.1000.6 §5.6.4: error code, register, 5 bytes]. On a
+  // multi-axis slave it goes to the axes whose error code (603Fh + n x axis_offset, in the inputs
+  // the same cycle the drive raised it) says it; to every axis when none does (603Fh not mapped).
+  bool claimed = false;
+  if (s.axes.size() > 1)
+    for (std::size_t a : s.axes) claimed = claimed || claims_emergency(*axes_[a].io, e.error_code);
   for (std::size_t a : s.axes) {
+    if (claimed && !claims_emergency(*axes_[a].io, e.error_code)) continue;
     axes_[a].io->on_emergency(e);
     core::Event ev;
     ev.axis = static_cast<core::AxisIndex>(a);

@@ -21,7 +21,7 @@ void read_ethercat_axis(const MapReader& axis, const BusPlan& bus, const DeviceP
   if (const auto n = c.integer("axis", Need::Optional, 0, 7, "an axis index of the slave (0 = its first)")) {
     if (*n >= axes)
       c.error("axis", "device \"" + (device ? device->name : std::string{}) + "\" carries " + std::to_string(axes) +
-                          " axis" + (axes == 1 ? "" : "es") + " per slave (0.." + std::to_string(axes - 1) + "), got " +
+                          (axes == 1 ? " axis" : " axes") + " per slave (0.." + std::to_string(axes - 1) + "), got " +
                           std::to_string(*n));
     else
       ax.slave_axis = static_cast<int>(*n);

@@ -13,14 +13,34 @@ namespace {
 
 std::string hex16(std::uint16_t v) { return object_hex({v, 0}); }
 
+// Where a mapped object sits on a multi-axis slave [ETG.6010 §4: axis n's profile objects
+// 6000h..67FFh at + n x axis_offset]: the axis and the object as axis 0 numbers it. Objects
+// outside the axes' areas belong to the slave (axis -1).
+struct AxisObject {
+  int axis = -1;
+  cia402::ObjectId local;
+};
+AxisObject axis_object(const EthercatDeviceSpec& spec, cia402::ObjectId id) {
+  constexpr int kProfileArea = 0x6000;
+  if (id.index < kProfileArea) return {-1, id};
+  const int n = (id.index - kProfileArea) / spec.axis_offset;
+  if (n >= spec.axes || (spec.axes == 1 && id.index >= kProfileArea + 0x800)) return {-1, id};
+  return {n, cia402::ObjectId{static_cast<std::uint16_t>(id.index - n * spec.axis_offset), id.sub}};
+}
+
 bool is_mode_object(cia402::ObjectId id) {
   return id == cia402::obj::kModesOfOperation.id || id == cia402::obj::kModesOfOperationDisplay.id;
 }
 
 // The entry's size against CiA 402, except 6060h/6061h on a device with quirk mode_objects_16bit
 // (ESR/Dunker: INTEGER16, dunker-ethercat-coe.md quirk 1).
-void check_entry_type(const YAML::Node& n, const std::string& path, const Source& src, const PdoEntrySpec& e,
-                      const DeviceProfile& p) {
+void check_entry_type(const YAML::Node& n, const std::string& path, const Source& src, PdoEntrySpec e,
+                      const DeviceProfile& p, const EthercatDeviceSpec& spec) {
+  // Axis n's 6860h is a 6060h: its type is checked as that, the message names the entry.
+  const AxisObject o = axis_object(spec, e.object);
+  const std::string axis_hint =
+      o.axis > 0 ? " (" + object_hex(e.object) + " is axis " + std::to_string(o.axis) + "'s " + object_hex(o.local) + ")" : "";
+  e.object = o.local;
   if (is_mode_object(e.object) && p.quirk("mode_objects_16bit")) {
     if (e.type != cia402::DataType::I16)
       src.error(n.Mark(), path, object_hex(e.object) + " is INTEGER16 on this device (quirk mode_objects_16bit), got " +
@@ -28,7 +48,7 @@ void check_entry_type(const YAML::Node& n, const std::string& path, const Source
     return;
   }
   check_known_type(n, path, src, e.object, e.type,
-                   is_mode_object(e.object) ? " (a device with 16-bit mode objects needs quirk mode_objects_16bit)" : "");
+                   axis_hint + (is_mode_object(e.object) ? " (a device with 16-bit mode objects needs quirk mode_objects_16bit)" : ""));
 }
 
 std::vector<std::uint16_t> read_indexes(const MapReader& m, const std::string& key, std::uint16_t lo, std::uint16_t hi) {
@@ -121,7 +141,7 @@ void read_pdos(const MapReader& e, bool receive, const DeviceProfile& p, Etherca
         const std::string path = indexed(m.field("map"), k);
         const auto entry = read_pdo_entry((*entries)[k], path, src);
         if (!entry) continue;
-        check_entry_type((*entries)[k], path, src, *entry, p);
+        check_entry_type((*entries)[k], path, src, *entry, p, spec);
         if (!mappable.empty() && std::find(mappable.begin(), mappable.end(), entry->object) == mappable.end()) {
           src.error((*entries)[k].Mark(), path,
                     object_hex(entry->object) + " may not be mapped into " + (receive ? "an RxPDO" : "a TxPDO") +
@@ -142,6 +162,29 @@ void check_startup_writes(const MapReader& e, const EthercatDeviceSpec& spec) {
     if ((id.index >= 0x1600 && id.index <= 0x17FF) || (id.index >= 0x1A00 && id.index <= 0x1BFF) ||
         (id.index >= 0x1C00 && id.index <= 0x1C3F))
       e.error("startup_writes", object_hex(id) + " is a PDO mapping or assignment object; the PDOs come from rxpdos/txpdos");
+  }
+}
+
+// A multi-axis slave: every axis maps what axis 0 maps, at its own offset (each axis' master sees
+// the same cyclic image), its controlword and statusword among them.
+void check_axes(const MapReader& e, const EthercatDeviceSpec& spec) {
+  if (spec.axes < 2) return;
+  if (0x6000 + spec.axes * spec.axis_offset > 0x10000) {
+    e.error("axes", std::to_string(spec.axes) + " axes at " + hex16(spec.axis_offset) + " apart do not fit below FFFFh");
+    return;
+  }
+  std::vector<std::vector<cia402::ObjectId>> per_axis(static_cast<std::size_t>(spec.axes));
+  for (const auto* pdos : {&spec.rxpdos, &spec.txpdos})
+    for (const auto& pdo : *pdos)
+      for (const auto& entry : pdo.entries)
+        if (const AxisObject o = axis_object(spec, entry.object); o.axis >= 0)
+          per_axis[static_cast<std::size_t>(o.axis)].push_back(o.local);
+  for (int n = 1; n < spec.axes; ++n) {
+    const auto d = cyclic_image_difference(per_axis[static_cast<std::size_t>(n)], per_axis[0], "mapped for axis 0");
+    if (!d.empty())
+      e.error("rxpdos", "axis " + std::to_string(n) + " of the slave (its objects at + " +
+                            hex16(static_cast<std::uint16_t>(n * spec.axis_offset)) +
+                            ") must map what axis 0 maps, as axis 0 numbers them:" + d);
   }
 }
 
@@ -174,17 +217,23 @@ void read_ethercat_device(const MapReader& root, DeviceProfile& p) {
   read_pdos(e, false, p, spec, tx);
   check_one_way(e.source(), rx, tx);
   check_control_and_status(e, rx, "rxpdos", tx, "txpdos");
+  check_axes(e, spec);
   read_startup_writes(e, "startup_writes", std::nullopt, spec.startup_writes);
   check_startup_writes(e, spec);
   spec.ignored_writes = read_objects(e, "ignored_writes");
 }
 
 std::vector<cia402::ObjectId> ethercat_mapped_objects(const DeviceProfile& p) {
+  // The cyclic image of one axis: on a multi-axis slave the other axes' objects as axis 0 numbers
+  // them (check_axes makes them the same), once.
   std::vector<cia402::ObjectId> mapped;
   const auto& spec = p.section<EthercatDeviceSpec>();
   for (const auto* pdos : {&spec.rxpdos, &spec.txpdos})
     for (const auto& pdo : *pdos)
-      for (const auto& e : pdo.entries) mapped.push_back(e.object);
+      for (const auto& e : pdo.entries) {
+        const cia402::ObjectId id = spec.axes > 1 ? axis_object(spec, e.object).local : e.object;
+        if (spec.axes == 1 || std::find(mapped.begin(), mapped.end(), id) == mapped.end()) mapped.push_back(id);
+      }
   return mapped;
 }
 

@@ -63,12 +63,11 @@ std::set<std::uint32_t> products(const EsiFile& esi) {
   return out;
 }
 
-// Where the axis' objects are: ETG.6010 offsets the profile area (6000h..67FFh) by axis_offset per axis.
-cia402::ObjectId on_axis(cia402::ObjectId id, const EthercatDeviceSpec& spec, int slave_axis) {
-  if (slave_axis > 0 && id.index >= 0x6000 && id.index < 0x6800)
-    id.index = static_cast<std::uint16_t>(id.index + slave_axis * spec.axis_offset);
-  return id;
-}
+// Where the axis' objects are: a profile lists its PDO entries and start-up writes as the slave
+// numbers them, every axis' at its own offset (ETG.6010; profiles/devices/README.md), and the bus
+// maps and writes them so for the whole slave: the ESI is checked against them as they are, for
+// any axis. (Offsetting them again by the axis took axis 1's 6840h for 7040h, its 6040h for 6840h.)
+cia402::ObjectId on_axis(cia402::ObjectId id, const EthercatDeviceSpec& /*spec*/, int /*slave_axis*/) { return id; }
 
 const EsiPdoEntry* find_pdo_entry(const EsiDevice& dev, cia402::ObjectId id, bool rx) {
   for (const auto& pdo : rx ? dev.rxpdos : dev.txpdos)

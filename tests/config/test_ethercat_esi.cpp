@@ -214,16 +214,20 @@ ethercat:
   axes: 2
   rxpdos:
     - { index: 0x1600, map: ["0x6040 u16", "0x607A i32"] }
+    - { index: 0x1601, map: ["0x6840 u16", "0x687A i32"] }
   txpdos:
     - { index: 0x1A00, map: ["0x6041 u16", "0x6064 i32"] }
+    - { index: 0x1A01, map: ["0x6841 u16", "0x6864 i32"] }
 )");
   LoadOptions o = options();
   o.device_dirs.push_back(dir_);
   const std::string two = "  - { name: a, bus: ec0, address: 1, device: two-axis, mechanics: { encoder_counts_per_rev: 4096 }, "
                           "ethercat: { axis: 1, esi: \"" + esi_path("generic-cia402-dc.xml") + "\" } }\n";
   const std::string e = test::errors_of(config(two), o);
-  EXPECT_REPORTED(e, "axes[0].ethercat.esi: device \"two-axis\" maps 6840h in 1600h, which ESI \"generic-cia402-dc.xml\" does not list");
-  EXPECT_REPORTED(e, "axes[0].ethercat.esi: device \"two-axis\" maps 6864h in 1A00h, which ESI \"generic-cia402-dc.xml\" does not list");
+  // The profile's entries as the slave numbers them: axis 1's in 1601h/1A01h, axis 0's not offset.
+  EXPECT_REPORTED(e, "axes[0].ethercat.esi: device \"two-axis\" maps 6840h in 1601h, which ESI \"generic-cia402-dc.xml\" does not list");
+  EXPECT_REPORTED(e, "axes[0].ethercat.esi: device \"two-axis\" maps 6864h in 1A01h, which ESI \"generic-cia402-dc.xml\" does not list");
+  EXPECT_EQ(e.find("maps 6840h in 1600h"), std::string::npos) << e;
 }
 
 TEST_F(EthercatEsi, IoSlavesAreCheckedAgainstTheirEsi) {

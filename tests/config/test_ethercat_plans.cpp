@@ -131,6 +131,38 @@ axes:
   EXPECT_REPORTED(e, "I/O slave \"panel\" is at position 2, where axis \"c\" is");
 }
 
+// Two axes on one two-axis slave, told apart by `ethercat.axis`; an index beyond the profile's
+// axes, and a slave axis claimed twice, are refused.
+TEST(EthercatPlans, TwoAxesOfATwoAxisSlave) {
+  const Plan p = load_plan_from_string(R"(gateway: { name: cell }
+buses: [{ name: ec0, type: ethercat, cycle_time: 1ms, options: { transport: sim } }]
+axes:
+  - { name: l, bus: ec0, address: 1, device: generic-cia402-2axis, mechanics: { encoder_counts_per_rev: 4096 } }
+  - { name: r, bus: ec0, address: 1, device: generic-cia402-2axis, mechanics: { encoder_counts_per_rev: 4096 }, ethercat: { axis: 1 } }
+)",
+                                       "t.yaml", options());
+  ASSERT_EQ(p.buses[0].axes.size(), 2U);
+  EXPECT_EQ(p.buses[0].axes[0].section<EthercatAxisSpec>().slave_axis, 0);
+  EXPECT_EQ(p.buses[0].axes[1].section<EthercatAxisSpec>().slave_axis, 1);
+  EXPECT_EQ(ethercat_address_key(p.buses[0].axes[1]), "1 axis 1");
+
+  const std::string e = errors_of(R"(gateway: { name: cell }
+buses: [{ name: ec0, type: ethercat, cycle_time: 1ms, options: { transport: sim } }]
+axes:
+  - { name: a, bus: ec0, address: 1, device: generic-cia402-2axis, mechanics: { encoder_counts_per_rev: 4096 }, ethercat: { axis: 1 } }
+  - { name: b, bus: ec0, address: 1, device: generic-cia402-2axis, mechanics: { encoder_counts_per_rev: 4096 }, ethercat: { axis: 1 } }
+  - { name: c, bus: ec0, address: 2, device: generic-cia402-2axis, mechanics: { encoder_counts_per_rev: 4096 }, ethercat: { axis: 2 } }
+  - { name: d, bus: ec0, address: 3, device: generic-cia402-2axis, mechanics: { encoder_counts_per_rev: 4096 } }
+  - { name: e, bus: ec0, address: 3, device: generic-cia402, mechanics: { encoder_counts_per_rev: 4096 }, ethercat: { axis: 1 } }
+)",
+                                  options());
+  EXPECT_REPORTED(e, "axes[1].address: axis \"b\": position 1 axis 1 on bus \"ec0\" is already used by axes[0].address "
+                     "(axis \"a\")");
+  EXPECT_REPORTED(e, "axes[2].ethercat.axis: device \"generic-cia402-2axis\" carries 2 axes per slave (0..1), got 2");
+  EXPECT_REPORTED(e, "axes[4].ethercat.axis: device \"generic-cia402\" carries 1 axis per slave (0..0), got 1");
+  EXPECT_REPORTED(e, "axes \"d\" and \"e\" share the slave at position 3 but name different devices");
+}
+
 TEST(EthercatPlans, AnAxisNeedsADeviceWithAnEthercatSection) {
   const std::string e = errors_of(R"(gateway: { name: cell }
 buses: [{ name: ec0, type: ethercat, cycle_time: 1ms, options: { transport: sim } }]

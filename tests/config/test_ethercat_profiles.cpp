@@ -162,5 +162,51 @@ ethercat:
   EXPECT_EQ(same, "(parsed)");
 }
 
+// A two-axis slave [ETG.6010 §4]: the PDO entries as the slave numbers them (axis 1 at + 800h);
+// each axis' cyclic image is axis 0's objects.
+TEST(EthercatProfiles, TwoAxisDriveMapsBothAxesAndEachSeesOneImage) {
+  const DeviceProfile p = load_device_profile(fs::path{DRIVEGATE_DEVICE_DIR_SOURCE} / "generic-cia402-2axis.yaml");
+  ASSERT_TRUE(p.has_section<EthercatDeviceSpec>());
+  const auto& e = p.section<EthercatDeviceSpec>();
+  EXPECT_EQ(e.axes, 2);
+  EXPECT_EQ(e.axis_offset, 0x800);
+  EXPECT_EQ(e.persona, "generic-cia402-2axis");
+  ASSERT_EQ(e.identities.size(), 1U);
+  EXPECT_EQ(e.identities[0].product_code, 0x00020192U);
+  ASSERT_EQ(e.rxpdos.size(), 2U);
+  ASSERT_EQ(e.txpdos.size(), 2U);
+  EXPECT_EQ(e.rxpdos[1].index, 0x1601);
+  EXPECT_EQ(e.rxpdos[1].entries[0].object, (cia402::ObjectId{0x6840, 0}));
+  EXPECT_EQ(e.txpdos[1].entries[0].object, (cia402::ObjectId{0x6841, 0}));
+  EXPECT_EQ(e.rxpdos[1].bits(), e.rxpdos[0].bits());
+  // One axis' image: the generic drive's twelve objects, as axis 0 numbers them.
+  const DeviceProfile g = load_device_profile(fs::path{DRIVEGATE_DEVICE_DIR_SOURCE} / "generic-cia402.yaml");
+  EXPECT_EQ(p.cyclic_objects, g.cyclic_objects);
+}
+
+TEST_F(EthercatProfileErrors, EveryAxisOfAMultiAxisSlaveMapsWhatAxisZeroMaps) {
+  const std::string e = errors_of_profile(R"(cyclic_objects: ["0x6040", "0x607A", "0x6041", "0x6064"]
+ethercat:
+  axes: 2
+  rxpdos:
+    - { index: 0x1600, map: ["0x6040 u16", "0x607A i32"] }
+    - { index: 0x1601, map: ["0x6840 u16", "0x6860 i16"] }
+  txpdos:
+    - { index: 0x1A00, map: ["0x6041 u16", "0x6064 i32"] }
+    - { index: 0x1A01, map: ["0x6864 i32"] }
+)");
+  // 6860h is axis 1's 6060h: INTEGER8 in CiA 402.
+  EXPECT_REPORTED(e, "ethercat.rxpdos[1].map[1]: 0x6060 is i8 in CiA 402, got i16 (0x6860 is axis 1's 0x6060)");
+  EXPECT_REPORTED(e, "ethercat.rxpdos: axis 1 of the slave (its objects at + 0x0800) must map what axis 0 maps, as axis "
+                     "0 numbers them: not mapped: 0x607A 0x6041; mapped but not mapped for axis 0: 0x6060");
+  const std::string ok = errors_of_profile(R"(ethercat:
+  axes: 2
+  axis_offset: 0x100
+  rxpdos: [{ index: 0x1600, map: ["0x6040 u16", "0x607A i32", "0x6140 u16", "0x617A i32"] }]
+  txpdos: [{ index: 0x1A00, map: ["0x6041 u16", "0x6064 i32", "0x6141 u16", "0x6164 i32"] }]
+)");
+  EXPECT_EQ(ok, "(parsed)");
+}
+
 }  // namespace
 }  // namespace drivegate::config::test

@@ -117,7 +117,7 @@ axes:
   - { name: x, bus: sim0, address: 1, device: sim-servoo }
 )");
   EXPECT_REPORTED(e, "t.yaml:5:47: axes[0].device: unknown device profile \"sim-servoo\", did you mean \"sim-servo\"?");
-  EXPECT_REPORTED(e, "available: esr-triodrive, generic-cia402, kollmorgen-akd, nord-sk500p, pp-only, sim-servo, stoeber-sd6;");
+  EXPECT_REPORTED(e, "available: esr-triodrive, generic-cia402, generic-cia402-2axis, kollmorgen-akd, nord-sk500p, pp-only, sim-servo, stoeber-sd6;");
 }
 
 TEST(LoadErrors, NoDeviceProfileInTheSearchPath) {

@@ -563,7 +563,7 @@ TEST(EthercatCia402Slave, LineBootFindsBothPersonasAndReadsIdentity) {
   MemoryLink link(16);
   link.open();
   SimLine line(link);
-  Cia402Device esr = make_cia402_device("esr-triodrive", Cia402SlaveOptions{.serial = 42, .station_alias = 0, .drive = {}});
+  Cia402Device esr = make_cia402_device("esr-triodrive", Cia402SlaveOptions{.serial = 42, .station_alias = 0, .drive = {}, .more_drives = {}});
   Cia402Device gen = make_cia402_device("generic-cia402");
   line.add(*esr.esc);
   line.add(*gen.esc);

@@ -3,6 +3,7 @@
 // follow ETG.1000.4 §5.4 (a BRD is counted once by every slave it reaches).
 #include <gtest/gtest.h>
 
+#include "adapters/ethercat/sim/cia402_slave.hpp"
 #include "adapters/ethercat/sim/generic_io.hpp"
 #include "adapters/ethercat/sim/line_builder.hpp"
 #include "adapters/ethercat/sim/line_console.hpp"
@@ -107,6 +108,39 @@ TEST(EthercatLineBuilder, APersonaFactoryGetsItsPositionAndRunsAtPowerOn) {
   line->power_on(0);
   line->power_on(0);  // already on: nothing
   EXPECT_EQ(power_ons, 1);
+}
+
+// Both axes of a two-axis drive on one simulated slave (generic-cia402-2axis), each model with its
+// own config axis' mechanics, whatever order the config lists them in.
+TEST(EthercatLineBuilder, TheAxesOfATwoAxisDriveShareOneSlave) {
+  const config::Plan plan = plan_of(R"(gateway: { name: t }
+buses:
+  - name: ec0
+    type: ethercat
+    cycle_time: 1ms
+    options: { transport: sim }
+    io: [{ name: panel, position: 1 }]
+axes:
+  - { name: r, bus: ec0, address: 2, device: generic-cia402-2axis, mechanics: { encoder_counts_per_rev: 8192 }, ethercat: { axis: 1 } }
+  - { name: l, bus: ec0, address: 2, device: generic-cia402-2axis, mechanics: { encoder_counts_per_rev: 4096 }, ethercat: { axis: 0 } }
+  - { name: g, bus: ec0, address: 3, device: generic-cia402, mechanics: { encoder_counts_per_rev: 1000 } }
+)");
+  const auto line = build_line(plan.buses.at(0));
+  ASSERT_EQ(line->size(), 3U);
+  EXPECT_EQ(line->slave(1).persona, "generic-cia402-2axis");
+  EXPECT_EQ(line->slave(1).name, "axes r, l");
+  EXPECT_EQ(line->slave(1).identity, (SiiIdentity{0x00000000, 0x00020192, 1, 2}));
+  const auto* duo = dynamic_cast<const Cia402Slave*>(line->slave(1).parts.app.get());
+  ASSERT_NE(duo, nullptr);
+  ASSERT_EQ(duo->axes(), 2U);
+  EXPECT_EQ(duo->drive(0).config().position_units_per_rev, 4096.0);
+  EXPECT_EQ(duo->drive(1).config().position_units_per_rev, 8192.0);
+  // Both axes' PDOs assigned at power-on: 2 x 17 bytes out, 2 x 15 in.
+  EXPECT_EQ(duo->output_size(), 34U);
+  EXPECT_EQ(duo->input_size(), 30U);
+  EXPECT_EQ(line->slave(2).persona, "generic-cia402");
+  EXPECT_EQ(line->slave(2).name, "axis g");
+  EXPECT_EQ(count(*line), 3);
 }
 
 TEST(EthercatLineBuilder, AFactoryErrorNamesThePosition) {

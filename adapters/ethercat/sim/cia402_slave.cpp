@@ -23,6 +23,9 @@ using cia402::sim::Access;
 constexpr ObjectId kControlword{0x6040, 0};
 constexpr ObjectId kStatusword{0x6041, 0};
 constexpr ObjectId kIpDataRecord{0x60C1, 1};
+constexpr ObjectId kAbortOption{0x6007, 0};
+// The profile area a multi-axis slave repeats per axis [ETG.6010 §4].
+constexpr std::uint16_t kProfileArea = 0x6000;
 
 // Access bits [ETG.1000.6 §5.6.3.6]: read in every state, write in every state / in PRE-OP.
 constexpr std::uint16_t kReadAll = object_access::kReadPreOp | object_access::kReadSafeOp | object_access::kReadOp;
@@ -125,8 +128,8 @@ std::string_view object_name(std::uint16_t index) noexcept {
   }
 }
 
-cia402::sim::DriveModelConfig model_config(const EthercatPersona& p, const Cia402SlaveOptions& o) {
-  cia402::sim::DriveModelConfig c = o.drive;
+cia402::sim::DriveModelConfig model_config(const EthercatPersona& p, const Cia402SlaveOptions& o, std::size_t axis) {
+  cia402::sim::DriveModelConfig c = axis >= 1 && axis - 1 < o.more_drives.size() ? o.more_drives[axis - 1] : o.drive;
   c.supported_modes.assign(p.modes.begin(), p.modes.end());
   c.identity = cia402::sim::DriveIdentity{p.vendor_id, p.product_code, p.revision, o.serial};
   c.device_type = p.device_type;
@@ -141,8 +144,14 @@ cia402::sim::DriveModelConfig model_config(const EthercatPersona& p, const Cia40
 }  // namespace
 
 Cia402Slave::Cia402Slave(const EthercatPersona& persona, Cia402SlaveOptions options)
-    : persona_(persona), model_(model_config(persona, options)), vendor_(persona.vendor_objects.size()) {
+    : persona_(persona), vendor_(persona.vendor_objects.size()) {
   const auto& p = persona_;
+  const std::uint32_t axes_end = std::uint32_t{kProfileArea} + std::uint32_t{p.axes} * p.axis_offset;
+  if (p.axes < 1 || std::size_t{p.axes} > kMaxAxes || (p.axes > 1 && (p.axis_offset == 0 || axes_end > 0x10000U)))
+    refuse(p, "an axis count or axis offset the simulator cannot hold");
+  axes_.resize(p.axes);
+  for (std::size_t n = 0; n < axes_.size(); ++n)
+    axes_[n].model = std::make_unique<cia402::sim::DriveModel>(model_config(p, options, n));
   for (const auto& v : p.vendor_objects) {
     if (!vendor_.add(v.def, v.access, v.value)) refuse(p, "manufacturer object table is inconsistent");
   }
@@ -209,21 +218,40 @@ void Cia402Slave::restore_defaults() noexcept {
   tx_assign_.count = p.tx_assign_count;
   std::copy(p.tx_assign.begin(), p.tx_assign.end(), tx_assign_.pdos.begin());
   vendor_.reset_to_defaults();
-  abort_option_ = p.abort_option_default;
   sm_out_sync_mode_ = kSyncFreeRun;
   sm_out_cycle_ns_ = 0;
   sm_in_sync_mode_ = kSyncFreeRun;
-  ip_active_ = false;
-  ip_elapsed_ns_ = 0;
-  for (const auto& d : p.application_defaults) (void)put_app(d.id, d.value);
+  for (std::size_t n = 0; n < axes_.size(); ++n) {
+    AxisState& a = axes_[n];
+    a.abort_option = p.abort_option_default;
+    a.ip_active = false;
+    a.ip_elapsed_ns = 0;
+    // Axis 0's objects: every axis takes them at its own offset.
+    for (const auto& d : p.application_defaults) {
+      ObjectId id = d.id;
+      if (n > 0 && id.index >= kProfileArea && id.index < kProfileArea + p.axis_offset)
+        id.index = static_cast<std::uint16_t>(id.index + n * p.axis_offset);
+      (void)put_app(id, d.value);
+    }
+  }
 }
 
 void Cia402Slave::power_cycle() noexcept {
-  model_.power_cycle();
+  for (AxisState& a : axes_) {
+    a.model->power_cycle();
+    a.comm_fault_raised = false;
+  }
   restore_defaults();
   started_ = false;
-  comm_fault_raised_ = false;
   al_error_seen_ = false;
+}
+
+Cia402Slave::Located Cia402Slave::locate(ObjectId id) const noexcept {
+  // Single-axis slaves keep the whole 6000h..FFFFh range on their one model.
+  if (axes_.size() <= 1 || id.index < kProfileArea) return {0, id};
+  const auto n = static_cast<std::size_t>((id.index - kProfileArea) / persona_.axis_offset);
+  if (n >= axes_.size()) return {0, id};
+  return {n, ObjectId{static_cast<std::uint16_t>(id.index - n * persona_.axis_offset), id.sub}};
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -231,12 +259,12 @@ void Cia402Slave::power_cycle() noexcept {
 
 bool Cia402Slave::hidden(ObjectId id) const noexcept {
   const auto& h = persona_.hidden;
-  return std::find(h.begin(), h.end(), id) != h.end();
+  return std::find(h.begin(), h.end(), locate(id).local) != h.end();
 }
 
 bool Cia402Slave::ignored(ObjectId id) const noexcept {
   const auto& l = persona_.ignored_writes;
-  return std::find(l.begin(), l.end(), id) != l.end();
+  return std::find(l.begin(), l.end(), locate(id).local) != l.end();
 }
 
 const EcatVendorObject* Cia402Slave::vendor_object(ObjectId id) const noexcept {
@@ -258,10 +286,11 @@ std::string_view Cia402Slave::text_of(ObjectId id) const noexcept {
 std::optional<DataType> Cia402Slave::type_of(ObjectId id) const noexcept {
   if (hidden(id)) return std::nullopt;
   if (const EcatVendorObject* v = vendor_object(id)) return v->def.type;
-  const auto t = model_.dictionary().type_of(id);
+  const Located at = locate(id);
+  const auto t = axes_[at.axis].model->dictionary().type_of(at.local);
   if (!t) return std::nullopt;
   for (const auto& o : persona_.type_overrides) {
-    if (o.id == id) return o.type;
+    if (o.id == at.local) return o.type;
   }
   return t;
 }
@@ -269,13 +298,14 @@ std::optional<DataType> Cia402Slave::type_of(ObjectId id) const noexcept {
 std::optional<Access> Cia402Slave::access_of(ObjectId id) const noexcept {
   if (hidden(id)) return std::nullopt;
   if (const EcatVendorObject* v = vendor_object(id)) return v->access;
-  return model_.dictionary().access_of(id);
+  const Located at = locate(id);
+  return axes_[at.axis].model->dictionary().access_of(at.local);
 }
 
 std::optional<DataType> Cia402Slave::mappable(ObjectId id, bool receive) const noexcept {
   const auto& list = receive ? persona_.rx_mappable : persona_.tx_mappable;
   if (!list.empty()) {
-    if (std::find(list.begin(), list.end(), id) == list.end()) return std::nullopt;  // whitelist (ESR §7.3)
+    if (std::find(list.begin(), list.end(), locate(id).local) == list.end()) return std::nullopt;  // whitelist (ESR §7.3)
   } else if (id.index < 0x2000) {
     return std::nullopt;  // communication objects are not process data
   }
@@ -330,12 +360,13 @@ std::size_t Cia402Slave::assigned_bytes(bool receive) const noexcept {
 std::optional<std::int64_t> Cia402Slave::app_value(ObjectId id) const noexcept {
   if (const EcatVendorObject* v = vendor_object(id)) {
     if (v->source == EcatVendorSource::TorqueActual) {
-      return std::clamp<std::int64_t>(std::llround(model_.torque()), cia402::sim::type_min(v->def.type),
+      return std::clamp<std::int64_t>(std::llround(axes_[0].model->torque()), cia402::sim::type_min(v->def.type),
                                       cia402::sim::type_max(v->def.type));
     }
     return vendor_.get(id);
   }
-  return model_.dictionary().get(id);
+  const Located at = locate(id);
+  return axes_[at.axis].model->dictionary().get(at.local);
 }
 
 Cia402Slave::Value Cia402Slave::get(ObjectId id) const noexcept {
@@ -344,13 +375,17 @@ Cia402Slave::Value Cia402Slave::get(ObjectId id) const noexcept {
     if (hidden(id)) return {abort::kNoObject, 0, 0};
     const bool vendor_index = std::any_of(persona_.vendor_objects.begin(), persona_.vendor_objects.end(),
                                           [&](const EcatVendorObject& v) { return v.def.id.index == id.index; });
-    return {vendor_index ? abort::kNoSubIndex : model_.dictionary().missing_code(id), 0, 0};
+    const Located at = locate(id);
+    return {vendor_index ? abort::kNoSubIndex : axes_[at.axis].model->dictionary().missing_code(at.local), 0, 0};
   }
   if (access_of(id) == Access::WriteOnly) return {abort::kWriteOnly, 0, 0};
+  const Located at = locate(id);
+  const AxisState& axis = axes_[at.axis];
   std::int64_t value = app_value(id).value_or(0);
-  if (id == kControlword) value = from_model_controlword(static_cast<std::uint16_t>(value));
+  if (at.local == kControlword) value = from_model_controlword(axis, static_cast<std::uint16_t>(value));
   // ESR: no "ip mode active" bit in ip (quirk 7).
-  if (id == kStatusword && !persona_.ip_status_bit12 && model_.active_mode() == cia402::op_mode::kInterpolatedPosition) {
+  if (at.local == kStatusword && !persona_.ip_status_bit12 &&
+      axis.model->active_mode() == cia402::op_mode::kInterpolatedPosition) {
     value &= ~std::int64_t{0x1000};
   }
   const std::uint8_t size = cia402::size_of(*type);
@@ -358,33 +393,35 @@ Cia402Slave::Value Cia402Slave::get(ObjectId id) const noexcept {
 }
 
 std::uint32_t Cia402Slave::put_app(ObjectId id, std::int64_t value) noexcept {
+  const Located at = locate(id);
+  AxisState& axis = axes_[at.axis];
   for (const auto& r : persona_.ranges) {
-    if (r.id == id) {
+    if (r.id == at.local) {
       if (value > r.max) return abort::kValueTooHigh;
       if (value < r.min) return abort::kValueTooLow;
     }
   }
   if (vendor_object(id) != nullptr) return vendor_.set(id, value);
-  const auto model_type = model_.dictionary().type_of(id);
+  const auto model_type = axis.model->dictionary().type_of(at.local);
   if (!model_type || hidden(id)) return abort::kNoObject;
   // A wider type on the wire than in the model (ESR 6060h as INTEGER16): values the model's type
   // cannot hold are out of range.
   if (value < cia402::sim::type_min(*model_type) || value > cia402::sim::type_max(*model_type)) {
     return abort::kValueRange;
   }
-  if (id == kControlword) value = to_model_controlword(static_cast<std::uint16_t>(value));
-  if (id == kIpDataRecord && persona_.fine_interpolation) {
+  if (at.local == kControlword) value = to_model_controlword(axis, static_cast<std::uint16_t>(value));
+  if (at.local == kIpDataRecord && persona_.fine_interpolation) {
     // ESR fine interpolator [dunker §12]: a new set-point is reached over one 60C2h period in
     // 1 ms steps (advance()).
-    if (!ip_active_ || value != ip_target_) {
-      ip_start_ = static_cast<std::int32_t>(model_.dictionary().get(kIpDataRecord).value_or(0));
-      ip_target_ = static_cast<std::int32_t>(value);
-      ip_elapsed_ns_ = 0;
-      ip_active_ = true;
+    if (!axis.ip_active || value != axis.ip_target) {
+      axis.ip_start = static_cast<std::int32_t>(axis.model->dictionary().get(kIpDataRecord).value_or(0));
+      axis.ip_target = static_cast<std::int32_t>(value);
+      axis.ip_elapsed_ns = 0;
+      axis.ip_active = true;
     }
     return 0;
   }
-  return model_.write_object(id, value);
+  return axis.model->write_object(at.local, value);
 }
 
 std::uint32_t Cia402Slave::put(ObjectId id, std::uint32_t raw, std::size_t size, AlState /*state*/) noexcept {
@@ -397,14 +434,16 @@ std::uint32_t Cia402Slave::put(ObjectId id, std::uint32_t raw, std::size_t size,
   return put_app(id, cia402::normalise(*type, raw));
 }
 
-std::uint16_t Cia402Slave::to_model_controlword(std::uint16_t cw) const noexcept {
+std::uint16_t Cia402Slave::to_model_controlword(const AxisState& a, std::uint16_t cw) const noexcept {
   // ESR: bit 6 = 1 is an absolute move in pp (quirk 14 [EXT]); the model follows CiA 402 (1 = relative).
-  if (persona_.controlword_bit6_absolute && model_.active_mode() == cia402::op_mode::kProfilePosition) {
+  if (persona_.controlword_bit6_absolute && a.model->active_mode() == cia402::op_mode::kProfilePosition) {
     return static_cast<std::uint16_t>(cw ^ 0x0040U);
   }
   return cw;
 }
-std::uint16_t Cia402Slave::from_model_controlword(std::uint16_t cw) const noexcept { return to_model_controlword(cw); }
+std::uint16_t Cia402Slave::from_model_controlword(const AxisState& a, std::uint16_t cw) const noexcept {
+  return to_model_controlword(a, cw);
+}
 
 // ---------------------------------------------------------------------------------------------
 // Communication objects
@@ -419,6 +458,10 @@ std::optional<Cia402Slave::Value> Cia402Slave::get_comm(ObjectId id) const noexc
     if (sub == 0) return Value{0, d->count, 1};
     if (sub > p.max_entries) return no_sub;
     return Value{0, d->entries[sub - 1U], 4};
+  }
+  if (const Located at = locate(id); at.local.index == kAbortOption.index) {
+    if (sub == 0) return Value{0, to_raw(axes_[at.axis].abort_option, 2), 2};
+    return no_sub;
   }
   switch (id.index) {
     case 0x1010:
@@ -455,9 +498,6 @@ std::optional<Cia402Slave::Value> Cia402Slave::get_comm(ObjectId id) const noexc
         default: return no_sub;
       }
     }
-    case 0x6007:
-      if (sub == 0) return Value{0, to_raw(abort_option_, 2), 2};
-      return no_sub;
     default:
       return std::nullopt;
   }
@@ -472,6 +512,15 @@ std::optional<std::uint32_t> Cia402Slave::put_comm(ObjectId id, std::uint32_t ra
     Pdo* d = pdo(id.index, &receive);
     if (d == nullptr) return abort::kNoObject;
     return put_pdo(*d, receive, sub, raw, size, state);
+  }
+  if (const Located at = locate(id); at.local.index == kAbortOption.index) {
+    if (sub != 0) return abort::kNoSubIndex;
+    if (size != 2) return abort::kTypeMismatch;
+    const auto v = cia402::normalise(DataType::I16, raw);
+    // CiA 402: 0..3 (negative values are manufacturer-specific, none here); ESR 0..1 (§11.2).
+    if (v < 0 || v > p.abort_option_max) return abort::kValueRange;
+    axes_[at.axis].abort_option = static_cast<std::int16_t>(v);
+    return 0;
   }
   switch (id.index) {
     case 0x1010:
@@ -503,15 +552,6 @@ std::optional<std::uint32_t> Cia402Slave::put_comm(ObjectId id, std::uint32_t ra
       const bool ok = raw == kSyncFreeRun || raw == kSyncSm || raw == kSyncDc0 || (!out && raw == kSyncSm2ForInputs);
       if (!ok) return abort::kValueRange;
       (out ? sm_out_sync_mode_ : sm_in_sync_mode_) = static_cast<std::uint16_t>(raw);
-      return 0;
-    }
-    case 0x6007: {
-      if (sub != 0) return abort::kNoSubIndex;
-      if (size != 2) return abort::kTypeMismatch;
-      const auto v = cia402::normalise(DataType::I16, raw);
-      // CiA 402: 0..3 (negative values are manufacturer-specific, none here); ESR 0..1 (§11.2).
-      if (v < 0 || v > p.abort_option_max) return abort::kValueRange;
-      abort_option_ = static_cast<std::int16_t>(v);
       return 0;
     }
     default:
@@ -645,7 +685,7 @@ bool Cia402Slave::describe_object(std::uint16_t index, SdoInfoObjectDescription&
   if (first == entries_.end() || first->id.index != index) return false;
   out = SdoInfoObjectDescription{};
   out.index = index;
-  out.name = object_name(index);
+  out.name = object_name(locate({index, 0}).local.index);
   for (auto it = first; it != entries_.end() && it->id.index == index; ++it) {
     out.max_subindex = std::max(out.max_subindex, it->id.sub);
     if (it->id.sub <= 1) out.data_type = it->data_type;  // sub-index 1's for arrays and records
@@ -665,7 +705,8 @@ bool Cia402Slave::describe_entry(std::uint16_t index, std::uint8_t subindex, Sdo
   out.data_type = e->data_type;
   out.bit_length = e->bits;
   out.object_access = e->access;
-  out.name = (subindex == 0 && sub1 != nullptr) ? std::string_view("Number of entries") : object_name(index);
+  out.name = (subindex == 0 && sub1 != nullptr) ? std::string_view("Number of entries")
+                                                 : object_name(locate({index, 0}).local.index);
   return true;
 }
 
@@ -709,7 +750,9 @@ void Cia402Slave::build_entries() {
       }
     }
   }
-  add({0x6007, 0}, data_type::kInteger16, kReadAll | kWriteAll, 16, Kind::Comm);
+  for (std::size_t n = 0; n < axes_.size(); ++n)
+    add({static_cast<std::uint16_t>(kAbortOption.index + n * p.axis_offset), 0}, data_type::kInteger16,
+        kReadAll | kWriteAll, 16, Kind::Comm);
   auto application = [&](ObjectId id, Kind kind) {
     const auto type = type_of(id);
     const auto access = access_of(id);
@@ -720,12 +763,16 @@ void Cia402Slave::build_entries() {
     add(id, coe_type(*type), a, static_cast<std::uint16_t>(8 * cia402::size_of(*type)), kind);
   };
   for (const auto& v : p.vendor_objects) application(v.def.id, Kind::Vendor);
-  // The model's dictionary has no iteration: probe the areas it fills (1000h..1FFFh, 6000h..6FFFh).
-  for (std::uint32_t index = 0x1000; index <= 0x6FFF; ++index) {
+  // The models' dictionaries have no iteration: probe the areas they fill (1000h..1FFFh,
+  // 6000h..6FFFh; a multi-axis slave's axes beyond 6FFFh too).
+  const auto last = std::max<std::uint32_t>(
+      0x6FFF, static_cast<std::uint32_t>(kProfileArea + axes_.size() * p.axis_offset - 1U));
+  for (std::uint32_t index = 0x1000; index <= last; ++index) {
     if (index == 0x2000) index = 0x6000;
     for (std::uint8_t sub = 0; sub <= 8; ++sub) {
       const ObjectId id{static_cast<std::uint16_t>(index), sub};
-      if (model_.dictionary().type_of(id) && vendor_object(id) == nullptr) application(id, Kind::Model);
+      const Located at = locate(id);
+      if (axes_[at.axis].model->dictionary().type_of(at.local) && vendor_object(id) == nullptr) application(id, Kind::Model);
     }
   }
   std::stable_sort(entries_.begin(), entries_.end(), [](const Entry& a, const Entry& b) { return a.id.key() < b.id.key(); });
@@ -784,7 +831,7 @@ void Cia402Slave::build_sii(std::uint32_t serial, std::uint16_t alias) {
   profile.order = p.sii_order;
   profile.name = p.device_name;
   profile.general.coe_details = coe_details::kSdo | coe_details::kSdoInfo | coe_details::kPdoAssign | coe_details::kPdoConfig;
-  profile.general.ds402_channels = 1;
+  profile.general.ds402_channels = static_cast<std::uint8_t>(axes_.size());
   profile.general.physical_ports = 0x0011;  // ports 0 and 1 MII
   profile.fmmus = fmmus;
   profile.sync_managers = sms;
@@ -825,23 +872,30 @@ void Cia402Slave::on_state_entered(AlState from, AlState to) noexcept {
   const bool watchdog = esc_ != nullptr && (esc_->memory()[reg::kWatchdogStatusProcessData] & 0x01U) == 0;
   // A requested exit counts only while the drive runs: a master that disables the drive first
   // (digest "What a master must do", step 13) leaves OP without a reaction.
-  const bool running = model_.state() == core::AxisState::OperationEnabled;
-  if (watchdog || (persona_.abort_on_requested_leave_op && running)) comm_loss();
+  // Per axis: the watchdog concerns them all, a requested exit only those that run.
+  bool any = false;
+  for (AxisState& a : axes_) {
+    const bool running = a.model->state() == core::AxisState::OperationEnabled;
+    if (watchdog || (persona_.abort_on_requested_leave_op && running)) {
+      comm_loss(a);
+      any = true;
+    }
+  }
+  if (any) ++counters_.comm_losses;
 }
 
-void Cia402Slave::comm_loss() noexcept {
-  ++counters_.comm_losses;
+void Cia402Slave::comm_loss(AxisState& a) noexcept {
   // 6007h [CiA 402; dunker §8.2]: 1 fault (EMCY comm_loss_code), 2 disable voltage, 3 quick stop.
-  switch (abort_option_) {
+  switch (a.abort_option) {
     case 1:
-      model_.inject_fault(persona_.comm_loss_code);
-      comm_fault_raised_ = true;
+      a.model->inject_fault(persona_.comm_loss_code);
+      a.comm_fault_raised = true;
       break;
     case 2:
-      (void)model_.write_object(kControlword, 0x0000);
+      (void)a.model->write_object(kControlword, 0x0000);
       break;
     case 3:
-      (void)model_.write_object(kControlword, 0x0002);
+      (void)a.model->write_object(kControlword, 0x0002);
       break;
     default:
       break;  // 0: no reaction (ESR default: the drive keeps its last set-point, §12)
@@ -903,33 +957,40 @@ void Cia402Slave::advance(std::uint64_t now_ns) noexcept {
   if (now_ns <= model_ns_) return;
   if (now_ns - model_ns_ > kMaxCatchUpNs) model_ns_ = now_ns - kMaxCatchUpNs;  // a stalled line: no jump
   while (now_ns - model_ns_ >= kModelStepNs) {
-    if (ip_active_) {
-      // 60C2h period = units x 10^index s (index -3: ms) [dunker §11.2].
-      const auto units = model_.dictionary().get(cia402::obj::kIpTimePeriodUnits.id).value_or(1);
-      auto index = model_.dictionary().get(cia402::obj::kIpTimePeriodIndex.id).value_or(-3);
-      double period_ns = static_cast<double>(std::max<std::int64_t>(units, 1));
-      for (index += 9; index > 0; --index) period_ns *= 10.0;
-      ip_elapsed_ns_ += kModelStepNs;
-      const double f = std::min(1.0, static_cast<double>(ip_elapsed_ns_) / period_ns);
-      const double v = static_cast<double>(ip_start_) + (static_cast<double>(ip_target_) - ip_start_) * f;
-      (void)model_.write_object(kIpDataRecord, std::llround(v));
+    for (AxisState& a : axes_) {
+      cia402::sim::DriveModel& model = *a.model;
+      if (a.ip_active) {
+        // 60C2h period = units x 10^index s (index -3: ms) [dunker §11.2].
+        const auto units = model.dictionary().get(cia402::obj::kIpTimePeriodUnits.id).value_or(1);
+        auto index = model.dictionary().get(cia402::obj::kIpTimePeriodIndex.id).value_or(-3);
+        double period_ns = static_cast<double>(std::max<std::int64_t>(units, 1));
+        for (index += 9; index > 0; --index) period_ns *= 10.0;
+        a.ip_elapsed_ns += kModelStepNs;
+        const double f = std::min(1.0, static_cast<double>(a.ip_elapsed_ns) / period_ns);
+        const double v = static_cast<double>(a.ip_start) + (static_cast<double>(a.ip_target) - a.ip_start) * f;
+        (void)model.write_object(kIpDataRecord, std::llround(v));
+      }
+      model.step(core::Duration(kModelStepNs));
     }
-    model_.step(core::Duration(kModelStepNs));
     model_ns_ += kModelStepNs;
   }
   // The communication fault has no lasting cause: once raised, a fault reset clears it.
-  if (comm_fault_raised_ && faulted(model_.state())) {
-    comm_fault_raised_ = false;
-    if (!injected_) model_.clear_fault_cause();
+  for (AxisState& a : axes_) {
+    if (a.comm_fault_raised && faulted(a.model->state())) {
+      a.comm_fault_raised = false;
+      if (!a.injected) a.model->clear_fault_cause();
+    }
   }
 }
 
 void Cia402Slave::report_emcys() noexcept {
-  while (const auto e = model_.take_pending_emcy()) {
-    if (e->error_code == 0 && !persona_.emcy_on_fault_clear) continue;
-    // ESR: bytes 3..7 always zero (quirk 11).
-    const CoeEmergency emcy{e->error_code, e->error_register, {}};
-    if (esc_ == nullptr || !esc_->post_emergency(emcy)) ++counters_.emcy_dropped;
+  for (AxisState& a : axes_) {
+    while (const auto e = a.model->take_pending_emcy()) {
+      if (e->error_code == 0 && !persona_.emcy_on_fault_clear) continue;
+      // ESR: bytes 3..7 always zero (quirk 11).
+      const CoeEmergency emcy{e->error_code, e->error_register, {}};
+      if (esc_ == nullptr || !esc_->post_emergency(emcy)) ++counters_.emcy_dropped;
+    }
   }
 }
 

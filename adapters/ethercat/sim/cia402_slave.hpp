@@ -29,6 +29,13 @@
 // SM2/SM3 lengths follow the assignment (output_size()/input_size(); the ESC checks them at
 // PRE-OP -> SAFE-OP: 001Dh/001Eh).
 //
+// Multi-axis slave (persona.axes > 1) [ETG.6010 §4 modular device profile]: one drive model per
+// axis; axis n's profile objects (6000h..67FFh, 6007h among them) sit at + n x persona.axis_offset
+// in the dictionary and in the PDOs; everything below 6000h (identity, PDO mapping and assignment,
+// 1C32h/1C33h) is the slave's, answered from axis 0's model where the model holds it. The SM
+// watchdog runs every axis' own 6007h reaction; a requested exit from OP (per persona) those of
+// the axes that are Operation enabled. EMCYs of every axis go out through the one mailbox.
+//
 // Cycle (exchange(), after every frame): in OP the outputs are written to the mapped objects
 // (outside OP they are not applied: the drive keeps its last values [dunker §5]); the model steps
 // by the elapsed time in 1 ms steps (at most 1 s per call); the drive's EMCYs go to
@@ -66,6 +73,9 @@ struct Cia402SlaveOptions {
   // The drive model's mechanics; identity, device type, modes and the initial mode come from the
   // persona.
   cia402::sim::DriveModelConfig drive{};
+  // Axes 1.. of a multi-axis persona: their mechanics, in axis order; an axis without one takes
+  // `drive`'s.
+  std::vector<cia402::sim::DriveModelConfig> more_drives;
 };
 
 struct Cia402SlaveCounters {
@@ -81,6 +91,7 @@ class Cia402Slave final : public SlaveApplication, private ObjectDictionary {
   static constexpr std::size_t kMaxAssign = 8;    // 1C12h/1C13h sub-indexes
   static constexpr std::uint64_t kModelStepNs = 1'000'000;
   static constexpr std::uint64_t kMaxCatchUpNs = 1'000'000'000;
+  static constexpr std::size_t kMaxAxes = 8;
 
   // Allocates here only. Throws std::invalid_argument for a persona table the drive cannot hold
   // (too many PDOs or entries, a default mapping it refuses, a broken SII profile).
@@ -107,22 +118,28 @@ class Cia402Slave final : public SlaveApplication, private ObjectDictionary {
   // Power off and on (SimLine::power_off/on reset the ESC only; call this with it): every object
   // at its power-on value, the model power-cycled.
   void power_cycle() noexcept;
-  // A drive fault whose cause persists until clear_fault_cause() (the model's inject_fault).
-  void inject_fault(std::uint16_t code) noexcept {
-    injected_ = true;
-    model_.inject_fault(code);
+  // A drive fault whose cause persists until clear_fault_cause() (the model's inject_fault), on
+  // one axis (out of range: ignored).
+  void inject_fault(std::uint16_t code, std::size_t axis = 0) noexcept {
+    if (axis >= axes_.size()) return;
+    axes_[axis].injected = true;
+    axes_[axis].model->inject_fault(code);
   }
-  void clear_fault_cause() noexcept {
-    injected_ = false;
-    model_.clear_fault_cause();
+  void clear_fault_cause(std::size_t axis = 0) noexcept {
+    if (axis >= axes_.size()) return;
+    axes_[axis].injected = false;
+    axes_[axis].model->clear_fault_cause();
   }
 
   // --- Observation -----------------------------------------------------------------------------
   const EthercatPersona& persona() const noexcept { return persona_; }
-  cia402::sim::DriveModel& drive() noexcept { return model_; }
-  const cia402::sim::DriveModel& drive() const noexcept { return model_; }
+  std::size_t axes() const noexcept { return axes_.size(); }
+  // Axis `axis`'s model (axis < axes()).
+  cia402::sim::DriveModel& drive(std::size_t axis = 0) noexcept { return *axes_[axis].model; }
+  const cia402::sim::DriveModel& drive(std::size_t axis = 0) const noexcept { return *axes_[axis].model; }
   const Cia402SlaveCounters& counters() const noexcept { return counters_; }
-  std::int16_t abort_option() const noexcept { return abort_option_; }
+  // 6007h (+ axis x axis_offset).
+  std::int16_t abort_option(std::size_t axis = 0) const noexcept { return axes_[axis].abort_option; }
   // 1C32h:01 (0 free run, 1 SM2 synchronous, 2 DC SYNC0).
   std::uint16_t sync_mode() const noexcept { return sm_out_sync_mode_; }
 
@@ -142,6 +159,24 @@ class Cia402Slave final : public SlaveApplication, private ObjectDictionary {
     std::uint8_t size = 0;  // bytes
   };
   enum class Kind : std::uint8_t { Text, Comm, Vendor, Model };
+  // One axis: its model and what the slave keeps per axis.
+  struct AxisState {
+    std::unique_ptr<cia402::sim::DriveModel> model;
+    std::int16_t abort_option = 0;  // 6007h + n x axis_offset
+    bool comm_fault_raised = false;
+    bool injected = false;
+    // Fine interpolation (persona.fine_interpolation): the set-point ramps from start to target.
+    bool ip_active = false;
+    std::int32_t ip_start = 0;
+    std::int32_t ip_target = 0;
+    std::uint64_t ip_elapsed_ns = 0;
+  };
+  // An object as one axis sees it: the axis and the index axis 0 has it under.
+  struct Located {
+    std::size_t axis = 0;
+    cia402::ObjectId local;
+  };
+  Located locate(cia402::ObjectId id) const noexcept;
   // One entry as SDO information describes it (built at construction).
   struct Entry {
     cia402::ObjectId id;
@@ -195,13 +230,13 @@ class Cia402Slave final : public SlaveApplication, private ObjectDictionary {
   void advance(std::uint64_t now_ns) noexcept;
   void report_emcys() noexcept;
   void watch_al_status() noexcept;
-  void comm_loss() noexcept;
+  void comm_loss(AxisState& a) noexcept;
   void restore_defaults() noexcept;
-  std::uint16_t to_model_controlword(std::uint16_t cw) const noexcept;
-  std::uint16_t from_model_controlword(std::uint16_t cw) const noexcept;
+  std::uint16_t to_model_controlword(const AxisState& a, std::uint16_t cw) const noexcept;
+  std::uint16_t from_model_controlword(const AxisState& a, std::uint16_t cw) const noexcept;
 
   const EthercatPersona& persona_;
-  cia402::sim::DriveModel model_;
+  std::vector<AxisState> axes_;
   cia402::sim::ObjectDictionary vendor_;
   std::vector<Pdo> rx_;
   std::vector<Pdo> tx_;
@@ -212,21 +247,13 @@ class Cia402Slave final : public SlaveApplication, private ObjectDictionary {
   EscSlave* esc_ = nullptr;
   Cia402SlaveCounters counters_;
 
-  std::int16_t abort_option_ = 0;            // 6007h
   std::uint16_t sm_out_sync_mode_ = 0;       // 1C32h:01
   std::uint32_t sm_out_cycle_ns_ = 0;        // 1C32h:02
   std::uint16_t sm_in_sync_mode_ = 0;        // 1C33h:01
 
   bool started_ = false;
-  std::uint64_t model_ns_ = 0;  // time the model has been stepped to
-  bool comm_fault_raised_ = false;
-  bool injected_ = false;
+  std::uint64_t model_ns_ = 0;  // time the models have been stepped to
   bool al_error_seen_ = false;
-  // Fine interpolation (persona.fine_interpolation): the set-point ramps from start to target.
-  bool ip_active_ = false;
-  std::int32_t ip_start_ = 0;
-  std::int32_t ip_target_ = 0;
-  std::uint64_t ip_elapsed_ns_ = 0;
 };
 
 // A drive and its ESC, ready for SimLine::add(*esc).

@@ -220,7 +220,75 @@ constexpr EthercatPersona kGeneric{
     .emcy_on_fault_clear = true,
 };
 
-constexpr std::array<const EthercatPersona*, 2> kPersonas{&kEsr, &kGeneric};
+// ---------------------------------------------------------------------------------------------
+// Generic two-axis CiA 402 (profiles/devices/generic-cia402-2axis.yaml)
+
+// A modular device with two drive channels [ETG.6010 §4]: axis 1's profile objects at + 800h.
+// Power-on mapping = the device profile's: one RxPDO and one TxPDO per axis (1600h/1A00h axis 0,
+// 1601h/1A01h axis 1, each as generic-cia402's), both assigned; 34 output bytes, 30 input bytes.
+constexpr std::uint16_t kAxis1 = 0x800;
+constexpr std::uint16_t ax1(std::uint16_t index) noexcept { return static_cast<std::uint16_t>(index + kAxis1); }
+constexpr std::array<std::uint32_t, 6> kGen2Rx2{map(ax1(0x6040), 0, 16), map(ax1(0x6060), 0, 8),
+                                                map(ax1(0x6071), 0, 16), map(ax1(0x607A), 0, 32),
+                                                map(ax1(0x60FF), 0, 32), map(ax1(0x60C1), 1, 32)};
+constexpr std::array<std::uint32_t, 6> kGen2Tx2{map(ax1(0x6041), 0, 16), map(ax1(0x6061), 0, 8),
+                                                map(ax1(0x6077), 0, 16), map(ax1(0x603F), 0, 16),
+                                                map(ax1(0x6064), 0, 32), map(ax1(0x606C), 0, 32)};
+constexpr std::array<EcatPdoDefault, 4> kGen2RxPdos{{{0x1600, kGenRx1}, {0x1601, kGen2Rx2}, {0x1602, {}}, {0x1603, {}}}};
+constexpr std::array<EcatPdoDefault, 4> kGen2TxPdos{{{0x1A00, kGenTx1}, {0x1A01, kGen2Tx2}, {0x1A02, {}}, {0x1A03, {}}}};
+constexpr std::array<std::uint16_t, 2> kGen2RxAssign{0x1600, 0x1601};
+constexpr std::array<std::uint16_t, 2> kGen2TxAssign{0x1A00, 0x1A01};
+
+constexpr EthercatPersona kGeneric2Axis{
+    .name = "generic-cia402-2axis",
+    // Not a registered vendor (as generic-cia402); its own product code, so that a profile can
+    // tell it from a single-axis drive by identity.
+    .vendor_id = 0x00000000,
+    .product_code = 0x00020192,
+    .revision = 0x00000001,
+    .device_type = 0x00020192,
+    .device_name = "drivegate simulated two-axis CiA 402 drive",
+    .hardware_version = "sim-1",
+    .software_version = "drivegate-sim 1.0",
+    .sii_group = "Drive",
+    .sii_order = "SIM-CIA402-2AX",
+    .dc_supported = true,
+    .modes = kGenModes,
+    .initial_mode = 0,
+    .rx_pdos = kGen2RxPdos,
+    .tx_pdos = kGen2TxPdos,
+    .max_entries = 16,
+    .assign_slots = 4,
+    .rx_assign = kGen2RxAssign,
+    .rx_assign_count = 2,
+    .tx_assign = kGen2TxAssign,
+    .tx_assign_count = 2,
+    .rx_mappable = {},
+    .tx_mappable = {},
+    .rx_mapping_writable_in_safeop = false,
+    .process_data_capacity = 256,
+    .type_overrides = {},
+    .vendor_objects = {},
+    .hidden = {},
+    .ignored_writes = {},
+    .ranges = {},
+    .application_defaults = {},
+    .store_parameters = true,
+    .sync_manager_parameters = true,
+    .abort_option_default = 1,  // per axis (6007h, 6807h), as generic-cia402
+    .abort_option_max = 3,
+    .abort_on_requested_leave_op = true,
+    .comm_loss_code = 0x8100,
+    .controlword_bit6_absolute = false,
+    .ip_status_bit12 = true,
+    .fine_interpolation = false,
+    .transition_error_emcy = false,
+    .emcy_on_fault_clear = true,
+    .axes = 2,
+    .axis_offset = kAxis1,
+};
+
+constexpr std::array<const EthercatPersona*, 3> kPersonas{&kEsr, &kGeneric, &kGeneric2Axis};
 
 }  // namespace
 

@@ -5,6 +5,7 @@
 // and their sources are in ethercat_persona.cpp:
 //   esr-triodrive   ESR TrioDrive/MidiDrive D/ES, Dunkermotoren DME (dunker-ethercat-coe.md)
 //   generic-cia402  a drive that follows CiA 402 / ETG.6010 to the letter, with DC SYNC0
+//   generic-cia402-2axis  the same as a two-axis slave (ETG.6010 multi-axis: axis 1 at +800h)
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -118,6 +119,14 @@ struct EthercatPersona {
   bool fine_interpolation = false;  // ip set-points ramped over 60C2h in 1 ms steps (ESR §12)
   bool transition_error_emcy = false;  // EMCY A000h when the ESC refuses a state (ESR App. C)
   bool emcy_on_fault_clear = true;     // EMCY 0000h when the faults clear (ESR: only faults, §8.1)
+
+  // Axes on the slave, each its own drive model [ETG.6010 §4 modular device profile: axis n's
+  // profile objects 6000h..67FFh at + n x axis_offset, 6007h included]. The mapping defaults
+  // name the objects as the slave numbers them (axis 1's controlword at 6040h + axis_offset); the
+  // whitelists, ranges, type overrides, hidden, ignored objects and application defaults name
+  // axis 0's objects and apply to every axis.
+  std::uint8_t axes = 1;
+  std::uint16_t axis_offset = 0x800;
 };
 
 // The persona with that name; nullptr for an unknown name.

@@ -1,11 +1,13 @@
 #include "adapters/ethercat/sim/sim_personas.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 #include <utility>
 
 #include "adapters/ethercat/sim/cia402_slave.hpp"
 #include "adapters/ethercat/sim/generic_io.hpp"
 #include "adapters/sim/sim_bus.hpp"
+#include "config/ethercat/plan.hpp"
 
 namespace drivegate::ethercat::sim {
 
@@ -14,7 +16,19 @@ namespace {
 SimSlaveParts make_cia402_parts(const SlaveRequest& q) {
   Cia402SlaveOptions options;
   options.serial = q.serial;
-  if (!q.axes.empty()) options.drive = drivegate::sim::drive_config_for(*q.axes.front());
+  // Each axis' mechanics from its config axis (slave axis 0 first); a slave axis no config axis
+  // names takes the first one's.
+  std::vector<const config::AxisPlan*> by_axis(q.axes.begin(), q.axes.end());
+  std::stable_sort(by_axis.begin(), by_axis.end(), [](const config::AxisPlan* a, const config::AxisPlan* b) {
+    return a->section<config::EthercatAxisSpec>().slave_axis < b->section<config::EthercatAxisSpec>().slave_axis;
+  });
+  if (!by_axis.empty()) options.drive = drivegate::sim::drive_config_for(*by_axis.front());
+  const int axes = q.device != nullptr ? q.device->section<config::EthercatDeviceSpec>().axes : 1;
+  for (int n = 1; n < axes; ++n) {
+    options.more_drives.push_back(options.drive);
+    for (const config::AxisPlan* a : by_axis)
+      if (a->section<config::EthercatAxisSpec>().slave_axis == n) options.more_drives.back() = drivegate::sim::drive_config_for(*a);
+  }
   auto app = make_cia402_slave(q.persona, options);
   Cia402Slave* p = app.get();
   SimSlaveParts parts;
@@ -31,7 +45,7 @@ PersonaRegistry PersonaRegistry::builtin() {
   PersonaRegistry r;
   r.add(std::string(kGenericIoPersona), make_generic_io);
   // The CiA 402 drives (sim/cia402_slave.hpp), with the first axis' mechanics.
-  for (const char* name : {"esr-triodrive", "generic-cia402"})
+  for (const char* name : {"esr-triodrive", "generic-cia402", "generic-cia402-2axis"})
     r.add(name, make_cia402_parts);
   return r;
 }
