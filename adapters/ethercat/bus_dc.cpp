@@ -15,11 +15,13 @@ using core::put_u64;
 
 namespace {
 
-// Tag: bits 28-31 kind, 24-27 slave, 16-23 run, 0-15 sequence.
+// Tag: bits 30-31 kind, 24-29 slave (6 bits: a line has up to 64; 4 bits sent the answers of
+// slaves 17.. to slaves 1.. and timed the others out), 16-23 run, 0-15 sequence.
 constexpr std::uint32_t kProbe = 1;
 constexpr std::uint32_t kRejoin = 2;
+static_assert(BusDc::kMaxSlaves <= 64, "the tag has 6 bits for the slave");
 constexpr std::uint32_t make_tag(std::uint32_t kind, std::size_t k, std::uint8_t run, std::uint16_t seq) noexcept {
-  return (kind << 28) | ((static_cast<std::uint32_t>(k) & 0x0FU) << 24) | (static_cast<std::uint32_t>(run) << 16) | seq;
+  return (kind << 30) | ((static_cast<std::uint32_t>(k) & 0x3FU) << 24) | (static_cast<std::uint32_t>(run) << 16) | seq;
 }
 // FPRD 0900h..092Bh: port receive times, system time, 0918h receive time of the processing unit,
 // 0920h offset, 0928h delay [ETG.1000.4 Table 31].
@@ -364,8 +366,8 @@ void BusDc::poll(core::TimePoint now, Transactions& tx) noexcept {
 }
 
 void BusDc::on_result(std::uint32_t tag, const DatagramAnswer& a) noexcept {
-  const std::uint32_t kind = tag >> 28;
-  const std::size_t k = (tag >> 24) & 0x0FU;
+  const std::uint32_t kind = tag >> 30;
+  const std::size_t k = (tag >> 24) & 0x3FU;
   if (((tag >> 16) & 0xFFU) != run_ || k >= count_) return;
   const auto seq = static_cast<std::uint16_t>(tag & 0xFFFF);
   if (kind == kProbe) {

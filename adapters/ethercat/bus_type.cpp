@@ -49,10 +49,13 @@ void check_image(const config::BusPlan& bus, const config::BusEntry& at) {
     return;
   }
   if (!image->fits(bus.cycle_time)) {
+    const std::string frames =
+        image->frame_count() == 1 ? "the cyclic frame (" : "the " + std::to_string(image->frame_count()) + " cyclic frames (";
     at.source.error(at.mark, at.path,
-                    "the cyclic frame (" + std::to_string(image->frame_bytes()) + " bytes, " +
+                    frames + std::to_string(image->frame_bytes()) + " bytes, " +
                         micros(image->round_trip()) + " round trip with " + std::to_string(image->slave_count()) +
-                        " slaves at 100 Mbit/s) does not fit in half the cycle_time of " + micros(bus.cycle_time) +
+                        " slaves at 100 Mbit/s) " + (image->frame_count() == 1 ? "does" : "do") +
+                        " not fit in half the cycle_time of " + micros(bus.cycle_time) +
                         ": lengthen cycle_time or map fewer objects");
   }
 }
@@ -74,8 +77,16 @@ void describe_image(const config::BusPlan& bus, config::DescribeRows& rows) {
                                  std::to_string(in) + " in) over " + std::to_string(image->slave_count()) + " slaves, " +
                                  std::to_string(image->datagrams().size()) + " datagrams, working counter " +
                                  std::to_string(image->expected_wkc()));
-  rows.emplace_back("frame", std::to_string(image->frame_bytes()) + " bytes, " + micros(image->wire_time()) +
-                                 " on the wire at 100 Mbit/s (round trip " + micros(image->round_trip()) + ")");
+  // "1 frame, 162 bytes, ..." or "3 frames (1458 + 1442 + 104 bytes), ...": the frames a cycle
+  // sends, back to back (ProcessImage::kMaxFrames at most).
+  std::string frames = std::to_string(image->frame_count()) + (image->frame_count() == 1 ? " frame, " : " frames (");
+  for (std::size_t i = 0; i < image->frame_count(); ++i) {
+    if (image->frame_count() == 1) break;
+    frames += (i == 0 ? "" : " + ") + std::to_string(image->frames()[i].bytes);
+  }
+  frames += image->frame_count() == 1 ? std::to_string(image->frame_bytes()) + " bytes, " : " bytes), ";
+  rows.emplace_back("frame", frames + micros(image->wire_time()) + " on the wire at 100 Mbit/s (round trip " +
+                                 micros(image->round_trip()) + ")");
 }
 
 void describe_axis(const config::BusPlan& bus, const config::AxisPlan& axis, config::DescribeRows& rows) {

@@ -76,7 +76,7 @@ TEST(EthercatBusConfig, PrintoutRows) {
   EXPECT_EQ(row(out, "image"), "76 bytes (39 out, 37 in) over 3 slaves, 3 datagrams, working counter 9") << out;
   // 16 bytes of headers, the three LRWs (12 + 40, 12 + 4, 12 + 32), the AL status check and DC
   // slots (24 + 10): 162 bytes; with preamble, FCS and gap 186 bytes at 80 ns (IEEE 802.3).
-  EXPECT_EQ(row(out, "frame"), "162 bytes, 14.9 us on the wire at 100 Mbit/s (round trip 17.9 us)") << out;
+  EXPECT_EQ(row(out, "frame"), "1 frame, 162 bytes, 14.9 us on the wire at 100 Mbit/s (round trip 17.9 us)") << out;
   EXPECT_EQ(row(out, "slave"), "position 1, station 0x1001, axis 0, outputs at 0 (20 bytes), inputs at 20 (20 bytes)")
       << out;
   EXPECT_EQ(row(out, "slave", 1), "position 3, station 0x1003, axis 0, outputs at 44 (17 bytes), inputs at 61 (15 bytes)")

@@ -1,5 +1,6 @@
 // ProcessImage: byte-exact SM and FMMU entries, cyclic datagrams, working counters and frame
-// sizes for a line of three slaves, and the layouts it refuses.
+// sizes for a line of three slaves, the frames of a line of 64 (several per cycle, as
+// Transactions sends them), and the layouts it refuses.
 //
 // The vectors are derived by hand from ETG.1000.4 Table 59 (SM entry: start u16, length u16,
 // control, status, activate, PDI control) and Table 56 (FMMU entry: logical start u32, length u16,
@@ -11,7 +12,9 @@
 #include <memory>
 #include <vector>
 
+#include "adapters/ethercat/master/cyclic_exchange.hpp"
 #include "adapters/ethercat/master/process_image.hpp"
+#include "adapters/ethercat/master/transactions.hpp"
 #include "adapters/ethercat/sim/generic_io.hpp"
 #include "tests/ethercat_master/pdo_sim.hpp"
 
@@ -156,23 +159,189 @@ TEST(ProcessImage, LogicalBaseAndLrdLwr) {
   EXPECT_EQ(img.expected_wkc(), 6);
 }
 
-TEST(ProcessImage, AnImageLargerThanOneFrameIsRefused) {
+// Two slaves of 800 bytes: the whole-image LRW does not fit one frame, so it is cut at the slave
+// boundary into two LRWs, one per frame, each with its slaves' working counter.
+TEST(ProcessImage, AnImageLargerThanOneFrameIsCutAtASlaveBoundary) {
   std::array<ImageSlave, 2> s{};
   s[0] = ImageSlave{0x1001, 800, 0, ProcessSm{0x1000, 0x64, 0}, ProcessSm{0x2000, 0x20, 0}, 0, 1, false};
   s[1] = ImageSlave{0x1002, 0, 800, ProcessSm{0x1000, 0x64, 0}, ProcessSm{0x1000, 0x20, 0}, 0, 1, false};
   ProcessImage img;
+  ASSERT_TRUE(img.build(s)) << img.text();
+  ASSERT_EQ(img.datagrams().size(), 2U);
+  EXPECT_EQ(img.datagrams()[0].command, Command::LRW);
+  EXPECT_EQ(img.datagrams()[0].logical_address, 0U);
+  EXPECT_EQ(img.datagrams()[0].length, 800);
+  EXPECT_EQ(img.datagrams()[0].expected_wkc, 2);  // slave 1 writes
+  EXPECT_EQ(img.datagrams()[0].frame, 0);
+  EXPECT_EQ(img.datagrams()[1].logical_address, 800U);
+  EXPECT_EQ(img.datagrams()[1].length, 800);
+  EXPECT_EQ(img.datagrams()[1].expected_wkc, 1);  // slave 2 reads
+  EXPECT_EQ(img.datagrams()[1].frame, 1);
+  EXPECT_EQ(img.expected_wkc(), 3);
+  // Frame 1: 16 + the AL status check (12 + 2) + 12 + 800 = 842; frame 2: 16 + 12 + 800 = 828.
+  ASSERT_EQ(img.frame_count(), 2U);
+  EXPECT_EQ(img.frames()[0].bytes, 842U);
+  EXPECT_EQ(img.frames()[0].datagrams, 2U);
+  EXPECT_EQ(img.frames()[1].bytes, 828U);
+  EXPECT_EQ(img.frames()[1].datagrams, 1U);
+  EXPECT_EQ(img.frame_bytes(), 1670U);
+  EXPECT_EQ(img.wire_bytes(), 1670U + 2 * 24);
+  EXPECT_EQ(img.wire_time(), std::chrono::nanoseconds(80 * 1718));
+  // 1468 data bytes fit one frame exactly: 16 + 12 + 1468 + 14 = 1510.
+  s[1].input_bytes = 668;
+  ASSERT_TRUE(img.build(s)) << img.text();
+  EXPECT_EQ(img.frame_count(), 1U);
+  EXPECT_EQ(img.datagrams().size(), 1U);
+  EXPECT_EQ(img.frame_bytes(), 1510U);
+  // One slave with more than one datagram carries.
+  s[0].output_bytes = 1500;
   EXPECT_FALSE(img.build(s));
   EXPECT_EQ(img.error(), ImageError::FrameTooLarge);
-  // 14 + 2 + 2 × 12 + 1600 + 2 = 1642 bytes.
-  EXPECT_EQ(img.text(),
-            "process image of 1600 bytes: the cyclic frame needs 1642 bytes in 2 datagrams (1 for the image), one "
-            "Ethernet frame carries 1514 bytes and 32 datagrams");
-  EXPECT_EQ(img.slave_count(), 0U);
+  EXPECT_EQ(img.text(), "slave 1 (0x1001): 1500 bytes of process data, one Ethernet frame carries 1486");
+  EXPECT_EQ(img.frame_count(), 0U);
   EXPECT_FALSE(img.fits(std::chrono::seconds(1)));
-  // 1468 data bytes fit exactly: 16 + 12 + 1468 + 14 = 1510.
-  s[1].input_bytes = 668;
-  EXPECT_TRUE(img.build(s)) << img.text();
-  EXPECT_EQ(img.frame_bytes(), 1510U);
+}
+
+// `n` generic CiA 402 drives as the bus plans them without an SII (17 bytes out, 15 in; SM2 at
+// 1000h, SM3 after its three buffers).
+std::vector<ImageSlave> generic_drives(std::size_t n, bool lrd_lwr = false) {
+  std::vector<ImageSlave> v(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    v[k] = ImageSlave{static_cast<std::uint16_t>(0x1001 + k), 17, 15, ProcessSm{0x1000, 0x64, 0},
+                      ProcessSm{0x1033, 0x20, 0}, 0, 1, lrd_lwr};
+  }
+  return v;
+}
+
+// The bus' options: one LRW per slave, DC's FRMW (8 bytes) and the AL status check (2) first.
+constexpr ImageOptions kBusOptions{0, CyclicDatagrams::PerSlave, 2, 10};
+
+// 64 drives, one LRW of 32 bytes each: 66 datagrams in three frames of at most 32, packed in queue
+// order as Transactions does.
+TEST(ProcessImage, SixtyFourSlavesTakeThreeFrames) {
+  const auto drives = generic_drives(64);
+  ProcessImage img;
+  ASSERT_TRUE(img.build(drives, kBusOptions)) << img.text();
+  EXPECT_EQ(img.size(), 64U * 32U);
+  const auto dg = img.datagrams();
+  ASSERT_EQ(dg.size(), 64U);
+  for (std::size_t k = 0; k < 64; ++k) {
+    EXPECT_EQ(dg[k].command, Command::LRW) << k;
+    EXPECT_EQ(dg[k].logical_address, 32U * k) << k;
+    EXPECT_EQ(dg[k].length, 32) << k;
+    EXPECT_EQ(dg[k].expected_wkc, 3) << k;
+    EXPECT_EQ(dg[k].slave, k) << k;
+    // FRMW, AL check and slaves 1-30 | slaves 31-62 | slaves 63-64.
+    EXPECT_EQ(dg[k].frame, k < 30 ? 0 : k < 62 ? 1 : 2) << k;
+  }
+  EXPECT_EQ(img.expected_wkc(), 192);
+  ASSERT_EQ(img.frame_count(), 3U);
+  // 16 + (12 + 8) + (12 + 2) + 30 × (12 + 32) = 1370; 16 + 32 × 44 = 1424; 16 + 2 × 44 = 104.
+  EXPECT_EQ(img.frames()[0].bytes, 1370U);
+  EXPECT_EQ(img.frames()[0].datagrams, 32U);
+  EXPECT_EQ(img.frames()[1].bytes, 1424U);
+  EXPECT_EQ(img.frames()[1].datagrams, 32U);
+  EXPECT_EQ(img.frames()[2].bytes, 104U);
+  EXPECT_EQ(img.frames()[2].datagrams, 2U);
+  EXPECT_EQ(img.frame_bytes(), 2898U);
+  // On the wire 2898 + 3 × 24 = 2970 bytes = 237.6 µs; + 64 slaves × 1 µs = 301.6 µs.
+  EXPECT_EQ(img.wire_time(), std::chrono::nanoseconds(237'600));
+  EXPECT_EQ(img.round_trip(), std::chrono::nanoseconds(301'600));
+  EXPECT_TRUE(img.fits(std::chrono::milliseconds(1)));
+  EXPECT_FALSE(img.fits(std::chrono::microseconds(500)));  // half: 250 µs
+
+  // The same line in whole-image mode: LRWs cut at slave boundaries. The first frame has room for
+  // 1514 - 16 - 34 - 12 = 1452 bytes: 45 slaves (1440); the other 19 (608 bytes) go in the second.
+  ProcessImage whole;
+  ASSERT_TRUE(whole.build(drives, ImageOptions{0x10000, CyclicDatagrams::WholeImage, 2, 10})) << whole.text();
+  ASSERT_EQ(whole.datagrams().size(), 2U);
+  EXPECT_EQ(whole.datagrams()[0].logical_address, 0x10000U);
+  EXPECT_EQ(whole.datagrams()[0].length, 1440);
+  EXPECT_EQ(whole.datagrams()[0].expected_wkc, 135);
+  EXPECT_EQ(whole.datagrams()[1].logical_address, 0x10000U + 1440U);
+  EXPECT_EQ(whole.datagrams()[1].image_offset, 1440U);
+  EXPECT_EQ(whole.datagrams()[1].length, 608);
+  EXPECT_EQ(whole.datagrams()[1].expected_wkc, 57);
+  EXPECT_EQ(whole.datagrams()[1].frame, 1);
+  ASSERT_EQ(whole.frame_count(), 2U);
+  EXPECT_EQ(whole.frames()[0].bytes, 16U + 34U + 12U + 1440U);
+  EXPECT_EQ(whole.frames()[1].bytes, 16U + 12U + 608U);
+}
+
+// Beyond ProcessImage::kMaxFrames frames the line is refused in one sentence: 64 slaves that each
+// need an LWR and an LRD are 128 datagrams + 2, five frames.
+TEST(ProcessImage, MoreFramesThanACycleSendsAreRefused) {
+  ProcessImage img;
+  EXPECT_FALSE(img.build(generic_drives(64, true), kBusOptions));
+  EXPECT_EQ(img.error(), ImageError::FrameTooLarge);
+  EXPECT_EQ(img.text(),
+            "process image of 2048 bytes: its 128 cyclic datagrams (and 2 more) need 5 Ethernet frames, a cycle sends at "
+            "most 4 (of 1514 bytes and 32 datagrams each)");
+  EXPECT_EQ(img.slave_count(), 0U);
+  EXPECT_EQ(img.frame_count(), 0U);
+  EXPECT_TRUE(img.datagrams().empty());
+  // 63 such slaves: 126 + 2 datagrams, exactly four full frames.
+  ASSERT_TRUE(img.build(generic_drives(63, true), kBusOptions)) << img.text();
+  ASSERT_EQ(img.frame_count(), 4U);
+  for (const auto& f : img.frames()) EXPECT_EQ(f.datagrams, 32U);
+  EXPECT_EQ(img.datagrams()[125].frame, 3);
+}
+
+// What goes on the wire is what was planned: DC's FRMW, then CyclicExchange's datagrams through
+// Transactions give three frames of the planned sizes; the last one byte by byte.
+TEST(ProcessImage, TransactionsSendThePlannedFrames) {
+  const auto drives = generic_drives(64);
+  ProcessImage img;
+  ASSERT_TRUE(img.build(drives, kBusOptions)) << img.text();
+  CyclicExchange cx(img);
+  for (std::size_t k = 62; k < 64; ++k) {
+    const auto out = cx.outputs(k);
+    ASSERT_EQ(out.size(), 17U);
+    for (std::size_t i = 0; i < out.size(); ++i) out[i] = static_cast<std::uint8_t>(0x10 * (k - 61) + i);
+  }
+  Transactions tx;
+  ASSERT_TRUE(tx.queue(nullptr, 0, Command::FRMW, physical_address(0x1001, 0x0910), 8));
+  ASSERT_TRUE(cx.queue(tx));
+  const auto frames = tx.take_frames(core::TimePoint{} + std::chrono::milliseconds(1));
+  ASSERT_EQ(frames.size(), img.frame_count());
+  for (std::size_t f = 0; f < frames.size(); ++f) EXPECT_EQ(frames[f].size(), img.frames()[f].bytes) << f;
+  // Frame 1 starts with the FRMW, then the AL status check of slave 1, then slave 1's LRW.
+  {
+    FrameParser p(frames[0]);
+    Datagram d;
+    ASSERT_TRUE(p.next(d));
+    EXPECT_EQ(d.header.command, Command::FRMW);
+    ASSERT_TRUE(p.next(d));
+    EXPECT_EQ(d.header.command, Command::FPRD);
+    EXPECT_EQ(d.header.address, physical_address(0x1001, 0x0130));
+    ASSERT_TRUE(p.next(d));
+    EXPECT_EQ(d.header.command, Command::LRW);
+    EXPECT_EQ(d.header.address, 0U);
+  }
+  {
+    FrameParser p(frames[1]);
+    Datagram d;
+    ASSERT_TRUE(p.next(d));
+    EXPECT_EQ(d.header.command, Command::LRW);
+    EXPECT_EQ(d.header.address, 960U);  // slave 31
+  }
+  // Frame 3 [ETG.1000.4 §5.3-§5.4]: broadcast destination, source 02:00:00:00:00:01, EtherType
+  // 88A4h; EtherCAT header: length 2 × 44 = 88 (58h), type 1; LRW (0Ch), index 2 (the third frame
+  // of Transactions), logical address 7C0h (1984), length 32 with the M bit (8020h), IRQ 0, the
+  // 17 output bytes and 15 input bytes (zero), WKC 0; then the same at 7E0h without the M bit.
+  std::vector<std::uint8_t> want = {0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0x02, 0x00, 0x00, 0x00,
+                                    0x00, 0x01, 0x88, 0xA4, 0x58, 0x10};
+  for (const std::uint8_t k : {std::uint8_t{1}, std::uint8_t{2}}) {
+    const std::uint8_t lo = k == 1 ? 0xC0 : 0xE0;
+    const std::uint8_t more = k == 1 ? 0x80 : 0x00;
+    for (const std::uint8_t b : {std::uint8_t{0x0C}, std::uint8_t{0x02}, lo, std::uint8_t{0x07}, std::uint8_t{0x00},
+                                 std::uint8_t{0x00}, std::uint8_t{0x20}, more, std::uint8_t{0x00}, std::uint8_t{0x00}})
+      want.push_back(b);
+    for (std::uint8_t i = 0; i < 17; ++i) want.push_back(static_cast<std::uint8_t>(0x10 * k + i));
+    want.insert(want.end(), 15 + 2, 0x00);
+  }
+  ASSERT_EQ(want.size(), 104U);
+  EXPECT_EQ(std::vector<std::uint8_t>(frames[2].begin(), frames[2].end()), want);
 }
 
 TEST(ProcessImage, PdosLargerThanTheirSmAreRefused) {

@@ -51,6 +51,19 @@ bool CyclicExchange::queue(Transactions& tx) noexcept {
   }
   slot = CycleSlot{cycle_, 0, 0, 0, false, false};
   bool all = true;
+  // The AL status check first: it is one of the image's extra datagrams, planned at the start of
+  // the first frame (after DC's FRMW, queued before this) [ProcessImage's header comment].
+  if (options_.al_status_check && image_.slave_count() > 0) {
+    const std::size_t k = round_robin_++ % image_.slave_count();
+    if (tx.queue(this, make_tag(cycle_, kAlItem | static_cast<std::uint32_t>(k)), Command::FPRD,
+                 physical_address(image_.slave(k).station, reg::kAlStatus), 2)) {
+      ++slot.expected;
+      al_[k].cycle = cycle_;
+    } else {
+      ++counters_.refused;
+      all = false;
+    }
+  }
   const auto datagrams = image_.datagrams();
   for (std::size_t i = 0; i < datagrams.size(); ++i) {
     const CyclicDatagram& d = datagrams[i];
@@ -63,17 +76,6 @@ bool CyclicExchange::queue(Transactions& tx) noexcept {
     } else {
       ++counters_.refused;
       slot.lost = true;
-      all = false;
-    }
-  }
-  if (options_.al_status_check && image_.slave_count() > 0) {
-    const std::size_t k = round_robin_++ % image_.slave_count();
-    if (tx.queue(this, make_tag(cycle_, kAlItem | static_cast<std::uint32_t>(k)), Command::FPRD,
-                 physical_address(image_.slave(k).station, reg::kAlStatus), 2)) {
-      ++slot.expected;
-      al_[k].cycle = cycle_;
-    } else {
-      ++counters_.refused;
       all = false;
     }
   }

@@ -2,11 +2,12 @@
 // The cyclic process data exchange of a line (dunker-ethercat-coe.md "What a master must do",
 // steps 6-8 and 11; ETG.1000.4 §5.4 logical commands and working counter):
 //
-//   queue(tx)     per cycle: the image's datagrams (one LRW, LWR + LRD, or one per slave: see
-//                 ProcessImage) with the output image as the application left it, and optionally
-//                 one FPRD 0130h (AL status) of one slave, round robin. The caller may queue other
-//                 datagrams before or after (DC's FRMW first, mailbox polls); Transactions packs
-//                 them into the same frame while it has room.
+//   queue(tx)     per cycle: optionally one FPRD 0130h (AL status) of one slave, round robin, then
+//                 the image's datagrams (one LRW, LWR + LRD, or one per slave, in up to
+//                 ProcessImage::kMaxFrames frames: see ProcessImage) with the output image as the
+//                 application left it. The caller may queue other datagrams before or after (DC's
+//                 FRMW first, mailbox polls); Transactions packs them into the same frames while
+//                 they have room, as ProcessImage planned.
 //   on_result()   copies the inputs of each datagram that came back with its expected working
 //                 counter into the input image (so the input image holds the last good inputs),
 //                 and counts the cycle: good, working counter wrong, or lost.
@@ -23,8 +24,8 @@
 //     every slave Answered. The check also catches a slave that dropped its state while the
 //     counter still looks right (digest step 11: "AL Status (an unsolicited drop ...)").
 //
-// The output image and the input image are fixed arrays (one frame's worth of data); nothing
-// here allocates. The ProcessImage must outlive the exchange.
+// The output image and the input image are fixed arrays (ProcessImage::kMaxBytes: the data of
+// kMaxFrames frames); nothing here allocates. The ProcessImage must outlive the exchange.
 #include <array>
 #include <cstddef>
 #include <cstdint>

@@ -44,7 +44,7 @@ std::string_view to_string(ImageError e) noexcept {
     case ImageError::InputsBeyondSm: return "inputs larger than SM3";
     case ImageError::SmOverlap: return "SM2 and SM3 overlap";
     case ImageError::SameFmmu: return "invalid FMMU choice";
-    case ImageError::FrameTooLarge: return "cyclic frame larger than one Ethernet frame";
+    case ImageError::FrameTooLarge: return "cyclic datagrams need more Ethernet frames than a cycle sends";
   }
   return "?";
 }
@@ -104,6 +104,7 @@ bool ProcessImage::fail(ImageError e, const char* fmt, ...) noexcept {
   datagram_count_ = 0;
   size_ = 0;
   expected_wkc_ = 0;
+  frame_count_ = 0;
   frame_bytes_ = 0;
   return false;
 }
@@ -164,11 +165,78 @@ bool ProcessImage::place_sms(std::size_t k, const ImageSlave& in) noexcept {
   return true;
 }
 
-void ProcessImage::add_datagram(Command c, std::uint32_t offset, std::uint32_t length, std::uint16_t wkc,
+std::size_t ProcessImage::room() const noexcept {
+  // As Transactions::queue(): a frame takes a datagram while it has fewer than 32 and room for
+  // its 12 bytes of header and WKC and its data within 1514 bytes [ETG.1000.4 §5.3-§5.4].
+  if (planned_frames_ == 0 || open_datagrams_ >= kMaxDatagramsPerFrame) return 0;
+  const std::size_t used = open_bytes_ + kDatagramOverhead;
+  return used < kMaxFrameSize ? kMaxFrameSize - used : 0;
+}
+
+void ProcessImage::open_frame() noexcept {
+  ++planned_frames_;
+  open_datagrams_ = 0;
+  open_bytes_ = kEthernetHeaderSize + kEcatHeaderSize;
+}
+
+bool ProcessImage::add_datagram(Command c, std::uint32_t offset, std::uint32_t length, std::uint16_t wkc,
                                 std::uint16_t slave) noexcept {
-  if (datagram_count_ >= datagrams_.size()) return;  // cannot happen: at most 2 per slave
-  datagrams_[datagram_count_++] =
-      CyclicDatagram{c, options_.logical_base + offset, offset, static_cast<std::uint16_t>(std::min<std::uint32_t>(length, 0xFFFF)), wkc, slave};
+  if (length > room() && open_datagrams_ > 0) open_frame();
+  if (length > room()) {
+    return fail(ImageError::FrameTooLarge, "%u bytes of process data in one datagram: one Ethernet frame carries %zu", length,
+                kMaxDatagramData);
+  }
+  if (datagram_count_ >= datagrams_.size()) {  // cannot happen: at most 2 per slave
+    return fail(ImageError::FrameTooLarge, "more than %zu cyclic datagrams", datagrams_.size());
+  }
+  datagrams_[datagram_count_++] = CyclicDatagram{c, options_.logical_base + offset, offset, static_cast<std::uint16_t>(length), wkc,
+                                                 slave, static_cast<std::uint8_t>(std::min<std::size_t>(planned_frames_ - 1, 0xFF))};
+  ++open_datagrams_;
+  open_bytes_ += kDatagramOverhead + length;
+  if (planned_frames_ <= kMaxFrames) {
+    frames_[planned_frames_ - 1] = CyclicFrame{open_datagrams_, std::max(open_bytes_, kMinFrameSize)};
+  }
+  return true;
+}
+
+bool ProcessImage::add_whole(Command command) noexcept {
+  // Working counter of a slave in a logical datagram [ETG.1000.4 §5.4]: read +1; write +1 (LWR)
+  // or +2 (LRW).
+  const auto wkc_of = [command](const SlaveImage& s) {
+    const int reads = s.input_bytes > 0 ? 1 : 0;
+    const int writes = s.output_bytes > 0 ? 1 : 0;
+    switch (command) {
+      case Command::LWR: return writes;
+      case Command::LRD: return reads;
+      default: return reads + 2 * writes;
+    }
+  };
+  std::size_t k = 0;
+  while (k < count_) {
+    // One datagram: the slaves from k on while they fit in the newest frame's room; a slave that
+    // does not fit starts the next datagram (in a new frame, as Transactions::queue() would put it).
+    const std::uint32_t lo = slaves_[k].output_offset;
+    std::uint32_t hi = lo;
+    int wkc = 0;
+    while (k < count_) {
+      const SlaveImage& s = slaves_[k];
+      const std::uint32_t bytes = std::uint32_t{s.output_bytes} + s.input_bytes;
+      if (hi - lo + bytes > room()) {
+        if (hi > lo) break;
+        if (open_datagrams_ > 0) {
+          open_frame();
+          continue;
+        }
+        return fail(ImageError::FrameTooLarge, "slave %zu (0x%04X): %u bytes of process data, one Ethernet frame carries %zu",
+                    k + 1, s.station, bytes, kMaxDatagramData);
+      }
+      hi += bytes;
+      wkc += wkc_of(s);
+      ++k;
+    }
+    if (hi > lo && !add_datagram(command, lo, hi - lo, static_cast<std::uint16_t>(wkc), 0xFFFF)) return false;
+  }
+  return true;
 }
 
 bool ProcessImage::build(std::span<const ImageSlave> slaves, const ImageOptions& options) noexcept {
@@ -180,7 +248,9 @@ bool ProcessImage::build(std::span<const ImageSlave> slaves, const ImageOptions&
   datagram_count_ = 0;
   size_ = 0;
   expected_wkc_ = 0;
+  frame_count_ = 0;
   frame_bytes_ = 0;
+  planned_frames_ = 0;
   if (slaves.size() > kMaxSlaves) {
     return fail(ImageError::TooManySlaves, "%zu slaves with process data: at most %zu", slaves.size(), kMaxSlaves);
   }
@@ -214,12 +284,16 @@ bool ProcessImage::build(std::span<const ImageSlave> slaves, const ImageOptions&
   count_ = slaves.size();
   size_ = offset;
 
+  // The first frame starts with the extra datagrams (queued first, DC's FRMW first).
+  open_frame();
+  open_datagrams_ = options_.extra_datagrams;
+  open_bytes_ += kDatagramOverhead * options_.extra_datagrams + options_.extra_data_bytes;
+  frames_[0] = CyclicFrame{open_datagrams_, std::max(open_bytes_, kMinFrameSize)};
   if (options_.datagrams == CyclicDatagrams::WholeImage) {
     if (size_ > 0 && !any_lrd_lwr) {
-      add_datagram(Command::LRW, 0, size_, lrw_wkc, 0xFFFF);
+      if (!add_whole(Command::LRW)) return false;
     } else if (size_ > 0) {
-      add_datagram(Command::LWR, 0, size_, writers_wkc, 0xFFFF);
-      add_datagram(Command::LRD, 0, size_, readers_wkc, 0xFFFF);
+      if (!add_whole(Command::LWR) || !add_whole(Command::LRD)) return false;
     }
   } else {
     for (std::size_t k = 0; k < count_; ++k) {
@@ -227,29 +301,27 @@ bool ProcessImage::build(std::span<const ImageSlave> slaves, const ImageOptions&
       const auto slave = static_cast<std::uint16_t>(k);
       if (s.output_bytes + s.input_bytes == 0) continue;
       if (!s.lrd_lwr) {
-        add_datagram(Command::LRW, s.output_offset, std::uint32_t{s.output_bytes} + s.input_bytes, s.expected_wkc, slave);
+        if (!add_datagram(Command::LRW, s.output_offset, std::uint32_t{s.output_bytes} + s.input_bytes, s.expected_wkc, slave))
+          return false;
         continue;
       }
-      if (s.output_bytes > 0) add_datagram(Command::LWR, s.output_offset, s.output_bytes, 1, slave);
-      if (s.input_bytes > 0) add_datagram(Command::LRD, s.input_offset, s.input_bytes, 1, slave);
+      if (s.output_bytes > 0 && !add_datagram(Command::LWR, s.output_offset, s.output_bytes, 1, slave)) return false;
+      if (s.input_bytes > 0 && !add_datagram(Command::LRD, s.input_offset, s.input_bytes, 1, slave)) return false;
     }
   }
   expected_wkc_ = 0;
-  std::size_t data = options_.extra_data_bytes;
   for (std::size_t i = 0; i < datagram_count_; ++i) {
     expected_wkc_ = static_cast<std::uint16_t>(expected_wkc_ + datagrams_[i].expected_wkc);
-    data += datagrams_[i].length;
   }
-  // Ethernet II header 14 + EtherCAT header 2 + 12 per datagram + the data [ETG.1000.4 §5.3-§5.4].
-  const std::size_t count = datagram_count_ + options_.extra_datagrams;
-  const std::size_t bytes = kEthernetHeaderSize + kEcatHeaderSize + kDatagramOverhead * count + data;
-  if (bytes > kMaxFrameSize || count > kMaxDatagramsPerFrame) {
+  if (planned_frames_ > kMaxFrames) {
     return fail(ImageError::FrameTooLarge,
-                "process image of %u bytes: the cyclic frame needs %zu bytes in %zu datagrams (%zu for the image), one "
-                "Ethernet frame carries %zu bytes and %zu datagrams",
-                offset, bytes, count, datagram_count_, kMaxFrameSize, kMaxDatagramsPerFrame);
+                "process image of %u bytes: its %zu cyclic datagrams (and %zu more) need %zu Ethernet frames, a cycle "
+                "sends at most %zu (of 1514 bytes and 32 datagrams each)",
+                offset, datagram_count_, options_.extra_datagrams, planned_frames_, kMaxFrames);
   }
-  frame_bytes_ = std::max(bytes, kMinFrameSize);
+  frame_count_ = planned_frames_;
+  frame_bytes_ = 0;
+  for (std::size_t i = 0; i < frame_count_; ++i) frame_bytes_ += frames_[i].bytes;
   built_ = true;
   return true;
 }

@@ -27,6 +27,17 @@
 // sends one LWR and one LRD over the whole image (twice the bytes), the per-slave mode an LWR+LRD
 // pair for those slaves only.
 //
+// Frames: the cycle's datagrams may span up to kMaxFrames Ethernet frames (each at most 1514
+// bytes and 32 datagrams), as SOEM and the IgH master split a large image over several frames.
+// They are planned the way Transactions::queue() packs them: in queue order, each datagram into
+// the newest frame while it has room for it, else into a new frame. The extra datagrams (DC's
+// FRMW, then the AL status check) are queued first and so sit at the start of the first frame.
+// A whole-image LRW (or LWR/LRD) that does not fit in the room left in a frame is cut at slave
+// boundaries into several datagrams (one per frame), each with the working counter of its slaves.
+// kMaxFrames is 4: four full frames take 4 x 1538 bytes x 80 ns = 492 us on the wire, half of a
+// 1 ms cycle (fits() refuses more at 1 kHz anyway); 64 slaves with one LRW each need 3 (66
+// datagrams, 32 per frame).
+//
 // Frame time on the wire at 100 Mbit/s: 8 bytes preamble and SFD + the frame (at least 60 bytes)
 // + 4 bytes FCS + 12 bytes inter-frame gap, 80 ns per byte [IEEE 802.3 §4.4.2, §3.1.1].
 #include <array>
@@ -82,8 +93,8 @@ enum class CyclicDatagrams : std::uint8_t {
 struct ImageOptions {
   std::uint32_t logical_base = 0;  // logical address of the image's first byte
   CyclicDatagrams datagrams = CyclicDatagrams::WholeImage;
-  // Other datagrams the cycle puts into the same frame (DC's FRMW, the AL status check of
-  // CyclicExchange: 12 + 2 bytes): counted in the frame size.
+  // Other datagrams the cycle queues before the image's, so at the start of its first frame (DC's
+  // FRMW: 12 + 8 bytes, then the AL status check of CyclicExchange: 12 + 2 bytes).
   std::size_t extra_datagrams = 1;
   std::size_t extra_data_bytes = 2;
 };
@@ -96,7 +107,7 @@ enum class ImageError : std::uint8_t {
   InputsBeyondSm,   // a slave's inputs larger than its SM3's room
   SmOverlap,        // SM2's and SM3's buffers overlap
   SameFmmu,         // outputs and inputs on one FMMU, or an FMMU index beyond 15
-  FrameTooLarge,    // the cyclic datagrams do not fit in one Ethernet frame
+  FrameTooLarge,    // the cyclic datagrams do not fit in ProcessImage::kMaxFrames Ethernet frames
 };
 std::string_view to_string(ImageError e) noexcept;
 
@@ -125,14 +136,24 @@ struct CyclicDatagram {
   std::uint16_t length = 0;
   std::uint16_t expected_wkc = 0;
   std::uint16_t slave = 0xFFFF;    // PerSlave: the slave (index into slaves()); WholeImage: FFFFh
+  std::uint8_t frame = 0;          // the frame of the cycle it goes in (0: the first)
+};
+
+// One Ethernet frame of the cycle.
+struct CyclicFrame {
+  std::size_t datagrams = 0;  // all of them: the extra ones (first frame) and the image's
+  std::size_t bytes = 0;      // Ethernet + EtherCAT headers + datagrams, padded to 60, without FCS
 };
 
 class ProcessImage {
  public:
   static constexpr std::size_t kMaxSlaves = 64;
   static constexpr std::size_t kMaxDatagrams = 2 * kMaxSlaves;
-  static constexpr std::size_t kMaxBytes = kMaxDatagramData;  // one datagram in one frame
-  // Transactions::kMaxDatagramsPerFrame (one frame per cycle).
+  // Frames per cycle (see the header comment for why 4).
+  static constexpr std::size_t kMaxFrames = 4;
+  // Image bytes: as much as kMaxFrames frames of one datagram each carry.
+  static constexpr std::size_t kMaxBytes = kMaxFrames * kMaxDatagramData;
+  // Transactions::kMaxDatagramsPerFrame.
   static constexpr std::size_t kMaxDatagramsPerFrame = 32;
 
   // Lays out `slaves` (line order). Returns ok(); on failure error() and text() say why and the
@@ -150,19 +171,23 @@ class ProcessImage {
   [[nodiscard]] std::span<const CyclicDatagram> datagrams() const noexcept { return {datagrams_.data(), datagram_count_}; }
   [[nodiscard]] std::uint16_t expected_wkc() const noexcept { return expected_wkc_; }
 
-  // The cycle's frame: Ethernet + EtherCAT headers + the datagrams (+ the extra ones), padded to
-  // 60 bytes, without FCS.
+  // The cycle's frames, in the order they are sent.
+  [[nodiscard]] std::span<const CyclicFrame> frames() const noexcept { return {frames_.data(), frame_count_}; }
+  [[nodiscard]] std::size_t frame_count() const noexcept { return frame_count_; }
+  // All the cycle's frames: Ethernet + EtherCAT headers + the datagrams (+ the extra ones), each
+  // padded to 60 bytes, without FCS.
   [[nodiscard]] std::size_t frame_bytes() const noexcept { return frame_bytes_; }
-  // On the wire: + preamble/SFD 8, FCS 4, inter-frame gap 12.
-  [[nodiscard]] std::size_t wire_bytes() const noexcept { return frame_bytes_ + 24; }
-  // Time the frame occupies the wire at 100 Mbit/s.
+  // On the wire: + preamble/SFD 8, FCS 4, inter-frame gap 12 per frame.
+  [[nodiscard]] std::size_t wire_bytes() const noexcept { return frame_bytes_ + 24 * frame_count_; }
+  // Time the frames occupy the wire at 100 Mbit/s (sent back to back).
   [[nodiscard]] core::Duration wire_time() const noexcept { return core::Duration(80 * static_cast<std::int64_t>(wire_bytes())); }
-  // Time from sending the frame to having it back: the wire time plus every slave's forwarding
-  // delay out and back (`per_slave`, about 1 µs for an ESC with two 100BASE-TX ports).
+  // Time from sending the first frame to having the last back: the wire time of all of them plus
+  // every slave's forwarding delay out and back (`per_slave`, about 1 µs for an ESC with two
+  // 100BASE-TX ports).
   [[nodiscard]] core::Duration round_trip(core::Duration per_slave = std::chrono::microseconds(1)) const noexcept {
     return wire_time() + per_slave * static_cast<std::int64_t>(count_);
   }
-  // The frame is back within `share` of the cycle (default: half, leaving the rest for the
+  // The frames are back within `share` of the cycle (default: half, leaving the rest for the
   // mailbox traffic and the application).
   [[nodiscard]] bool fits(core::Duration cycle, double share = 0.5,
                           core::Duration per_slave = std::chrono::microseconds(1)) const noexcept {
@@ -172,7 +197,14 @@ class ProcessImage {
  private:
   bool fail(ImageError e, const char* fmt, ...) noexcept __attribute__((format(printf, 3, 4)));
   bool place_sms(std::size_t k, const ImageSlave& in) noexcept;
-  void add_datagram(Command c, std::uint32_t offset, std::uint32_t length, std::uint16_t wkc, std::uint16_t slave) noexcept;
+  // Plans a datagram of `length` data bytes as Transactions::queue() packs it; false when it would
+  // need a frame beyond kMaxFrames.
+  bool add_datagram(Command c, std::uint32_t offset, std::uint32_t length, std::uint16_t wkc, std::uint16_t slave) noexcept;
+  // Data bytes the newest frame still takes in one more datagram (0: none, it is full).
+  [[nodiscard]] std::size_t room() const noexcept;
+  void open_frame() noexcept;
+  // WholeImage: `command` over the image, cut at slave boundaries where a frame's room ends.
+  bool add_whole(Command command) noexcept;
 
   ImageOptions options_{};
   std::array<SlaveImage, kMaxSlaves> slaves_{};
@@ -181,7 +213,14 @@ class ProcessImage {
   std::size_t datagram_count_ = 0;
   std::uint32_t size_ = 0;
   std::uint16_t expected_wkc_ = 0;
+  std::array<CyclicFrame, kMaxFrames> frames_{};
+  std::size_t frame_count_ = 0;
   std::size_t frame_bytes_ = 0;
+  // Frames planned so far (may pass kMaxFrames while planning: the refusal says how many), and
+  // the newest one's datagrams and bytes.
+  std::size_t planned_frames_ = 0;
+  std::size_t open_datagrams_ = 0;
+  std::size_t open_bytes_ = 0;
   bool built_ = false;
   ImageError error_ = ImageError::None;
   core::FixedString<200> text_{};

@@ -71,7 +71,11 @@ struct TransactionCounters {
 
 class Transactions {
  public:
-  static constexpr std::size_t kMaxFrames = 8;
+  // Frame buffers. A cycle sends up to ProcessImage::kMaxFrames (4) cyclic frames plus the
+  // mailbox and set-up traffic after them (a frame or a few), and a frame stays in flight until the
+  // next cycle's receive matches or expires it (one more cycle when that cycle comes early against
+  // its deadline): two cycles of 4 + 4 frames. 8 held only one frame's image and its mailbox traffic.
+  static constexpr std::size_t kMaxFrames = 16;
   static constexpr std::size_t kMaxDatagramsPerFrame = 32;
 
   explicit Transactions(const MacAddress& source = MacAddress{0x02, 0, 0, 0, 0, 0x01}) noexcept;
