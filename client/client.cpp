@@ -860,7 +860,8 @@ class Client::Impl : public dds::DataReaderListener, public dds::DataWriterListe
                   in.achieved_period_ns(), in.lateness_p50_ns(), in.lateness_p99_ns(),
                   in.lateness_max_ns(), in.cycles(),      in.overruns(),
                   in.frames_sent(),    in.frames_received(), in.frames_lost(),
-                  in.frames_dropped(), in.errors()};
+                  in.frames_dropped(), in.errors(),  in.clock_sync(),
+                  in.clock_difference_ns(), in.clock_master_offset_ns()};
       std::lock_guard lock(mutex_);
       buses_[{b.gateway, b.bus}] = std::move(b);
     });

@@ -126,6 +126,11 @@ struct BusStatus {
   std::uint64_t frames_lost = 0;
   std::uint64_t frames_dropped = 0;
   std::uint64_t errors = 0;
+  // Distributed clocks (EtherCAT): clock_sync false when the bus reports no figure (no DC, or
+  // before the first measurement); then the two figures are 0.
+  bool clock_sync = false;
+  std::int64_t clock_difference_ns = 0;     // largest |system time difference| of the last round
+  std::int64_t clock_master_offset_ns = 0;  // the master's clock minus the reference clock
 };
 
 // Mirrors core::Command in user units; kind/mode use the names of core/axis_types.cpp.

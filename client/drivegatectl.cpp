@@ -613,8 +613,12 @@ int cmd_buses(Context& ctx) {
           .field("frames_received", b.frames_received)
           .field("frames_lost", b.frames_lost)
           .field("frames_dropped", b.frames_dropped)
-          .field("errors", b.errors)
-          .end_object();
+          .field("errors", b.errors);
+      // Absent rather than 0 without a figure (a bus without distributed clocks).
+      if (b.clock_sync) {
+        w.field("clock_difference_ns", b.clock_difference_ns).field("clock_master_offset_ns", b.clock_master_offset_ns);
+      }
+      w.end_object();
       std::cout << w.str() << "\n";
       continue;
     }
@@ -626,6 +630,10 @@ int cmd_buses(Context& ctx) {
               << " overruns " << b.overruns << "  frames sent " << b.frames_sent << " received "
               << b.frames_received << " lost " << b.frames_lost << " dropped " << b.frames_dropped << " errors "
               << b.errors << "\n";
+    if (b.clock_sync) {
+      std::cout << "  distributed clocks: max difference " << b.clock_difference_ns << "ns  master - reference "
+                << b.clock_master_offset_ns << "ns\n";
+    }
   }
   return 0;
 }

@@ -34,6 +34,16 @@ struct BusCounters {
   std::uint64_t errors = 0;          // bus errors (error frames, working-counter errors, ...)
 };
 
+// How closely the bus holds its devices' clocks together (EtherCAT distributed clocks: the system
+// time difference register 092Ch, ETG.1000.4 §9.2.3). `valid` is false on a bus that does not
+// synchronise clocks, and before its first complete measurement, so a client tells "no figure"
+// from "0 ns".
+struct ClockSync {
+  bool valid = false;
+  std::int64_t max_difference_ns = 0;          // largest |device - reference clock| of the last round
+  std::int64_t master_minus_reference_ns = 0;  // the master's clock minus the reference clock
+};
+
 class Bus {
  public:
   virtual ~Bus() = default;
@@ -82,6 +92,8 @@ class Bus {
 
   // May be called from any thread while the bus runs (implementations keep relaxed atomics).
   [[nodiscard]] virtual BusCounters counters() const noexcept = 0;
+  // Same threading as counters(). The default: the bus synchronises no clocks.
+  [[nodiscard]] virtual ClockSync clock_sync() const noexcept { return {}; }
 };
 
 }  // namespace drivegate::core

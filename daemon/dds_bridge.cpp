@@ -1209,6 +1209,9 @@ void DdsBridge::Impl::publish_bus_status() {
     out.frames_lost(s.counters.frames_lost);
     out.frames_dropped(s.counters.frames_dropped);
     out.errors(s.counters.errors);
+    out.clock_sync(s.clock_sync.valid);
+    out.clock_difference_ns(s.clock_sync.valid ? s.clock_sync.max_difference_ns : 0);
+    out.clock_master_offset_ns(s.clock_sync.valid ? s.clock_sync.master_minus_reference_ns : 0);
     bus_w_->write(&out);
   }
 }

@@ -186,6 +186,7 @@ BusStatus Gateway::bus_status(std::size_t bus) const {
   }
   s.counters = b.bus->counters();
   s.counters.frames_dropped += b.runner->dropped_outputs();
+  s.clock_sync = b.bus->clock_sync();
   return s;
 }
 

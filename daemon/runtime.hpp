@@ -54,6 +54,7 @@ struct BusStatus {
   std::uint64_t cycles = 0;
   std::uint64_t overruns = 0;
   core::BusCounters counters;
+  core::ClockSync clock_sync;  // distributed clocks' figures; valid false on a bus without
 };
 
 // Outputs of the cycle threads, with axis ids translated to global ones (index into axes()).

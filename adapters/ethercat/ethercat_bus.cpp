@@ -414,8 +414,15 @@ void EthercatBus::dc_step(core::TimePoint now) noexcept {
   bool warning = false;
   while (dc_->take_event(text, warning)) bus_event(warning ? core::EventKind::Warning : core::EventKind::Info, text.view());
   const DcCyclic& c = dc_->cyclic();
-  dc_difference_.store(c.configured() && c.difference_valid() ? static_cast<std::int64_t>(c.max_abs_difference_ns()) : -1,
-                       std::memory_order_relaxed);
+  // A line whose only DC slave is the reference clock has no 092Ch to read: nothing differs (0)
+  // once the reference's time comes back.
+  std::int64_t difference = -1;
+  if (c.configured() && c.difference_valid()) {
+    difference = static_cast<std::int64_t>(c.max_abs_difference_ns());
+  } else if (c.configured() && c.station_count() == 0 && c.has_reference_time()) {
+    difference = 0;
+  }
+  dc_difference_.store(difference, std::memory_order_relaxed);
   dc_master_offset_.store(c.configured() && c.has_reference_time() ? c.master_minus_reference_ns() : 0,
                           std::memory_order_relaxed);
 }

@@ -147,11 +147,22 @@ class EthercatBus final : public core::Bus, private EmergencySink, private Datag
   // Distributed clocks (bus thread): the line's setup, the cyclic FRMW, per slave its verdict.
   [[nodiscard]] const BusDc& dc() const noexcept { return *dc_; }
   // Any thread: the largest |system time difference| (092Ch) of the DC slaves' last complete
-  // round in ns, -1 before one completed or without DC; the master's system time minus the
+  // round in ns (0 when the reference clock is the only DC slave), -1 before one completed or
+  // without DC; the master's system time minus the
   // reference clock's at the last cycle (ns, 0 without DC).
   [[nodiscard]] std::int64_t dc_max_difference_ns() const noexcept { return dc_difference_.load(std::memory_order_relaxed); }
   [[nodiscard]] std::int64_t dc_master_minus_reference_ns() const noexcept {
     return dc_master_offset_.load(std::memory_order_relaxed);
+  }
+  // Both figures for the bus status: valid once a 092Ch round completed (-1 before, without DC).
+  core::ClockSync clock_sync() const noexcept override {
+    core::ClockSync s;
+    const std::int64_t d = dc_max_difference_ns();
+    if (d < 0) return s;
+    s.valid = true;
+    s.max_difference_ns = d;
+    s.master_minus_reference_ns = dc_master_minus_reference_ns();
+    return s;
   }
 
  private:

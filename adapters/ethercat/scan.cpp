@@ -120,7 +120,7 @@ void EthercatScan::poll(core::TimePoint now, Transactions& tx) {
         if (run.running == 0) {
           if (run.next < run.todo.size()) {
             run.current = run.todo[run.next++];
-            run.running = run.client->upload_value(run.current.index, run.current.subindex);
+            run.running = coe_request(run);
             if (run.running == 0) {
               slaves_[k].notes.push_back("the CoE client refused a request for " + hex4h(run.current.index));
               run.finished = true;
@@ -138,6 +138,15 @@ void EthercatScan::poll(core::TimePoint now, Transactions& tx) {
       break;
     }
     case Phase::Done: break;
+  }
+}
+
+CoeSdoId EthercatScan::coe_request(CoeRun& run) {
+  const Request& r = run.current;
+  switch (r.what) {
+    case Read::OdList: return run.client->od_list(OdListType::All, run.list);
+    case Read::ObjectName: return run.client->object_description(r.index, run.name);
+    default: return run.client->upload_value(r.index, r.subindex);
   }
 }
 
@@ -189,6 +198,13 @@ void EthercatScan::boot_finished() {
         for (std::uint8_t sub = 1; sub <= 4; ++sub) run.todo.push_back({Read::Identity, 0x1018, sub, false, 0});
         run.todo.push_back({Read::AssignCount, kRxAssign, 0, false, 0});
         run.todo.push_back({Read::AssignCount, kTxAssign, 0, true, 0});
+        // SDO Information only where the SII offers it: a slave without it may not answer at
+        // all, and the scan would wait for its timeout [ETG.1000.6 Table 21, CoE details].
+        s.sdo_info = (s.coe_details & coe_details::kSdoInfo) != 0;
+        if (s.sdo_info && settings_.max_objects > 0) {
+          run.list.assign(settings_.max_objects, 0);
+          run.todo.push_back({Read::OdList, 0, 0, false, 0});
+        }
       } else {
         s.notes.push_back("its SII mailbox sizes cannot carry CoE SDO requests: objects not read");
       }
@@ -265,6 +281,30 @@ void EthercatScan::coe_answer(std::size_t k, const Request& r, const CoeSdoResul
       if (r.pdo < pdos.size())
         pdos[r.pdo].entries.push_back({static_cast<std::uint16_t>(v >> 16), static_cast<std::uint8_t>((v >> 8) & 0xFFU),
                                        static_cast<std::uint8_t>(v & 0xFFU)});
+      break;
+    case Read::OdList:
+      if (!ok) {
+        s.notes.push_back("SDO Information (Get OD List): " + abort_words(result.abort_code));
+        break;
+      }
+      s.objects_read = true;
+      s.objects.clear();
+      for (std::size_t i = 0; i < result.size && i < run.list.size(); ++i) s.objects.push_back({run.list[i], 0, {}});
+      if (settings_.object_names)
+        for (std::size_t i = 0; i < s.objects.size(); ++i)
+          run.todo.push_back({Read::ObjectName, s.objects[i].index, 0, false, i});
+      break;
+    case Read::ObjectName:
+      if (!ok) {
+        if (run.names_failed++ == 0) run.first_name_abort = result.abort_code;
+      } else if (r.pdo < s.objects.size()) {
+        s.objects[r.pdo].object_code = result.info.object_code;
+        s.objects[r.pdo].name.assign(run.name.data(), result.size);
+      }
+      if (r.pdo + 1 == s.objects.size() && run.names_failed > 0)
+        s.notes.push_back("SDO Information: " + std::to_string(run.names_failed) + " of " +
+                          std::to_string(s.objects.size()) + " object descriptions failed, the first with " +
+                          abort_words(run.first_name_abort));
       break;
   }
   if (run.assign_rx_ok || run.assign_tx_ok) s.pdo_source = "1C12h/1C13h";
@@ -369,6 +409,28 @@ std::uint32_t pdo_bytes(const std::vector<ScannedPdo>& pdos) {
   return (bits + 7) / 8;
 }
 
+// The OD list by area [CiA 301 §7.4.1 object dictionary structure; ETG.1000.6 §5.6.7]:
+// "97 objects: 26 communication (1000h-1FFFh), 12 manufacturer (2000h-5FFFh), 59 profile (6000h-9FFFh)".
+std::string objects_words(const std::vector<ScannedObject>& objects) {
+  std::size_t comm = 0, manufacturer = 0, profile = 0, other = 0;
+  for (const auto& o : objects) {
+    if (o.index >= 0x1000 && o.index <= 0x1FFF) ++comm;
+    else if (o.index >= 0x2000 && o.index <= 0x5FFF) ++manufacturer;
+    else if (o.index >= 0x6000 && o.index <= 0x9FFF) ++profile;
+    else ++other;
+  }
+  std::string s = std::to_string(objects.size()) + (objects.size() == 1 ? " object" : " objects");
+  std::string parts;
+  const auto add = [&](std::size_t n, const char* what) {
+    if (n != 0) parts += (parts.empty() ? "" : ", ") + std::to_string(n) + " " + what;
+  };
+  add(comm, "communication (1000h-1FFFh)");
+  add(manufacturer, "manufacturer (2000h-5FFFh)");
+  add(profile, "profile (6000h-9FFFh)");
+  add(other, "other");
+  return parts.empty() ? s : s + ": " + parts;
+}
+
 std::string identity_words(const SiiIdentity& id) {
   return "vendor " + hex(id.vendor_id, 8) + " product " + hex(id.product_code, 8) + " revision " +
          hex(id.revision, 8);
@@ -453,6 +515,19 @@ core::ScanResult ethercat_scan_result(const std::vector<ScannedSlave>& slaves, c
       if (!s.pdo_source.empty())
         d.notes.push_back("PDOs (" + s.pdo_source + "): outputs " + pdo_words(s.rxpdos) + "; inputs " +
                           pdo_words(s.txpdos));
+      if (s.objects_read) {
+        d.notes.push_back("object dictionary (SDO Information): " + objects_words(s.objects));
+        // With objects=1: one line per object that was described.
+        for (const auto& o : s.objects) {
+          if (o.name.empty() && o.object_code == 0) continue;
+          const char* code = o.object_code == object_code::kArray    ? " (array)"
+                             : o.object_code == object_code::kRecord ? " (record)"
+                                                                     : "";
+          d.notes.push_back("  " + hex4h(o.index) + " " + o.name + code);
+        }
+      } else if (s.coe && !s.sdo_info) {
+        d.notes.push_back("object dictionary: not listed (the SII does not offer SDO Information)");
+      }
       // 1018h differs from the SII: the SII is what the bus checks at every start.
       const auto& o = s.identity_object;
       if ((o[0] && *o[0] != s.identity.vendor_id) || (o[1] && *o[1] != s.identity.product_code))
@@ -567,7 +642,7 @@ config::BusPlan ethercat_scan_plan(const core::ScanRequest& request, const confi
     throw core::ScanError("sim: a simulated line exists only inside a gateway; scan the interface drivegate-sim "
                           "serves (ethercat:IFACE)");
   if (interface == "raw") interface.clear();  // ethercat:raw?interface=eth1
-  const std::vector<std::string> allowed{"interface", "sdo_timeout", "transition_timeout"};
+  const std::vector<std::string> allowed{"interface", "sdo_timeout", "transition_timeout", "objects"};
   std::ostringstream y;
   y << "gateway: { name: scan }\nbuses:\n  - name: scan\n    type: ethercat\n    cycle_time: 1ms\n"
     << "    options:\n      transport: raw\n";
@@ -581,7 +656,12 @@ config::BusPlan ethercat_scan_plan(const core::ScanRequest& request, const confi
   for (const auto& [key, value] : options) {
     if (std::find(allowed.begin(), allowed.end(), key) == allowed.end())
       throw core::ScanError("\"" + key + "\" is not a scan option of ethercat; it takes interface, sdo_timeout, "
-                            "transition_timeout");
+                            "transition_timeout, objects");
+    if (key == "objects") {  // the scan's own, not a bus option
+      if (value != "0" && value != "1")
+        throw core::ScanError("objects=\"" + value + "\": 1 lists every object's name, 0 (the default) counts them");
+      continue;
+    }
     if (!plain_value(value)) throw core::ScanError(key + "=\"" + value + "\": a value is letters, digits, '.', '_' and '-'");
     if (key == "interface") {
       if (named) throw core::ScanError("the interface is named twice");
@@ -607,6 +687,12 @@ config::BusPlan ethercat_scan_plan(const core::ScanRequest& request, const confi
   }
 }
 
+bool ethercat_scan_object_names(const core::ScanRequest& request) {
+  for (const auto& [key, value] : where_options(request.where))
+    if (key == "objects") return value == "1";
+  return false;
+}
+
 core::ScanResult run_ethercat_scan(const config::BusPlan& plan, const core::ScanRequest& request,
                                    const config::BusTypeRegistry& types) {
   std::vector<std::string> profile_notes;
@@ -623,6 +709,7 @@ core::ScanResult run_ethercat_scan(const config::BusPlan& plan, const core::Scan
   EthercatScanSettings settings;
   settings.frame_timeout = std::max<core::Duration>(request.answer_timeout, 1ms);
   settings.sdo_timeout = o.sdo_timeout;
+  settings.object_names = ethercat_scan_object_names(request);
   SteadyScanClock clock;
   const auto start = clock.now();
   std::string line_text;

@@ -12,7 +12,12 @@
 //      the other over a CoeSdoClient: 1000h, 1018h:01..04, 1C12h:00 and 1C13h:00, each assigned
 //      PDO (1C12h:n, 1C13h:n) and its mapping (PDO:00, PDO:n) [ETG.1000.6 §5.6.7.4 PDO
 //      assignment and mapping]. Without 1C12h/1C13h the PDOs are the SII's.
-//   4. The line stays in PRE-OP (a slave whose PRE-OP failed stays where it stopped, INIT mostly).
+//   4. Per CoE slave whose SII general category says SDO Information (CoE details bit 1,
+//      ETG.1000.6 Table 21): Get OD List of all objects [ETG.1000.6 §5.6.3.3], its fragments
+//      joined; with `objects=1` (EthercatScanSettings::object_names) each object's name by Get
+//      Object Description [§5.6.3.5]. The table shows the count by area (communication,
+//      manufacturer, profile), with the option every object with its name.
+//   5. The line stays in PRE-OP (a slave whose PRE-OP failed stays where it stopped, INIT mostly).
 //
 // The device profile of a slave: one of the profile's `ethercat.identities` is its SII identity
 // (revision where the profile names one), else a profile without identities (generic-cia402) when
@@ -47,6 +52,15 @@ struct EthercatScanSettings {
   core::Duration frame_timeout = std::chrono::milliseconds(100);  // a frame not back by then is lost
   core::Duration sdo_timeout = std::chrono::seconds(1);           // one CoE request
   core::Duration budget = std::chrono::seconds(30);               // the whole scan at most
+  bool object_names = false;       // objects=1: every object's name (one request each)
+  std::size_t max_objects = 2048;  // an OD list longer than this is not read (05040005h)
+};
+
+// An object of the slave's dictionary as SDO Information lists it.
+struct ScannedObject {
+  std::uint16_t index = 0;
+  std::uint8_t object_code = 0;  // 7 variable, 8 array, 9 record; 0 when not described
+  std::string name;              // "" when not read
 };
 
 struct ScannedPdoEntry {
@@ -80,6 +94,9 @@ struct ScannedSlave {
   std::vector<ScannedPdo> txpdos;             // inputs (SM3)
   std::uint32_t sm_output_bytes = 0;          // SII SyncM categories (type outputs / inputs)
   std::uint32_t sm_input_bytes = 0;
+  bool sdo_info = false;                      // the SII says SDO Information (CoE details bit 1)
+  bool objects_read = false;                  // its OD list came (objects holds it, maybe 0)
+  std::vector<ScannedObject> objects;         // by the list's order
   std::vector<std::string> notes;
 
   [[nodiscard]] bool dc() const noexcept { return esc_features && (*esc_features & 0x0004U) != 0; }
@@ -103,13 +120,14 @@ class EthercatScan final : public DatagramOwner {
 
  private:
   enum class Phase : std::uint8_t { Boot, Registers, Coe, Done };
-  enum class Read : std::uint8_t { DeviceType, Identity, AssignCount, AssignEntry, MapCount, MapEntry };
+  enum class Read : std::uint8_t { DeviceType, Identity, AssignCount, AssignEntry, MapCount, MapEntry, OdList,
+                                    ObjectName };
   struct Request {
     Read what = Read::DeviceType;
     std::uint16_t index = 0;
     std::uint8_t subindex = 0;
     bool tx = false;        // 1C13h / TxPDO
-    std::size_t pdo = 0;    // MapCount/MapEntry: which PDO of the direction
+    std::size_t pdo = 0;    // MapCount/MapEntry: which PDO of the direction; ObjectName: which object
   };
   struct CoeRun {
     std::unique_ptr<CoeSdoClient> client;
@@ -119,10 +137,15 @@ class EthercatScan final : public DatagramOwner {
     Request current{};
     bool assign_rx_ok = false, assign_tx_ok = false;
     bool finished = false;
+    std::vector<std::uint16_t> list;  // Get OD List target (max_objects)
+    std::array<char, 128> name{};     // Get Object Description target
+    std::size_t names_failed = 0;
+    std::uint32_t first_name_abort = 0;
   };
 
   void boot_finished();
   void coe_answer(std::size_t k, const Request& r, const CoeSdoResult& result);
+  CoeSdoId coe_request(CoeRun& run);
   void finish(core::TimePoint now);
 
   EthercatScanSettings settings_;
@@ -160,8 +183,11 @@ core::ScanResult ethercat_scan_result(const std::vector<ScannedSlave>& slaves, c
                                       const std::string& interface, const std::vector<config::DeviceProfile>& profiles);
 
 // `ethercat:IFACE[?key=value&...]` checked by the configuration's rules for a raw ethercat bus
-// (interface, sdo_timeout, transition_timeout). Throws core::ScanError naming the option.
+// (interface, sdo_timeout, transition_timeout), and the scan's own `objects` (0/1: list every
+// object's name). Throws core::ScanError naming the option.
 config::BusPlan ethercat_scan_plan(const core::ScanRequest& request, const config::BusTypeRegistry& types);
+// `objects=1` in the request (checked by ethercat_scan_plan).
+bool ethercat_scan_object_names(const core::ScanRequest& request);
 
 // The scan on a RawSocketLink on the plan's interface in real time. Throws core::ScanError when
 // the interface does not open.

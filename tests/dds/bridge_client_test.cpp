@@ -535,6 +535,33 @@ TEST(DdsBridge, StatesArriveAtAboutTheConfiguredRate) {
   EXPECT_EQ(c.buses()[0].cycles, 42U);
 }
 
+// The distributed clocks' figures of a bus travel on bus_status; a bus without them (can0 here)
+// says so rather than reporting 0 ns.
+TEST(DdsBridge, BusStatusCarriesTheClockSyncFiguresOnlyWhereABusHasThem) {
+  FakeRuntime rt("gw1", {"x"});
+  daemon::BusStatus ec;
+  ec.name = "ec0";
+  ec.type = "ethercat";
+  ec.running = true;
+  ec.clock_sync = core::ClockSync{true, 37, -1'250};
+  rt.add_bus(ec);
+  daemon::DdsBridge bridge(rt, bridge_options());
+  bridge.start();
+  Client c(client_options());
+  ASSERT_TRUE(c.wait_until([&] { return c.buses().size() == 2; }, kTimeout));
+  for (const auto& b : c.buses()) {
+    if (b.bus == "ec0") {
+      EXPECT_TRUE(b.clock_sync);
+      EXPECT_EQ(b.clock_difference_ns, 37);
+      EXPECT_EQ(b.clock_master_offset_ns, -1'250);
+    } else {
+      EXPECT_EQ(b.bus, "can0");
+      EXPECT_FALSE(b.clock_sync);
+      EXPECT_EQ(b.clock_difference_ns, 0);
+    }
+  }
+}
+
 // status_keepalive: an unchanged state is written again only after the keep-alive (seq counts the
 // 50 ms periods), a changed one at the next period.
 TEST(DdsBridge, UnchangedStatesWaitForTheKeepAliveChangedOnesGoAtTheNextPeriod) {

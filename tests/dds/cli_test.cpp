@@ -294,6 +294,40 @@ TEST(DrivegateDemo, RunsTheWholeSequenceAndLeavesAxesDisabled) {
   EXPECT_EQ(rt.commands().back().command.kind, core::CommandKind::Disable);
 }
 
+// `buses` prints the distributed clocks' line only for a bus that has the figures; --json has
+// the two fields only then.
+TEST(DrivegatectlBuses, ClockFiguresShownOnlyForTheBusThatHasThem) {
+  FakeRuntime rt("gw1", {"x"});
+  daemon::BusStatus ec;
+  ec.name = "ec0";
+  ec.type = "ethercat";
+  ec.running = true;
+  ec.clock_sync = core::ClockSync{true, 42, -900};
+  rt.add_bus(ec);
+  daemon::DdsBridge bridge(rt, bridge_options());
+  bridge.start();
+  CtlRun r;
+  // bus_status is published at 1 Hz: wait until both buses are listed.
+  for (int i = 0; i < 20; ++i) {
+    r = ctl("buses");
+    if (r.output.find("gw1/ec0") != std::string::npos && r.output.find("gw1/can0") != std::string::npos) break;
+  }
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("  distributed clocks: max difference 42ns  master - reference -900ns\n"), std::string::npos)
+      << r.output;
+  EXPECT_EQ(r.output.find("distributed clocks"), r.output.rfind("distributed clocks")) << r.output;  // ec0's only
+  r = ctl("--json buses");
+  EXPECT_EQ(r.status, 0) << r.output;
+  const auto ec_line = r.output.find(R"("bus":"ec0")");
+  const auto can_line = r.output.find(R"("bus":"can0")");
+  ASSERT_NE(ec_line, std::string::npos) << r.output;
+  ASSERT_NE(can_line, std::string::npos) << r.output;
+  const std::string ec_json = r.output.substr(ec_line, r.output.find('\n', ec_line) - ec_line);
+  const std::string can_json = r.output.substr(can_line, r.output.find('\n', can_line) - can_line);
+  EXPECT_NE(ec_json.find(R"("clock_difference_ns":42,"clock_master_offset_ns":-900)"), std::string::npos) << r.output;
+  EXPECT_EQ(can_json.find("clock_"), std::string::npos) << r.output;
+}
+
 TEST(DrivegatectlUsage, BadUsageExitsWithTwo) {
   EXPECT_EQ(ctl("move x").status, 2);
   EXPECT_EQ(ctl("move x 1 --bogus 3").status, 2);

@@ -190,7 +190,10 @@ void FakeRuntime::set_link(std::size_t axis_id, core::LinkState link, std::strin
   s.link_since_ns = since_ns;
 }
 
-daemon::BusStatus FakeRuntime::bus_status(std::size_t /*bus*/) const {
+void FakeRuntime::add_bus(daemon::BusStatus status) { extra_buses_.push_back(std::move(status)); }
+
+daemon::BusStatus FakeRuntime::bus_status(std::size_t bus) const {
+  if (bus >= 1 && bus - 1 < extra_buses_.size()) return extra_buses_[bus - 1];
   daemon::BusStatus b;
   b.name = "can0";
   b.type = "canopen";

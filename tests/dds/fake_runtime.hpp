@@ -24,7 +24,7 @@ class FakeRuntime final : public daemon::Runtime {
   [[nodiscard]] daemon::ParameterLookup lookup_parameter(std::size_t axis_id, std::string_view name,
                                                          std::uint16_t index, std::uint8_t sub) const override;
   [[nodiscard]] core::AxisSnapshot snapshot(std::size_t axis_id) const override;
-  [[nodiscard]] std::size_t bus_count() const noexcept override { return 1; }
+  [[nodiscard]] std::size_t bus_count() const noexcept override { return 1 + extra_buses_.size(); }
   [[nodiscard]] daemon::BusStatus bus_status(std::size_t bus) const override;
   void drain(daemon::Outbox& out) override;
   [[nodiscard]] std::span<const daemon::IoSlaveInfo> io_slaves() const noexcept override { return io_; }
@@ -39,6 +39,8 @@ class FakeRuntime final : public daemon::Runtime {
   // A lost slave: inputs stale, writes refused with slave_lost (as the EtherCAT bus does).
   void set_io_lost(std::size_t io_id, bool lost);
   [[nodiscard]] std::vector<std::uint8_t> io_outputs(std::size_t io_id) const;
+  // A bus after the default can0 (canopen, no clock figures), reported as given (before start()).
+  void add_bus(daemon::BusStatus status);
   void set_busy(bool busy);
   void set_complete_commands(bool complete);  // false: reply Accepted only
   // An object and its type as the axis' EDS would give it (Unknown: the gateway would not know it);
@@ -82,6 +84,7 @@ class FakeRuntime final : public daemon::Runtime {
   std::map<std::size_t, core::AxisSnapshot> links_;  // link, link_detail, link_since_ns per axis
   std::map<std::size_t, double> positions_;
   std::vector<daemon::IoSlaveInfo> io_;
+  std::vector<daemon::BusStatus> extra_buses_;
   std::vector<core::IoSnapshot> io_data_;
 };
 

@@ -121,6 +121,11 @@ TEST(EthercatBusDc, SystemTimeDifferenceStaysSmallAndIsPublished) {
   EXPECT_GT(h.bus->dc().cyclic().counters().answered, 2000U);
   // The master's clock (virtual time + the base from open()) is the reference's within a cycle.
   EXPECT_LT(std::llabs(h.bus->dc_master_minus_reference_ns()), 1'000'000);
+  // The same figures for the bus status (core::Bus::clock_sync, any thread).
+  const core::ClockSync cs = h.bus->clock_sync();
+  EXPECT_TRUE(cs.valid);
+  EXPECT_EQ(cs.max_difference_ns, h.bus->dc_max_difference_ns());
+  EXPECT_EQ(cs.master_minus_reference_ns, h.bus->dc_master_minus_reference_ns());
 }
 
 TEST(EthercatBusDc, CspSetpointsOnSync0) {
@@ -155,6 +160,7 @@ TEST(EthercatBusDc, DistributedClocksOffRunsFree) {
   EXPECT_FALSE(h.esr.esc->sync0_running());
   EXPECT_FALSE(h.gen.esc->sync0_running());
   EXPECT_EQ(h.bus->dc_max_difference_ns(), -1);
+  EXPECT_FALSE(h.bus->clock_sync().valid);  // the bus status shows no figure
   expect_completed(h, h.push("b", CommandKind::Enable), 3s, "enable");
 }
 
@@ -169,6 +175,10 @@ TEST(EthercatBusDc, EsrRunsFreeNextToADcDrive) {
   EXPECT_FALSE(h.esr.esc->sync0_running());
   EXPECT_TRUE(h.gen.esc->sync0_running());
   EXPECT_EQ(h.gen.app->sync_mode(), 2U);
+  // The reference clock is the only DC slave: no 092Ch to read, nothing differs once its time
+  // comes back.
+  EXPECT_EQ(h.bus->dc_max_difference_ns(), 0);
+  EXPECT_TRUE(h.bus->clock_sync().valid);
 }
 
 // Slave 3 (not the reference) power-cycled: its DC registers are zero when it comes back; it gets

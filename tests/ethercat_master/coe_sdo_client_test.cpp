@@ -73,6 +73,17 @@ struct Server {
       --ignore;
       return;
     }
+    if (const CoeView c = decode_coe(req);
+        c.error == MailboxError::None && c.service == static_cast<std::uint8_t>(CoeService::SdoInformation)) {
+      // SDO Information: the scripted replies, in order (fragments follow as SM1 empties).
+      info_requests.emplace_back(req.begin(), req.end());
+      for (auto& r : info_replies) {
+        r[5] = static_cast<std::uint8_t>((r[5] & 0x0F) | (next() << 4));
+        send(esc, r);
+      }
+      info_replies.clear();
+      return;
+    }
     std::array<std::uint8_t, 64> out{};
     if (emergency_first) {
       emergency_first = false;
@@ -138,7 +149,32 @@ struct Server {
     send(esc, std::span<const std::uint8_t>(out.data(), n));
   }
   std::vector<std::uint8_t> pending;
+  std::vector<std::vector<std::uint8_t>> info_replies;  // sent (counter stamped) on the next info request
+  std::vector<std::vector<std::uint8_t>> info_requests;
 };
+
+// One SDO Information message as a slave sends it [ETG.1000.6 §5.6.3.2]: mailbox header (type
+// CoE), CoE header service 8, opcode with the incomplete bit, fragments left, `data`.
+std::vector<std::uint8_t> info_message(SdoInfoOpcode op, bool incomplete, std::uint16_t left,
+                                       std::vector<std::uint8_t> data) {
+  // Sized once and copied into (GCC 12 warns falsely about vector::insert here).
+  std::vector<std::uint8_t> m(6 + 2 + 4 + data.size());
+  std::copy(data.begin(), data.end(), m.begin() + 12);
+  put_u16(m, 0, static_cast<std::uint16_t>(2 + 4 + data.size()));
+  m[5] = 0x03;           // CoE; counter stamped when sent
+  m[7] = 0x80;           // CoE service 8: SDO Information
+  m[8] = static_cast<std::uint8_t>(static_cast<std::uint8_t>(op) | (incomplete ? 0x80 : 0x00));
+  put_u16(m, 10, left);
+  return m;
+}
+std::vector<std::uint8_t> le16s(std::initializer_list<std::uint16_t> v) {
+  std::vector<std::uint8_t> b;
+  for (const auto x : v) {
+    b.push_back(static_cast<std::uint8_t>(x & 0xFF));
+    b.push_back(static_cast<std::uint8_t>(x >> 8));
+  }
+  return b;
+}
 
 struct Emergencies final : EmergencySink {
   std::vector<std::pair<std::uint16_t, CoeEmergency>> got;
@@ -431,6 +467,122 @@ TEST(EthercatCoeSdo, ResetFailsQueuedRequestsAndForgetsTheReplyCounter) {
   const auto r = h.run(h.client.upload_value(0x1000, 0));
   ASSERT_EQ(r.status, CoeSdoStatus::Done) << std::hex << r.abort_code;  // its reply has counter 1 again
   EXPECT_EQ(r.value, 0x00020192U);
+}
+
+// SDO Information through the fake slave: request layout, fragments joined (an index split across
+// two of them), a gap in the fragments, an SDO Info Error, malformed replies survived.
+TEST(EthercatCoeSdoInfo, OdListRequestLayoutAndFragmentsJoined) {
+  Harness h;
+  // List type 1 and 1000h, 1018h, 6040h; then 6041h split over two fragments; then 607Ah.
+  auto a = le16s({0x0001, 0x1000, 0x1018, 0x6040});
+  a.push_back(0x41);
+  h.server.info_replies.push_back(info_message(SdoInfoOpcode::GetOdListResponse, true, 2, a));
+  h.server.info_replies.push_back(info_message(SdoInfoOpcode::GetOdListResponse, true, 1, {0x60}));
+  h.server.info_replies.push_back(info_message(SdoInfoOpcode::GetOdListResponse, false, 0, le16s({0x607A})));
+  std::array<std::uint16_t, 16> list{};
+  const CoeSdoId id = h.client.od_list(OdListType::All, list);
+  ASSERT_NE(id, 0U);
+  const auto r = h.run(id);
+  ASSERT_EQ(r.status, CoeSdoStatus::Done) << std::hex << r.abort_code;
+  ASSERT_EQ(r.size, 5U);
+  EXPECT_EQ(std::vector<std::uint16_t>(list.begin(), list.begin() + 5),
+            (std::vector<std::uint16_t>{0x1000, 0x1018, 0x6040, 0x6041, 0x607A}));
+  // Get OD List request: length 8, CoE 8000h, opcode 01h, fragments 0, list type 0001h.
+  ASSERT_EQ(h.server.info_requests.size(), 1U);
+  const auto& q = h.server.info_requests[0];
+  ASSERT_EQ(q.size(), 64U);  // the whole SM0
+  EXPECT_EQ(std::vector<std::uint8_t>(q.begin(), q.begin() + 14),
+            (std::vector<std::uint8_t>{0x08, 0x00, 0x00, 0x00, 0x00, 0x13, 0x00, 0x80, 0x01, 0x00, 0x00, 0x00, 0x01,
+                                       0x00}));
+}
+
+TEST(EthercatCoeSdoInfo, MissingFragmentFailsAndTheNextRequestWorks) {
+  Harness h;
+  h.server.info_replies.push_back(info_message(SdoInfoOpcode::GetOdListResponse, true, 2, le16s({1, 0x1000})));
+  h.server.info_replies.push_back(info_message(SdoInfoOpcode::GetOdListResponse, false, 0, le16s({0x6040})));
+  std::array<std::uint16_t, 16> list{};
+  auto r = h.run(h.client.od_list(OdListType::All, list));
+  EXPECT_EQ(r.status, CoeSdoStatus::Failed);
+  EXPECT_EQ(r.abort_code, 0x08000000U);
+  h.server.od[{0x1000, 0}] = {0x92, 0x01, 0x02, 0x00};
+  r = h.run(h.client.upload_value(0x1000, 0));
+  EXPECT_EQ(r.status, CoeSdoStatus::Done);
+  EXPECT_EQ(r.value, 0x00020192U);
+}
+
+TEST(EthercatCoeSdoInfo, ListLongerThanTheArrayFails) {
+  Harness h;
+  h.server.info_replies.push_back(
+      info_message(SdoInfoOpcode::GetOdListResponse, true, 1, le16s({1, 0x1000, 0x1001, 0x1008, 0x1009})));
+  h.server.info_replies.push_back(info_message(SdoInfoOpcode::GetOdListResponse, false, 0, le16s({0x6040})));
+  std::array<std::uint16_t, 3> list{};
+  const auto r = h.run(h.client.od_list(OdListType::All, list));
+  EXPECT_EQ(r.status, CoeSdoStatus::Failed);
+  EXPECT_EQ(r.abort_code, 0x05040005U);
+  // The second fragment came after the request ended: dropped as stale, not taken for another.
+  h.server.od[{0x1000, 0}] = {0x92, 0x01, 0x02, 0x00};
+  EXPECT_EQ(h.run(h.client.upload_value(0x1000, 0)).status, CoeSdoStatus::Done);
+  EXPECT_GE(h.client.counters().stale_replies, 1U);
+}
+
+TEST(EthercatCoeSdoInfo, DescriptionsWithNamesErrorAndTruncation) {
+  Harness h;
+  // Object description 6040h: data type 0006h, max sub-index 0, object code 7, "Controlword".
+  std::vector<std::uint8_t> od{0x40, 0x60, 0x06, 0x00, 0x00, 0x07};
+  for (const char c : std::string_view("Controlword")) od.push_back(static_cast<std::uint8_t>(c));
+  h.server.info_replies.push_back(info_message(SdoInfoOpcode::GetObjectDescriptionResponse, false, 0, od));
+  std::array<char, 32> name{};
+  auto r = h.run(h.client.object_description(0x6040, name));
+  ASSERT_EQ(r.status, CoeSdoStatus::Done) << std::hex << r.abort_code;
+  EXPECT_EQ(std::string_view(name.data(), r.size), "Controlword");
+  EXPECT_EQ(r.info.data_type, 0x0006);
+  EXPECT_EQ(r.info.object_code, 7);
+  EXPECT_FALSE(r.info.name_truncated);
+  ASSERT_EQ(h.server.info_requests.size(), 1U);
+  EXPECT_EQ(h.server.info_requests[0][8], 0x03);  // Get Object Description request
+  EXPECT_EQ(get_u16(h.server.info_requests[0], 12), 0x6040);
+
+  // Entry description 6041h:00 with the unit type, its name in two fragments, cut at 8 bytes.
+  std::vector<std::uint8_t> e{0x41, 0x60, 0x00, value_info::kUnitType, 0x06, 0x00, 16, 0x00, 0x07, 0x00,
+                              0x00, 0x00, 0x01, 0x00};
+  for (const char c : std::string_view("Status")) e.push_back(static_cast<std::uint8_t>(c));
+  h.server.info_replies.push_back(info_message(SdoInfoOpcode::GetEntryDescriptionResponse, true, 1, e));
+  h.server.info_replies.push_back(info_message(SdoInfoOpcode::GetEntryDescriptionResponse, false, 0,
+                                               {'w', 'o', 'r', 'd'}));
+  std::array<char, 8> shortname{};
+  r = h.run(h.client.entry_description(0x6041, 0, shortname, value_info::kUnitType));
+  ASSERT_EQ(r.status, CoeSdoStatus::Done) << std::hex << r.abort_code;
+  EXPECT_EQ(std::string_view(shortname.data(), r.size), "Statuswo");
+  EXPECT_TRUE(r.info.name_truncated);
+  EXPECT_EQ(r.info.bit_length, 16);
+  EXPECT_EQ(r.info.object_access, 0x0007);
+  EXPECT_EQ(r.info.unit_type, 0x00010000U);
+  EXPECT_EQ(h.server.info_requests[1][8], 0x05);  // Get Entry Description request
+  EXPECT_EQ(h.server.info_requests[1][15], value_info::kUnitType);
+
+  // SDO Info Error request: the abort code [ETG.1000.6 §5.6.3.7].
+  h.server.info_replies.push_back(info_message(SdoInfoOpcode::Error, false, 0, {0x00, 0x00, 0x02, 0x06}));
+  r = h.run(h.client.object_description(0x5555, name));
+  EXPECT_EQ(r.status, CoeSdoStatus::Failed);
+  EXPECT_EQ(r.abort_code, 0x06020000U);
+}
+
+TEST(EthercatCoeSdoInfo, MalformedAndForeignRepliesAreCountedAndSurvived) {
+  CoeSdoTiming timing;
+  timing.timeout = 50ms;
+  Harness h(timing);
+  // Cut in the info header; then the description of another object; then an SDO response.
+  h.server.info_replies.push_back({0x04, 0x00, 0x00, 0x00, 0x00, 0x03, 0x00, 0x80, 0x04, 0x00});
+  h.server.info_replies.push_back(
+      info_message(SdoInfoOpcode::GetObjectDescriptionResponse, false, 0, {0x41, 0x60, 0x06, 0x00, 0x00, 0x07}));
+  std::array<char, 16> name{};
+  const auto r = h.run(h.client.object_description(0x6040, name));
+  EXPECT_EQ(r.status, CoeSdoStatus::Failed);
+  EXPECT_EQ(r.abort_code, 0x05040000U);  // nothing fitting came: timed out
+  EXPECT_EQ(h.client.counters().malformed, 1U);
+  EXPECT_EQ(h.client.counters().unexpected, 1U);
+  h.server.od[{0x1000, 0}] = {0x92, 0x01, 0x02, 0x00};
+  EXPECT_EQ(h.run(h.client.upload_value(0x1000, 0)).status, CoeSdoStatus::Done);
 }
 
 TEST(EthercatCoeSdo, QueueHasAFixedSize) {

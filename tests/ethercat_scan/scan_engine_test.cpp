@@ -4,6 +4,7 @@
 // simulator's personas (SII identities, 1000h, 1C12h/1C13h); the profiles are the repository's.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <memory>
 #include <string>
 
@@ -60,7 +61,7 @@ struct Scanned {
   std::shared_ptr<sim::BuiltLine> line;
 };
 
-Scanned scan(const std::string& yaml) {
+Scanned scan(const std::string& yaml, const EthercatScanSettings& settings = {}) {
   const config::Plan plan = config::load_plan_from_string(yaml, "scan-test.yaml", load_options());
   Scanned s;
   s.line = sim::build_line(plan.buses.at(0));
@@ -69,7 +70,7 @@ Scanned scan(const std::string& yaml) {
   link.open();
   VirtualClock clock(peer);
   const auto start = clock.now();
-  s.slaves = scan_line(link, EthercatScanSettings{}, clock, s.line_text);
+  s.slaves = scan_line(link, settings, clock, s.line_text);
   s.took = clock.now() - start;
   return s;
 }
@@ -161,6 +162,51 @@ TEST(EthercatScan, ProfilesMatchedAndTheSkeletonPassesTheConfigurationChecks) {
   ASSERT_EQ(plan.buses[0].section<config::EthercatBusOptions>().io.size(), 1U);
 }
 
+// SDO Information [ETG.1000.6 §5.6.3]: the drives' SIIs offer it (CoE details bit 1), so their
+// object lists are read (counted by area in the table); with objects=1 every object's name too.
+// The I/O slave has no mailbox: nothing to list.
+TEST(EthercatScan, SdoInformationListsTheDrivesObjects) {
+  const Scanned s = scan(kLine);
+  for (const std::size_t k : {0U, 2U}) {
+    const ScannedSlave& d = s.slaves[k];
+    EXPECT_TRUE(d.sdo_info) << k;
+    ASSERT_TRUE(d.objects_read) << k;
+    // The list is the simulated drive's own dictionary, in its order.
+    auto* od = s.line->slave(k).parts.app->object_dictionary();
+    ASSERT_NE(od, nullptr);
+    std::vector<std::uint16_t> truth(1024);
+    truth.resize(od->list(OdListType::All, truth));
+    ASSERT_EQ(d.objects.size(), truth.size()) << k;
+    for (std::size_t i = 0; i < truth.size(); ++i) EXPECT_EQ(d.objects[i].index, truth[i]) << k << "/" << i;
+    EXPECT_TRUE(d.objects[0].name.empty());  // names only with objects=1
+    for (const auto& n : d.notes) EXPECT_EQ(n.find("SDO Information"), std::string::npos) << n;
+  }
+  EXPECT_FALSE(s.slaves[1].objects_read);
+  core::ScanResult r = ethercat_scan_result(s.slaves, s.line_text, "ecs0", profiles());
+  std::string table = daemon::format_scan_table(r);
+  const std::string count = "object dictionary (SDO Information): " + std::to_string(s.slaves[2].objects.size()) +
+                            " objects: ";
+  EXPECT_NE(table.find(count), std::string::npos) << table;
+  EXPECT_NE(table.find("communication (1000h-1FFFh)"), std::string::npos) << table;
+  EXPECT_NE(table.find("profile (6000h-9FFFh)"), std::string::npos) << table;
+  EXPECT_EQ(table.find("6040h Controlword"), std::string::npos) << table;
+
+  EthercatScanSettings named;
+  named.object_names = true;
+  const Scanned n = scan(kLine, named);
+  EXPECT_LT(n.took, 10s);
+  const ScannedSlave& gen = n.slaves[2];
+  ASSERT_TRUE(gen.objects_read);
+  const auto it = std::find_if(gen.objects.begin(), gen.objects.end(), [](const auto& o) { return o.index == 0x6040; });
+  ASSERT_NE(it, gen.objects.end());
+  EXPECT_EQ(it->name, "Controlword");
+  for (const auto& o : gen.objects) EXPECT_FALSE(o.name.empty()) << std::hex << o.index;
+  r = ethercat_scan_result(n.slaves, n.line_text, "ecs0", profiles());
+  table = daemon::format_scan_table(r);
+  EXPECT_NE(table.find("\n      6040h Controlword\n"), std::string::npos) << table;
+  EXPECT_NE(table.find("\n      1C12h Sync manager 2 PDO assignment (array)\n"), std::string::npos) << table;
+}
+
 TEST(EthercatScan, AnEmptyLineHasNoDevices) {
   // No slave at all: the count's BRD comes back with WKC 0 (a line of zero simulated slaves).
   auto line = std::make_shared<sim::BuiltLine>("empty");
@@ -187,6 +233,14 @@ TEST(EthercatScan, ThePlanTakesAnInterfaceAndRefusesOtherOptions) {
   EXPECT_EQ(p.section<config::EthercatBusOptions>().interface, "eth2");
   EXPECT_EQ(p.section<config::EthercatBusOptions>().sdo_timeout, 2s);
   q.where = "eth1?bitrate=5";
+  EXPECT_THROW(ethercat_scan_plan(q, types), core::ScanError);
+  // objects: the scan's own option, not the bus'.
+  q.where = "eth1?objects=1";
+  EXPECT_EQ(ethercat_scan_plan(q, types).section<config::EthercatBusOptions>().interface, "eth1");
+  EXPECT_TRUE(ethercat_scan_object_names(q));
+  q.where = "eth1";
+  EXPECT_FALSE(ethercat_scan_object_names(q));
+  q.where = "eth1?objects=2";
   EXPECT_THROW(ethercat_scan_plan(q, types), core::ScanError);
   q.where = "sim";
   EXPECT_THROW(ethercat_scan_plan(q, types), core::ScanError);

@@ -97,6 +97,64 @@ TEST(EthercatSimInterop, LineBootReachesPreOpAndSdoClientTalksToTheServer) {
   EXPECT_EQ(t.io_esc->state(), AlState::PreOp);
 }
 
+// SDO Information from the simulator's CoE server: an OD list in fragments (104 indexes, a
+// 128-byte mailbox carries 57 in the first fragment), object and entry descriptions with their
+// names, and its errors [ETG.1000.6 §5.6.3].
+TEST(EthercatSimInterop, SdoInformationListsAndDescribesTheDictionary) {
+  Interop t;
+  const std::array<std::uint8_t, 1> v{0};
+  for (std::uint16_t i = 0; i < 100; ++i) {
+    t.apps[0]->od.add_variable(static_cast<std::uint16_t>(0x3000 + i), data_type::kUnsigned8, object_access::kReadPreOp,
+                               "Extra", v);
+  }
+  t.boot = std::make_unique<LineBoot>(kExpected, LineBootConfig{});
+  t.boot->start(t.now);
+  for (int i = 0; i < 20000 && t.boot->status() == LineStatus::Running; ++i) t.cycle();
+  ASSERT_TRUE(t.boot->ok()) << t.boot->line_text();
+  t.clients.push_back(std::make_unique<CoeSdoClient>(0x1001, SiiMailbox{0x1000, 128, 0x1080, 128}));
+  CoeSdoClient& c = *t.clients.back();
+  auto run = [&](CoeSdoId id) {
+    for (int i = 0; i < 5000 && c.result(id).status < CoeSdoStatus::Done; ++i) t.cycle();
+    return c.take(id);
+  };
+  std::array<std::uint16_t, 256> list{};
+  CoeSdoResult r = run(c.od_list(OdListType::All, list));
+  ASSERT_EQ(r.status, CoeSdoStatus::Done) << std::hex << r.abort_code;
+  ASSERT_EQ(r.size, 104U);
+  // The dictionary's own list, in its order (by index), across both fragments.
+  std::array<std::uint16_t, 256> truth{};
+  ASSERT_EQ(t.apps[0]->od.list(OdListType::All, truth), 104U);
+  for (std::size_t i = 0; i < 104; ++i) EXPECT_EQ(list[i], truth[i]) << i;
+  EXPECT_EQ(list[0], 0x1000);
+  EXPECT_EQ(list[3], 0x3000);
+  EXPECT_EQ(list[103], 0x6040);
+
+  std::array<char, 64> name{};
+  r = run(c.object_description(0x6040, name));
+  ASSERT_EQ(r.status, CoeSdoStatus::Done) << std::hex << r.abort_code;
+  EXPECT_EQ(std::string_view(name.data(), r.size), "Record");
+  EXPECT_EQ(r.info.object_code, object_code::kRecord);
+  r = run(c.entry_description(0x1000, 0, name));
+  ASSERT_EQ(r.status, CoeSdoStatus::Done) << std::hex << r.abort_code;
+  EXPECT_EQ(std::string_view(name.data(), r.size), "Device type");
+  EXPECT_EQ(r.info.data_type, data_type::kUnsigned32);
+  EXPECT_EQ(r.info.bit_length, 32);
+  EXPECT_NE(r.info.object_access & object_access::kReadPreOp, 0);
+
+  r = run(c.object_description(0x5555, name));
+  EXPECT_EQ(r.status, CoeSdoStatus::Failed);
+  EXPECT_EQ(r.abort_code, 0x06020000U);
+  r = run(c.entry_description(0x6040, 9, name));
+  EXPECT_EQ(r.status, CoeSdoStatus::Failed);
+  EXPECT_EQ(r.abort_code, 0x06090011U);
+  // SDO transfers go on as before on the same mailbox.
+  r = run(c.upload_value(0x1000, 0));
+  EXPECT_EQ(r.status, CoeSdoStatus::Done);
+  EXPECT_EQ(r.value, 0x00020192U);
+  EXPECT_EQ(c.counters().timeouts, 0U);
+  EXPECT_EQ(c.counters().malformed, 0U);
+}
+
 TEST(EthercatSimInterop, RebootedLineAndResetClientKeepTalking) {
   // The boot run again (every slave through INIT: the mailboxes are set up afresh), the client
   // reset() as LineBoot users do after a re-init: requests work as before.

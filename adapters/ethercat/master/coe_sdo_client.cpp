@@ -16,6 +16,10 @@ namespace {
 // (8) for a normal initiate; + command byte (1) for a segment [ETG.1000.6 §5.6.2.2-§5.6.2.5].
 constexpr std::size_t kInitiateOverhead = kMailboxHeaderSize + kCoeHeaderSize + kSdoHeaderSize;
 constexpr std::size_t kSegmentOverhead = kMailboxHeaderSize + kCoeHeaderSize + 1;
+// SDO Information header: opcode with the incomplete bit, reserved, fragments left u16
+// [ETG.1000.6 §5.6.3.2].
+constexpr std::size_t kInfoHeader = 4;
+constexpr std::uint8_t kInfoIncomplete = 0x80;
 
 }  // namespace
 
@@ -90,6 +94,39 @@ CoeSdoId CoeSdoClient::download_value(std::uint16_t index, std::uint8_t subindex
   return id;
 }
 
+CoeSdoId CoeSdoClient::submit_info(Kind kind, std::uint16_t index, std::uint8_t subindex, std::size_t capacity) noexcept {
+  const CoeSdoId id = submit(false, index, subindex, nullptr, nullptr, capacity);
+  if (id != 0) slots_[(id & 0xFF) - 1].kind = kind;
+  return id;
+}
+
+CoeSdoId CoeSdoClient::od_list(OdListType type, std::span<std::uint16_t> into) noexcept {
+  // List type 0 answers five counts, not indexes: not a list to join.
+  if (into.empty() || type == OdListType::Lengths || static_cast<std::uint16_t>(type) > 5) return 0;
+  const CoeSdoId id = submit_info(Kind::OdList, 0, 0, into.size());
+  if (id == 0) return 0;
+  Slot& s = slots_[(id & 0xFF) - 1];
+  s.indexes = into.data();
+  s.list_type = static_cast<std::uint16_t>(type);
+  return id;
+}
+
+CoeSdoId CoeSdoClient::object_description(std::uint16_t index, std::span<char> name) noexcept {
+  const CoeSdoId id = submit_info(Kind::Object, index, 0, name.size());
+  if (id != 0) slots_[(id & 0xFF) - 1].name = name.data();
+  return id;
+}
+
+CoeSdoId CoeSdoClient::entry_description(std::uint16_t index, std::uint8_t subindex, std::span<char> name,
+                                         std::uint8_t value_info) noexcept {
+  const CoeSdoId id = submit_info(Kind::Entry, index, subindex, name.size());
+  if (id == 0) return 0;
+  Slot& s = slots_[(id & 0xFF) - 1];
+  s.name = name.data();
+  s.value_info = value_info;
+  return id;
+}
+
 const CoeSdoClient::Slot* CoeSdoClient::find(CoeSdoId id) const noexcept {
   const std::size_t i = id & 0xFF;
   if (i == 0 || i > slots_.size()) return nullptr;
@@ -121,7 +158,9 @@ void CoeSdoClient::finish(Slot& s, SlotState state, std::uint32_t abort_code) no
   s.state = state;
   s.result.status = state == SlotState::Done ? CoeSdoStatus::Done : CoeSdoStatus::Failed;
   s.result.abort_code = abort_code;
-  if (s.upload) {
+  if (s.kind != Kind::Sdo) {
+    s.result.size = s.done;
+  } else if (s.upload) {
     s.result.size = s.done;
     std::uint32_t v = 0;
     for (std::size_t i = 0; i < std::min<std::size_t>(s.done, 4); ++i) v |= static_cast<std::uint32_t>(s.into[i]) << (8 * i);
@@ -197,7 +236,15 @@ void CoeSdoClient::prepare(Expect expect, Encode&& encode) noexcept {
 
 void CoeSdoClient::prepare_initiate(Slot& s) noexcept {
   toggle_ = false;
+  s.first_fragment = true;
+  s.odd = false;
   prepare(Expect::Initiate, [&](std::span<std::uint8_t> out) -> std::size_t {
+    switch (s.kind) {
+      case Kind::Sdo: break;
+      case Kind::OdList: return encode_get_od_list_request(out, counter_, static_cast<OdListType>(s.list_type));
+      case Kind::Object: return encode_get_object_description_request(out, counter_, s.index);
+      case Kind::Entry: return encode_get_entry_description_request(out, counter_, s.index, s.subindex, s.value_info);
+    }
     if (s.upload) return encode_sdo_upload_request(out, counter_, s.index, s.subindex);
     if (s.capacity <= 4) {  // expedited [ETG.1000.6 §5.6.2.1]
       s.done = s.capacity;
@@ -421,6 +468,14 @@ void CoeSdoClient::on_mailbox(std::span<const std::uint8_t> mb, bool stale) noex
     if (emergencies_ != nullptr) emergencies_->on_emergency(station_, e.emergency);
     return;
   }
+  if (coe.service == static_cast<std::uint8_t>(CoeService::SdoInformation)) {
+    if (active_ == nullptr || active_->kind == Kind::Sdo) {
+      ++counters_.unexpected;
+      return;
+    }
+    on_info(*active_, mb, coe.body);
+    return;
+  }
   const SdoView sdo = decode_sdo_response(mb);
   if (sdo.error != MailboxError::None) {
     ++counters_.malformed;
@@ -434,6 +489,10 @@ void CoeSdoClient::on_mailbox(std::span<const std::uint8_t> mb, bool stale) noex
 }
 
 void CoeSdoClient::on_sdo(Slot& s, const CoeSdo& sdo) noexcept {
+  if (s.kind != Kind::Sdo) {  // an SDO response while an SDO Information request runs
+    ++counters_.unexpected;
+    return;
+  }
   if (sdo.command == SdoCommand::Abort) {
     ++counters_.aborts;
     finish(s, SlotState::Failed, sdo.abort_code);
@@ -505,6 +564,119 @@ void CoeSdoClient::on_sdo(Slot& s, const CoeSdo& sdo) noexcept {
   } else {
     prepare_upload_segment();
   }
+}
+
+}  // namespace drivegate::ethercat
+
+namespace drivegate::ethercat {
+
+void CoeSdoClient::take_indexes(Slot& s, std::span<const std::uint8_t> bytes) noexcept {
+  // The fragments are one byte stream [ETG.1000.6 §5.6.3.2]: an index may straddle two of them.
+  for (const std::uint8_t b : bytes) {
+    if (!s.odd) {
+      s.odd_byte = b;
+      s.odd = true;
+      continue;
+    }
+    s.odd = false;
+    if (s.done >= s.capacity) {
+      finish(s, SlotState::Failed, cia402::sdo_abort_code::kOutOfMemory);
+      return;
+    }
+    s.indexes[s.done++] = static_cast<std::uint16_t>(s.odd_byte | (b << 8));
+  }
+}
+
+void CoeSdoClient::take_name(Slot& s, std::span<const std::uint8_t> bytes) noexcept {
+  const std::size_t n = std::min(bytes.size(), s.capacity - s.done);
+  std::copy_n(bytes.begin(), n, s.name + s.done);
+  s.done += n;
+  if (n < bytes.size()) s.result.info.name_truncated = true;
+}
+
+void CoeSdoClient::on_info(Slot& s, std::span<const std::uint8_t> mb, std::span<const std::uint8_t> body) noexcept {
+  if (body.size() < kInfoHeader) {
+    ++counters_.malformed;
+    return;
+  }
+  const auto op = static_cast<SdoInfoOpcode>(body[0] & 0x7F);
+  const bool incomplete = (body[0] & kInfoIncomplete) != 0;
+  const std::uint16_t left = core::get_u16(body, 2);
+  const auto data = body.subspan(kInfoHeader);
+  if (op == SdoInfoOpcode::Error) {  // SDO Info Error request: an abort code [ETG.1000.6 §5.6.3.7]
+    if (data.size() < 4) {
+      ++counters_.malformed;
+      return;
+    }
+    ++counters_.aborts;
+    finish(s, SlotState::Failed, core::get_u32(data, 0));
+    return;
+  }
+  const SdoInfoOpcode wanted = s.kind == Kind::OdList   ? SdoInfoOpcode::GetOdListResponse
+                               : s.kind == Kind::Object ? SdoInfoOpcode::GetObjectDescriptionResponse
+                                                        : SdoInfoOpcode::GetEntryDescriptionResponse;
+  if (op != wanted) {
+    ++counters_.unexpected;
+    return;
+  }
+  if (!s.first_fragment) {
+    // Fragments count down to 0; a gap means one went missing (a repeated one is caught by the
+    // mailbox counter): the rest would be joined wrongly.
+    if (left + 1 != s.fragments_left) {
+      finish(s, SlotState::Failed, cia402::sdo_abort_code::kGeneral);
+      return;
+    }
+    if (s.kind == Kind::OdList) {
+      take_indexes(s, data);
+    } else {
+      take_name(s, data);  // the name is the tail of a description
+    }
+  } else if (s.kind == Kind::OdList) {
+    if (data.size() < 2) {
+      ++counters_.malformed;
+      return;
+    }
+    if (core::get_u16(data, 0) != s.list_type) {  // another list's answer
+      ++counters_.unexpected;
+      return;
+    }
+    take_indexes(s, data.subspan(2));
+  } else {
+    const SdoInfoView v = decode_sdo_info(mb);
+    if (v.error != MailboxError::None) {
+      ++counters_.malformed;
+      return;
+    }
+    const bool same = s.kind == Kind::Object ? v.object.index == s.index
+                                             : (v.entry.index == s.index && v.entry.subindex == s.subindex);
+    if (!same) {
+      ++counters_.unexpected;
+      return;
+    }
+    CoeSdoInfo& i = s.result.info;
+    if (s.kind == Kind::Object) {
+      i.data_type = v.object.data_type;
+      i.max_subindex = v.object.max_subindex;
+      i.object_code = v.object.object_code;
+      take_name(s, {reinterpret_cast<const std::uint8_t*>(v.object.name.data()), v.object.name.size()});
+    } else {
+      i.data_type = v.entry.data_type;
+      i.bit_length = v.entry.bit_length;
+      i.object_access = v.entry.object_access;
+      i.value_info = v.entry.value_info;
+      i.unit_type = v.entry.unit_type;
+      take_name(s, {reinterpret_cast<const std::uint8_t*>(v.entry.name.data()), v.entry.name.size()});
+    }
+  }
+  if (s.state != SlotState::InFlight) return;  // failed while taking the data
+  s.first_fragment = false;
+  s.fragments_left = left;
+  if (incomplete && left > 0) return;  // the next fragment comes in the next mailbox
+  if (s.kind == Kind::OdList && s.odd) {  // half an index at the end
+    finish(s, SlotState::Failed, cia402::sdo_abort_code::kTooShort);
+    return;
+  }
+  finish(s, SlotState::Done, 0);
 }
 
 }  // namespace drivegate::ethercat

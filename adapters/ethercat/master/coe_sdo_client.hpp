@@ -19,6 +19,14 @@
 //   transfers: expedited / normal / segmented upload and download, toggle checked; a server abort
 //             fails the request with its code (cia402::sdo_abort_text() for the words).
 //   emergencies (CoE service 1) arriving in the mailbox go to the EmergencySink, any time.
+//   SDO Information [ETG.1000.6 §5.6.3]: Get OD List (the indexes of one list type), Get Object
+//             Description and Get Entry Description (fixed fields and the name), through the same
+//             queue, mailbox handling and timeout as the transfers. A response may come in
+//             fragments (§5.6.3.2: "incomplete" bit, fragments left counting down): their data is
+//             one byte stream, joined in order; a fragment out of order fails the request
+//             (08000000h), an SDO Info Error request (§5.6.3.7) fails it with its abort code. The
+//             indexes go into the caller's array (more than it holds: 05040005h); a name longer
+//             than the caller's buffer is cut (CoeSdoInfo::name_truncated).
 //
 // One request in flight per slave, a FIFO of kQueueDepth. Each request has a timeout from its
 // start: then it fails with 05040000h (SDO protocol timed out); nothing is sent to the slave (its
@@ -60,12 +68,27 @@ using CoeSdoId = std::uint32_t;  // 0 = refused
 enum class CoeSdoStatus : std::uint8_t { Unknown, Queued, InFlight, Done, Failed };
 std::string_view to_string(CoeSdoStatus s) noexcept;
 
+// SDO Information fields of a finished object or entry description request.
+struct CoeSdoInfo {
+  std::uint16_t data_type = 0;      // object: of the variable / of the elements; entry: its own
+  std::uint8_t max_subindex = 0;    // object
+  std::uint8_t object_code = 0;     // object: 7 variable, 8 array, 9 record (object_code::)
+  std::uint16_t bit_length = 0;     // entry
+  std::uint16_t object_access = 0;  // entry (object_access::)
+  std::uint8_t value_info = 0;      // entry: what the response holds (value_info::)
+  std::uint32_t unit_type = 0;      // entry, with value_info::kUnitType
+  bool name_truncated = false;      // the name did not fit the caller's buffer
+};
+
 struct CoeSdoResult {
   CoeSdoStatus status = CoeSdoStatus::Unknown;
   std::uint32_t abort_code = 0;      // Failed: the server's code, 05040000h timeout, 05030000h toggle, ...
   std::uint16_t mailbox_error = 0;   // Failed by a mailbox error reply (its detail code), else 0
   std::size_t size = 0;              // uploads: bytes received
   std::uint32_t value = 0;           // uploads of 1..4 bytes: little-endian value
+  // SDO Information: od_list() the number of indexes in `size`; object/entry descriptions the
+  // name's bytes in `size` and the fields here.
+  CoeSdoInfo info{};
 };
 
 struct CoeSdoCounters {
@@ -92,6 +115,16 @@ class CoeSdoClient final : public DatagramOwner {
   CoeSdoId download(std::uint16_t index, std::uint8_t subindex, std::span<const std::uint8_t> data) noexcept;
   CoeSdoId download_value(std::uint16_t index, std::uint8_t subindex, std::uint32_t value, std::size_t size) noexcept;
 
+  // SDO Information [ETG.1000.6 §5.6.3.3-§5.6.3.6]. The buffers must stay valid until the result
+  // is taken. od_list: the indexes of `type` (not Lengths) into `into`, result.size of them.
+  CoeSdoId od_list(OdListType type, std::span<std::uint16_t> into) noexcept;
+  // The object's name into `name` (result.size bytes, not terminated), its fields in result.info.
+  CoeSdoId object_description(std::uint16_t index, std::span<char> name) noexcept;
+  // The entry's name and fields; `value_info` asks for unit type (kept), default/min/max (read
+  // past, not kept).
+  CoeSdoId entry_description(std::uint16_t index, std::uint8_t subindex, std::span<char> name,
+                             std::uint8_t value_info = 0) noexcept;
+
   [[nodiscard]] CoeSdoResult result(CoeSdoId id) const noexcept;
   [[nodiscard]] std::span<const std::uint8_t> data(CoeSdoId id) const noexcept;  // upload bytes
   CoeSdoResult take(CoeSdoId id) noexcept;  // frees a finished request
@@ -111,8 +144,10 @@ class CoeSdoClient final : public DatagramOwner {
 
  private:
   enum class SlotState : std::uint8_t { Free, Queued, InFlight, Done, Failed };
+  enum class Kind : std::uint8_t { Sdo, OdList, Object, Entry };
   struct Slot {
     SlotState state = SlotState::Free;
+    Kind kind = Kind::Sdo;
     bool upload = true;
     std::uint16_t generation = 0;
     std::uint64_t order = 0;
@@ -124,6 +159,16 @@ class CoeSdoClient final : public DatagramOwner {
     std::size_t done = 0;                  // bytes received / sent
     std::size_t total = 0;                 // uploads: the size the server stated
     std::array<std::uint8_t, kInline> inline_bytes{};
+    // SDO Information: the caller's index array or name buffer (capacity is its length), the list
+    // type or value info asked for, and the fragment state.
+    std::uint16_t* indexes = nullptr;
+    char* name = nullptr;
+    std::uint16_t list_type = 0;
+    std::uint8_t value_info = 0;
+    bool first_fragment = true;
+    std::uint16_t fragments_left = 0;  // as the last fragment said
+    bool odd = false;                  // an index byte waits for its high byte (next fragment)
+    std::uint8_t odd_byte = 0;
     CoeSdoResult result{};
   };
   enum class Phase : std::uint8_t { Idle, Drain, DrainRead, Write, Wait, Read, RepeatRead, RepeatWrite, RepeatWait };
@@ -144,6 +189,11 @@ class CoeSdoClient final : public DatagramOwner {
   void on_mailbox(std::span<const std::uint8_t> mb, bool stale) noexcept;
   void on_status(const DatagramAnswer& a) noexcept;  // an SM1 status read while idle or draining
   void on_sdo(Slot& s, const CoeSdo& sdo) noexcept;
+  CoeSdoId submit_info(Kind kind, std::uint16_t index, std::uint8_t subindex, std::size_t capacity) noexcept;
+  // An SDO Information message for the active request: `mb` the whole mailbox, `body` its CoE data.
+  void on_info(Slot& s, std::span<const std::uint8_t> mb, std::span<const std::uint8_t> body) noexcept;
+  void take_indexes(Slot& s, std::span<const std::uint8_t> bytes) noexcept;
+  void take_name(Slot& s, std::span<const std::uint8_t> bytes) noexcept;
   void finish(Slot& s, SlotState state, std::uint32_t abort_code) noexcept;
   bool queue(Transactions& tx, Command c, std::uint16_t ado, std::uint16_t length,
              std::span<const std::uint8_t> data = {}) noexcept;
