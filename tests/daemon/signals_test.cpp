@@ -35,10 +35,17 @@ class Signals : public ::testing::Test {
     process_ = std::make_unique<test::DaemonProcess>(config_, notify_.path());
     ASSERT_TRUE(notify_.wait_for("READY=1", kDiscovery)) << process_->log();
     client_ = std::make_unique<client::Client>(client::options_for(dds_.domain, dds_.ns, "sig-client"));
+    // Every axis of the configuration operational, not only the two that move: an axis still
+    // configuring when the signal arrives ends with no drive state at all, which the orderly-stop
+    // check below would take for an axis left enabled (the demo's EtherCAT DC drive takes longest).
+    std::vector<std::string> axes;
+    for (const auto& a : YAML::LoadFile(config_)["axes"]) axes.push_back(a["name"].as<std::string>());
     ASSERT_TRUE(client_->wait_until([&] {
-      const auto akd = client_->state("akd");
-      return client_->state("x") && akd && akd->link == "operational";
-    }, kDiscovery)) << process_->log();
+      return std::all_of(axes.begin(), axes.end(), [&](const std::string& name) {
+        const auto s = client_->state(name);
+        return s && s->link == "operational";
+      });
+    }, 2 * kDiscovery)) << process_->log();
   }
 
   void start_moving() {
