@@ -140,6 +140,8 @@ void EscSlave::power_on() noexcept {
   sync0_next_ = sync0_cycle_ = sync0_last_ = sync0_count_ = 0;
   sync0_fired_ = false;
   set_port1_link(port1_link_);
+  fmmus_valid_ = false;
+  system_time_fresh_ = false;
 }
 
 void EscSlave::set_port1_link(bool up) noexcept {
@@ -168,13 +170,22 @@ void EscSlave::begin_frame(std::uint64_t port0_ns, std::uint64_t port1_ns, bool 
   port1_ns_ = port1_ns;
   downstream_ = downstream;
   now_ns_ = port0_ns;
+  system_time_fresh_ = false;
 }
 
 // ---- SyncManagers -----------------------------------------------------------------------------
 
 SmEntry EscSlave::sm(unsigned n) const noexcept {
-  const auto e = decode_sm(std::span<const std::uint8_t>(mem_).subspan(reg::sm(n), kSmEntrySize));
-  return e.value_or(SmEntry{});
+  // decode_sm() of the 8 register bytes, in place [ETG.1000.4 Table 59].
+  const std::uint8_t* b = mem_.data() + reg::sm(n);
+  SmEntry e;
+  e.physical_start = static_cast<std::uint16_t>(b[0] | (b[1] << 8));
+  e.length = static_cast<std::uint16_t>(b[2] | (b[3] << 8));
+  e.control = b[4];
+  e.status = b[5];
+  e.activate = b[6];
+  e.pdi_control = b[7];
+  return e;
 }
 
 std::span<std::uint8_t> EscSlave::sm_buffer(const SmEntry& e) noexcept {
@@ -255,8 +266,12 @@ void EscSlave::set_pdi_deactivate(unsigned n, bool deactivate) noexcept {
 // ---- Physical memory access -------------------------------------------------------------------
 
 void EscSlave::refresh_dynamic_registers() noexcept {
-  // The system time as the datagram passes (a read of 0910h gives it) [ETG.1000.4 §6 DC].
-  if (cfg_.dc_supported) set64(reg::kDcSystemTime, system_time(now_ns_));
+  // The system time as the datagram passes (a read of 0910h gives it) [ETG.1000.4 §6 DC]. It
+  // depends on the frame's time, the clock and 0920h only: computed once per frame at this slave
+  // unless a register write (which may move the clock or 0920h) came in between.
+  if (!cfg_.dc_supported || system_time_fresh_) return;
+  set64(reg::kDcSystemTime, system_time(now_ns_));
+  system_time_fresh_ = true;
 }
 
 bool EscSlave::phys_read(std::uint32_t ado, std::span<std::uint8_t> data, bool or_in) noexcept {
@@ -282,6 +297,8 @@ bool EscSlave::phys_write(std::uint32_t ado, std::span<const std::uint8_t> data)
     if (a < reg::kProcessRam ? writable_.test(a) : a < ram_end) mem_[a] = data[i];
   }
   if (ado < reg::kProcessRam) {
+    system_time_fresh_ = false;
+    if (overlaps(ado, len, reg::fmmu(0), 16U * kFmmuEntrySize)) fmmus_valid_ = false;
     // SII control: only write enable (bit 0) and the command (bits 8-10) are written; a command
     // while busy is ignored [ETG.1000.4 Table 48].
     if (overlaps(ado, len, reg::kSiiControl, 2)) {
@@ -427,6 +444,26 @@ void EscSlave::sync0_cycle(std::uint64_t now_ns) noexcept {
 
 // ---- Datagrams --------------------------------------------------------------------------------
 
+void EscSlave::decode_fmmus() noexcept {
+  fmmu_n_ = 0;
+  fmmu_lo_ = UINT64_MAX;
+  fmmu_hi_ = 0;
+  for (unsigned n = 0; n < cfg_.fmmu_count && n < fmmus_.size(); ++n) {
+    const auto f = decode_fmmu(std::span<const std::uint8_t>(mem_).subspan(reg::fmmu(n), kFmmuEntrySize));
+    if (!f || !f->active || f->length == 0) continue;
+    if (f->logical_start_bit != 0 || f->logical_stop_bit != 7) continue;  // byte granularity only
+    MappedFmmu& m = fmmus_[fmmu_n_++];
+    m.lo = f->logical_start;
+    m.hi = m.lo + f->length;
+    m.physical = f->physical_start;
+    m.type = f->type;
+    m.index = static_cast<std::uint8_t>(n);
+    fmmu_lo_ = std::min(fmmu_lo_, m.lo);
+    fmmu_hi_ = std::max(fmmu_hi_, m.hi);
+  }
+  fmmus_valid_ = true;
+}
+
 bool EscSlave::logical(Command c, std::uint32_t address, std::span<std::uint8_t> data, std::uint16_t& wkc) noexcept {
   bool read_hit = false;
   bool write_hit = false;
@@ -434,26 +471,34 @@ bool EscSlave::logical(Command c, std::uint32_t address, std::span<std::uint8_t>
   const bool writes = c == Command::LWR || c == Command::LRW;
   const std::uint64_t lo = address;
   const std::uint64_t hi = lo + data.size();
+  if (!fmmus_valid_) decode_fmmus();
+  // A datagram outside every FMMU's logical range passes untouched.
+  if (hi <= fmmu_lo_ || lo >= fmmu_hi_) return false;
   // Writes first, from the data as the frame brought it; then reads into the frame, so an input
   // FMMU overlapping an output FMMU's logical range returns inputs [ETG.1000.4 §5.4 LRW].
   for (int pass = 0; pass < 2; ++pass) {
     const bool write_pass = pass == 0;
     if (write_pass ? !writes : !reads) continue;
-    for (unsigned n = 0; n < cfg_.fmmu_count; ++n) {
-      const auto f = decode_fmmu(std::span<const std::uint8_t>(mem_).subspan(reg::fmmu(n), kFmmuEntrySize));
-      if (!f || !f->active || f->length == 0) continue;
-      if ((f->type & (write_pass ? fmmu_type::kWrite : fmmu_type::kRead)) == 0) continue;
-      if (f->logical_start_bit != 0 || f->logical_stop_bit != 7) continue;  // byte granularity only
-      const std::uint64_t flo = f->logical_start;
-      const std::uint64_t fhi = flo + f->length;
-      const std::uint64_t a = std::max(lo, flo);
-      const std::uint64_t b = std::min(hi, fhi);
+    if (!fmmus_valid_) decode_fmmus();
+    for (std::size_t k = 0; k < fmmu_n_; ++k) {
+      const MappedFmmu f = fmmus_[k];
+      if ((f.type & (write_pass ? fmmu_type::kWrite : fmmu_type::kRead)) == 0) continue;
+      const std::uint64_t a = std::max(lo, f.lo);
+      const std::uint64_t b = std::min(hi, f.hi);
       if (a >= b) continue;
-      const auto phys = static_cast<std::uint32_t>(f->physical_start + (a - flo));
+      const auto phys = static_cast<std::uint32_t>(f.physical + (a - f.lo));
       const auto off = static_cast<std::size_t>(a - lo);
       const auto n_bytes = static_cast<std::size_t>(b - a);
       if (write_pass) {
         if (phys_write(phys, data.subspan(off, n_bytes))) write_hit = true;
+        if (!fmmus_valid_) {
+          // The write reached the FMMU registers themselves: go on with the FMMUs after this one
+          // as they read now.
+          decode_fmmus();
+          k = 0;
+          while (k < fmmu_n_ && fmmus_[k].index <= f.index) ++k;
+          --k;  // the loop's ++k
+        }
       } else if (phys_read(phys, data.subspan(off, n_bytes), false)) {
         read_hit = true;
       }
@@ -467,7 +512,15 @@ bool EscSlave::logical(Command c, std::uint32_t address, std::span<std::uint8_t>
 
 void EscSlave::process(std::span<std::uint8_t> header, std::span<std::uint8_t> data, std::span<std::uint8_t> wkc_bytes) noexcept {
   DatagramHeader h;
-  if (!decode_datagram_header(header, h) || wkc_bytes.size() < 2) return;
+  if (!decode_datagram_header(header, h)) return;
+  process(h, header, data, wkc_bytes);
+}
+
+void EscSlave::process(const DatagramHeader& decoded, std::span<std::uint8_t> header, std::span<std::uint8_t> data,
+                       std::span<std::uint8_t> wkc_bytes) noexcept {
+  if (header.size() < kDatagramHeaderSize || wkc_bytes.size() < 2) return;
+  DatagramHeader h = decoded;
+  h.address = get_u32(header, 2);  // the ADP as the slaves before this one left it
   std::uint16_t wkc = get_u16(wkc_bytes, 0);
   refresh_dynamic_registers();
   const std::uint16_t adp = h.adp();
@@ -764,6 +817,7 @@ void EscSlave::watchdog_check(std::uint64_t now_ns) noexcept {
 
 void EscSlave::pdi_cycle(std::uint64_t now_ns) noexcept {
   now_ns_ = now_ns;
+  system_time_fresh_ = false;
   if (cfg_.dc_supported) {
     clock_.advance(now_ns);
     sync0_cycle(now_ns);

@@ -110,6 +110,10 @@ class EscSlave {
   void begin_frame(std::uint64_t port0_ns, std::uint64_t port1_ns, bool downstream) noexcept;
   // One datagram in place (the frame's bytes): header (ADP auto-incremented), data, WKC.
   void process(std::span<std::uint8_t> header, std::span<std::uint8_t> data, std::span<std::uint8_t> wkc) noexcept;
+  // The same with the header already decoded by the line (command and length; the address is read
+  // again from `header`, as the slaves before this one may have incremented the ADP).
+  void process(const DatagramHeader& decoded, std::span<std::uint8_t> header, std::span<std::uint8_t> data,
+               std::span<std::uint8_t> wkc) noexcept;
   // The PDI side after the frame: mailbox handling, process data exchange, watchdog. Also called
   // by the line for slaves the frame did not reach (time goes on for them).
   void pdi_cycle(std::uint64_t now_ns) noexcept;
@@ -172,6 +176,9 @@ class EscSlave {
   void register_written(std::uint32_t start, std::uint32_t len) noexcept;
   void refresh_dynamic_registers() noexcept;
   bool logical(Command c, std::uint32_t address, std::span<std::uint8_t> data, std::uint16_t& wkc) noexcept;
+  // The FMMUs that map anything (active, length > 0, byte granularity), decoded from 0600h.. once
+  // and again after a write to their registers or a power-on, in register order.
+  void decode_fmmus() noexcept;
 
   void al_control_written() noexcept;
   void set_al(AlState s, std::uint16_t code, bool error) noexcept;
@@ -233,6 +240,24 @@ class EscSlave {
   std::uint64_t sync0_count_ = 0;
   bool sync0_fired_ = false;       // since the last PDI cycle
   std::array<std::uint8_t, kMaxDatagramData> scratch_{};
+
+  // Derived from memory, kept while the inputs are unchanged (pure caches: what a datagram sees is
+  // what it saw without them).
+  struct MappedFmmu {
+    std::uint64_t lo = 0;           // logical start
+    std::uint64_t hi = 0;           // logical end (exclusive)
+    std::uint16_t physical = 0;
+    std::uint8_t type = 0;
+    std::uint8_t index = 0;         // n of 0600h + 16 n
+  };
+  std::array<MappedFmmu, 16> fmmus_{};
+  std::size_t fmmu_n_ = 0;
+  std::uint64_t fmmu_lo_ = 0;       // the union of their logical ranges: [fmmu_lo_, fmmu_hi_)
+  std::uint64_t fmmu_hi_ = 0;
+  bool fmmus_valid_ = false;        // cleared by a write to 0600h-06FFh and by power_on()
+  // 0910h holds the system time for the current frame time and clock: no register written, no
+  // new frame or PDI cycle since it was computed.
+  bool system_time_fresh_ = false;
 };
 
 }  // namespace drivegate::ethercat::sim

@@ -122,7 +122,7 @@ void SimLine::on_frame(FrameView frame) noexcept {
     esc.begin_frame(port0, port1, k < last);
     for (std::size_t i = 0; i < count; ++i) {
       const Datagram& g = datagrams_[i];
-      esc.process(bytes.subspan(g.header_offset, kDatagramHeaderSize), bytes.subspan(g.data_offset, g.header.length),
+      esc.process(g.header, bytes.subspan(g.header_offset, kDatagramHeaderSize), bytes.subspan(g.data_offset, g.header.length),
                   bytes.subspan(g.wkc_offset, kWkcSize));
     }
   }
