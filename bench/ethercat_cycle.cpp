@@ -57,6 +57,7 @@ struct Options {
   std::vector<std::string> links{"memory", "veth"};
   int period_us = 1000;
   int lost_cycles = 0;  // 0: the bus' default (3)
+  bool no_dc = false;   // --no-dc: the bus option distributed_clocks: false (the drives run free)
 };
 
 std::optional<int> parse_int(std::string_view s) {
@@ -80,6 +81,10 @@ std::optional<Options> parse(int argc, char** argv) {
   Options o;
   for (int i = 1; i < argc; ++i) {
     const std::string_view arg(argv[i]);
+    if (arg == "--no-dc") {
+      o.no_dc = true;
+      continue;
+    }
     if (arg == "--help" || arg == "-h" || i + 1 >= argc) return std::nullopt;
     const std::string_view value(argv[++i]);
     if (arg == "--slaves") {
@@ -150,7 +155,8 @@ config::LoadOptions load_options() {
 std::string plan_yaml(const Options& o, int slaves, const std::string& interface) {
   std::string y = "gateway: { name: bench }\nbuses:\n  - name: ec0\n    type: ethercat\n    cycle_time: " +
                   std::to_string(o.period_us) + "us\n";
-  const std::string lost = o.lost_cycles > 0 ? ", lost_cycles: " + std::to_string(o.lost_cycles) : "";
+  std::string lost = o.lost_cycles > 0 ? ", lost_cycles: " + std::to_string(o.lost_cycles) : "";
+  if (o.no_dc) lost += ", distributed_clocks: false";
   y += interface.empty() ? "    options: { transport: sim" + lost + " }\n"
                          : "    options: { transport: raw, interface: " + interface + lost + " }\n";
   y += "axes:\n";
@@ -444,6 +450,10 @@ int run(const Options& o) {
               "  veth: the endpoint thread's CPU / cycles); lateness of the bus cycle's wake vs a bare timer wake half a\n"
               "  period later in the same run\n\n",
               o.period_us, o.cycles, static_cast<double>(overhead) / 1000.0);
+  if (o.no_dc) {
+    std::printf("  --no-dc: WITHOUT distributed clocks (bus option distributed_clocks: false): no DC set-up, no FRMW,\n"
+                "  the drives run free (not SYNC0-synchronized)\n\n");
+  }
   std::vector<Row> rows;
   for (const auto& link : o.links) {
     if (link == "veth" && !test::netns_unavailable().empty()) {
@@ -504,7 +514,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr,
                  "usage: bench_ethercat_cycle [--cycles N (default 100000)] [--slaves LIST (default 1,8,64)]\n"
                  "                            [--links memory,veth] [--period-us N (default 1000)]\n"
-                 "                            [--lost-cycles N (default: the bus' 3)]\n");
+                 "                            [--lost-cycles N (default: the bus' 3)] [--no-dc]\n");
     return 2;
   }
   return drivegate::bench::run(*o);

@@ -15,6 +15,7 @@
 //
 //   bench_ethercat_daemon_cpu [--seconds N (default 10)] [--axes N (default 64)]
 //                             [--axes-per-bus M (default 64)] [--transport sim|raw (default sim)]
+//                             [--no-dc (the buses with distributed_clocks: false)]
 //
 // CPU is utime + stime from /proc/PID/stat and /proc/PID/task/TID/stat over wall time, in % of one
 // core; threads grouped by name (comm), as bench_daemon_cpu does.
@@ -51,6 +52,7 @@ namespace {
 
 constexpr auto kCycle = 1ms;
 int g_axes_per_bus = 64;  // --axes-per-bus
+bool g_no_dc = false;     // --no-dc
 
 // A process' CPU ticks, in total and per thread (by thread id, with its name).
 struct Sample {
@@ -129,14 +131,15 @@ void print_usage(const char* who, const Usage& u, double seconds) {
 
 // `interfaces` empty: transport sim; else transport raw, bus b on interfaces[b].
 std::string config_text(const test::DdsIsolation& dds, int axes, const std::vector<std::string>& interfaces) {
+  const char* dc = g_no_dc ? ", distributed_clocks: false" : "";
   const int buses = (axes + g_axes_per_bus - 1) / g_axes_per_bus;
   std::ostringstream y;
   y << "gateway: { name: bench, dds: { domain: " << dds.domain << ", namespace: " << dds.ns << " } }\n"
     << "buses:\n";
   for (int b = 0; b < buses; ++b) {
     y << "  - { name: ec" << b << ", type: ethercat, cycle_time: 1ms, options: { ";
-    if (interfaces.empty()) y << "transport: sim } }\n";
-    else y << "transport: raw, interface: " << interfaces[static_cast<std::size_t>(b)] << " } }\n";
+    if (interfaces.empty()) y << "transport: sim" << dc << " } }\n";
+    else y << "transport: raw, interface: " << interfaces[static_cast<std::size_t>(b)] << dc << " } }\n";
   }
   y << "axes:\n";
   for (int b = 0, i = 0; b < buses; ++b) {
@@ -229,6 +232,9 @@ int run(int argc, char** argv) {
     if (a == "--axes-per-bus") g_axes_per_bus = std::clamp(std::atoi(argv[i + 1]), 1, 64);
     if (a == "--transport") raw = std::string(argv[i + 1]) == "raw";
   }
+  for (int i = 1; i < argc; ++i) {
+    if (std::string(argv[i]) == "--no-dc") g_no_dc = true;
+  }
   const int buses = (axes + g_axes_per_bus - 1) / g_axes_per_bus;
   const auto dds = test::unique_dds("bench_ecat_cpu");
   std::unique_ptr<RawRig> rig;
@@ -271,6 +277,10 @@ int run(int argc, char** argv) {
               raw ? "transport raw over veth (drivegate-sim in its own network namespace, measured apart)"
                   : "transport sim (the simulated slaves run in the cycle threads)",
               seconds);
+  if (g_no_dc) {
+    std::printf("--no-dc: WITHOUT distributed clocks (bus option distributed_clocks: false): no DC set-up, no FRMW, "
+                "the drives run free (not SYNC0-synchronized)\n");
+  }
   std::printf("drivegated pid %d (for top -H -p PID while it runs)\n", static_cast<int>(daemon.pid()));
   std::fflush(stdout);
   const auto measure = [&](const char* phase) {
