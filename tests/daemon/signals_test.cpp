@@ -119,7 +119,10 @@ TEST_F(Signals, HangupChecksTheFileAndSaysWhatWouldChange) {
   ASSERT_EQ(kill(process_->pid(), SIGHUP), 0);
   ASSERT_TRUE(notify_.wait_for("RELOADING=1", 5s));
   ASSERT_NO_FATAL_FAILURE(expect_still_moving());
-  EXPECT_NE(process_->log().find("re-read and checked: no changes"), std::string::npos) << process_->log();
+  // RELOADING=1 goes out before the file is read; the verdict reaches the log file afterwards.
+  EXPECT_TRUE(client_->wait_until(
+      [&] { return process_->log().find("re-read and checked: no changes") != std::string::npos; }, 5s))
+      << process_->log();
 
   // x's velocity limit in demo.yaml is 200 mm/s.
   const std::string changed = std::regex_replace(original, std::regex("max_velocity: 200"), "max_velocity: 250",
@@ -147,7 +150,8 @@ TEST_F(Signals, PipeAndTerminalStopsAreIgnored) {
   ASSERT_NO_FATAL_FAILURE(start_moving());
   for (int sig : {SIGPIPE, SIGTSTP, SIGTTIN, SIGTTOU}) ASSERT_EQ(kill(process_->pid(), sig), 0);
   ASSERT_NO_FATAL_FAILURE(expect_still_moving());
-  EXPECT_NE(process_->log().find("SIGTSTP ignored"), std::string::npos) << process_->log();
+  EXPECT_TRUE(client_->wait_until([&] { return process_->log().find("SIGTSTP ignored") != std::string::npos; }, 5s))
+      << process_->log();
   expect_orderly_stop(process_->terminate(SIGTERM, 20s));
 }
 
