@@ -183,6 +183,8 @@ class DcSetup final : public DatagramOwner {
   // Static drift compensation: FRMW answered and lost so far.
   [[nodiscard]] std::uint32_t drift_answered() const noexcept { return drift_answered_; }
   [[nodiscard]] std::uint32_t drift_lost() const noexcept { return drift_lost_; }
+  // FRMW the static drift compensation keeps in flight now (see drift_window_).
+  [[nodiscard]] std::uint32_t drift_window() const noexcept { return drift_window_; }
   // Stations of the synchronized DC slaves, front first, into `out`; returns how many.
   std::size_t synchronized_stations(std::span<std::uint16_t> out) const noexcept;
 
@@ -241,6 +243,12 @@ class DcSetup final : public DatagramOwner {
   std::uint32_t drift_in_flight_ = 0;
   std::uint32_t drift_answered_ = 0;
   std::uint32_t drift_lost_ = 0;
+  // Static drift: FRMW kept in flight at once. Halved (down to kMinDriftWindow) in a poll that
+  // follows losses, one more after a poll without (up to static_drift_per_poll): a line or a peer
+  // that cannot take the whole burst gets fewer at a time instead of failing the setup.
+  static constexpr std::uint32_t kMinDriftWindow = 4;
+  std::uint32_t drift_window_ = 0;
+  std::uint32_t drift_lost_seen_ = 0;
   core::FixedString<240> line_text_{};
 };
 
