@@ -205,4 +205,17 @@ struct EcatHarness {
   std::vector<core::Event> events;
 };
 
+// The value of the n-th "label:" row of a --check-config printout.
+inline std::string row(const std::string& out, const std::string& label, int n = 0) {
+  std::size_t at = 0;
+  for (;;) {
+    at = out.find("  " + label + ": ", at);
+    if (at == std::string::npos) return "(no row " + label + ")";
+    if (n-- == 0) break;
+    ++at;
+  }
+  const std::size_t start = out.find_first_not_of(' ', at + label.size() + 3);
+  return out.substr(start, out.find('\n', start) - start);
+}
+
 }  // namespace drivegate::ethercat::test

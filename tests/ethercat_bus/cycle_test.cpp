@@ -54,19 +54,6 @@ TEST(EthercatBusRecovery, SlaveLeavingOpIsLostWithItsAlStatusCode) {
   EXPECT_EQ(h.esr.esc->state(), AlState::Op);
 }
 
-// The value of the n-th "label:" row of a printout.
-std::string row(const std::string& out, const std::string& label, int n = 0) {
-  std::size_t at = 0;
-  for (;;) {
-    at = out.find("  " + label + ": ", at);
-    if (at == std::string::npos) return "(no row " + label + ")";
-    if (n-- == 0) break;
-    ++at;
-  }
-  const std::size_t start = out.find_first_not_of(' ', at + label.size() + 3);
-  return out.substr(start, out.find('\n', start) - start);
-}
-
 // --check-config: the image and frame rows of the bus, the slave row of each axis.
 TEST(EthercatBusConfig, PrintoutRows) {
   const config::Plan plan = config::load_plan_from_string(kLine, "ecat-test.yaml", load_options());

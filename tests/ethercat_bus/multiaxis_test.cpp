@@ -107,19 +107,6 @@ TEST(EthercatMultiAxis, BothAxesOfTheSlaveReachOpDisabled) {
   EXPECT_EQ(h.duo.app->input_size(), 30U);
 }
 
-// The value of the n-th "label:" row of a printout.
-std::string row(const std::string& out, const std::string& label, int n = 0) {
-  std::size_t at = 0;
-  for (;;) {
-    at = out.find("  " + label + ": ", at);
-    if (at == std::string::npos) return "(no row " + label + ")";
-    if (n-- == 0) break;
-    ++at;
-  }
-  const std::size_t start = out.find_first_not_of(' ', at + label.size() + 3);
-  return out.substr(start, out.find('\n', start) - start);
-}
-
 // --check-config: both axes on the one slave at position 2, with its whole image each.
 TEST(EthercatMultiAxis, PrintoutShowsBothAxesOnOneSlave) {
   const config::Plan plan = config::load_plan_from_string(kMultiLine, "ecat-multi.yaml", load_options());
