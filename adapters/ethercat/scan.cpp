@@ -28,8 +28,6 @@ constexpr std::uint16_t kTxAssign = 0x1C13;
 // skeleton needs is the count and the sizes, and a bounded scan).
 constexpr std::uint32_t kMaxAssigned = 32;
 constexpr std::uint32_t kMaxMapped = 64;
-// ESC features 0008h bit 2: distributed clocks [ETG.1000.4 Table 31].
-constexpr std::uint16_t kFeatureDc = 0x0004;
 
 std::string hex(std::uint32_t v, int digits) {
   char b[16];
