@@ -4,34 +4,13 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <sstream>
-#include <thread>
 
 namespace drivegate::test {
 
 namespace {
-
-// The last `lines` lines of `text`.
-std::string tail(const std::string& text, std::size_t lines) {
-  std::size_t at = text.size();
-  for (std::size_t n = 0; n <= lines; ++n) {  // one more: the text ends with a newline
-    if (at == 0) return text;
-    at = text.rfind('\n', at - 1);
-    if (at == std::string::npos) return text;
-  }
-  return text.substr(at + 1);
-}
-
-std::string read_file(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 // drivegated --check-config on the file; its exit status, the output in `out`.
 int check_config(const std::string& file, std::string& out) {
@@ -93,12 +72,7 @@ void CanopenE2e::SetUp() {
   connect_client();
 }
 
-void CanopenE2e::connect_client() {
-  client_.reset();
-  events_.clear();
-  event_cursor_ = 0;
-  client_ = std::make_unique<client::Client>(client::options_for(dds_.domain, dds_.ns, "e2e-client"));
-}
+void CanopenE2e::connect_client() { open_client(client::options_for(dds_.domain, dds_.ns, "e2e-client")); }
 
 void CanopenE2e::TearDown() {
   // The client first, so that nothing it waits for outlives the processes; then the gateway
@@ -109,11 +83,7 @@ void CanopenE2e::TearDown() {
   sim_.reset();
   // A sanitizer's report from drivegated or drivegate-sim lands in their logs, not in this test.
   for (const auto& c : configs_) {
-    for (const char* suffix : {".log", ".sim.log"}) {
-      const std::string log = read_file(c + suffix);
-      EXPECT_EQ(log.find("Sanitizer"), std::string::npos) << c + suffix << ":\n" << log;
-      EXPECT_EQ(log.find("runtime error:"), std::string::npos) << c + suffix << ":\n" << log;
-    }
+    for (const char* suffix : {".log", ".sim.log"}) expect_no_sanitizer_report(c + suffix);
   }
   // The files stay for a failed test, whose messages name them.
   if (HasFailure()) return;
@@ -138,38 +108,6 @@ void CanopenE2e::kill_gateway() {
   EXPECT_EQ(*rc, 128 + SIGKILL);
 }
 
-client::CommandRequest CanopenE2e::request(const std::string& axis, const std::string& kind) const {
-  client::CommandRequest r;
-  r.axis = axis;
-  r.kind = kind;
-  return r;
-}
-
-client::CommandResult CanopenE2e::send(const client::CommandRequest& r, std::chrono::milliseconds timeout) {
-  return client_->send(r, true, timeout);
-}
-
-client::CommandResult CanopenE2e::start(const client::CommandRequest& r, std::chrono::milliseconds timeout) {
-  return client_->send(r, false, timeout);
-}
-
-client::CommandResult CanopenE2e::send(const std::string& axis, const std::string& kind,
-                                       std::chrono::milliseconds timeout) {
-  return send(request(axis, kind), timeout);
-}
-
-client::AxisState CanopenE2e::state(const std::string& axis) const {
-  return client_->state(axis).value_or(client::AxisState{});
-}
-
-bool CanopenE2e::wait_axis(const std::string& axis, const std::function<bool(const client::AxisState&)>& done,
-                           std::chrono::milliseconds timeout) {
-  return client_->wait_until([&] {
-    const auto s = client_->state(axis);
-    return s && done(*s);
-  }, timeout);
-}
-
 bool CanopenE2e::wait_all(const std::string& drive_state, std::chrono::milliseconds timeout) {
   return client_->wait_until([&] {
     for (const char* axis : {"akd", "nord", "sd6"}) {
@@ -190,45 +128,6 @@ bool CanopenE2e::keep_alive_until(const std::string& axis, double position, doub
     if (wait_axis(axis, done, 20ms)) return true;
   }
   return false;
-}
-
-double CanopenE2e::stream_ramp(const std::string& axis, double speed, std::chrono::milliseconds duration) {
-  constexpr auto kPeriod = 10ms;
-  const double start = state(axis).position;
-  double target = start;
-  auto next = std::chrono::steady_clock::now();
-  for (auto left = duration; left > 0ms; left -= kPeriod) {
-    target += speed * std::chrono::duration<double>(kPeriod).count();
-    const std::string error = client_->stream_setpoint(axis, {}, target, 0, 0);
-    EXPECT_TRUE(error.empty()) << error;
-    // The set-point generator's period (a controller's own clock), not a wait for the gateway.
-    next += kPeriod;
-    std::this_thread::sleep_until(next);
-  }
-  return target;
-}
-
-const std::vector<client::AxisEvent>& CanopenE2e::events() {
-  for (auto& e : client_->events_since(event_cursor_)) events_.push_back(std::move(e));
-  return events_;
-}
-
-bool CanopenE2e::wait_event(const std::string& axis, const std::string& kind, const std::string& what,
-                            std::chrono::milliseconds timeout) {
-  return client_->wait_until([&] {
-    for (const auto& e : events()) {
-      if (e.axis == axis && e.kind == kind &&
-          (e.text.find(what) != std::string::npos || e.state.find(what) != std::string::npos))
-        return true;
-    }
-    return false;
-  }, timeout);
-}
-
-std::optional<client::BusStatus> CanopenE2e::bus_status() const {
-  for (const auto& b : client_->buses())
-    if (b.bus == "can0") return b;
-  return std::nullopt;
 }
 
 std::string CanopenE2e::diagnostics() {

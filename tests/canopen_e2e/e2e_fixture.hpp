@@ -5,30 +5,25 @@
 // simulated drives in a drivegate-sim process, drivegated on the same config, and a DDS client on
 // the test's own domain and namespace. Every wait is on a condition: the client's data, the
 // simulator's answers, the daemon's notify socket.
-#include <gtest/gtest.h>
-
 #include <chrono>
-#include <cstdint>
 #include <functional>
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include "client/client.hpp"
 #include "tests/canopen_e2e/sim_process.hpp"
 #include "tests/daemon/daemon_process.hpp"
+#include "tests/support/e2e_client.hpp"
 
 namespace drivegate::test {
-
-using namespace std::chrono_literals;
 
 // The three drives on one canopen bus: 4 ms SYNC at 1 Mbit/s (57 % estimated load, which
 // --check-config accepts), axis defaults so that pp moves need no rates of their own, and a homing
 // method each device profile lists.
 std::string three_drives_config(const std::string& gateway, const DdsIsolation& dds, const BusAddress& bus);
 
-class CanopenE2e : public ::testing::Test {
+class CanopenE2e : public E2eClientTest {
  protected:
   static constexpr auto kStartUp = 20s;  // DDS discovery, daemon start-up and the drives' boot
 
@@ -41,32 +36,13 @@ class CanopenE2e : public ::testing::Test {
   // A new DDS client (and event history).
   void connect_client();
 
-  client::CommandRequest request(const std::string& axis, const std::string& kind) const;
-  // Sends and waits for the final reply.
-  client::CommandResult send(const client::CommandRequest& r, std::chrono::milliseconds timeout = 10s);
-  // Sends and waits for the first reply only: a velocity or torque command runs (and has no final
-  // reply) until a later command, the command timeout or the drive ends it.
-  client::CommandResult start(const client::CommandRequest& r, std::chrono::milliseconds timeout = 10s);
-  client::CommandResult send(const std::string& axis, const std::string& kind,
-                             std::chrono::milliseconds timeout = 10s);
-
-  [[nodiscard]] client::AxisState state(const std::string& axis) const;
-  bool wait_axis(const std::string& axis, const std::function<bool(const client::AxisState&)>& done,
-                 std::chrono::milliseconds timeout);
   // Every axis' link operational and its drive in `drive_state`.
   bool wait_all(const std::string& drive_state, std::chrono::milliseconds timeout);
   // Streams the set-point (the keep-alive of pv, vl and tq) every 20 ms until `done` holds.
   bool keep_alive_until(const std::string& axis, double position, double velocity, double torque,
                         const std::function<bool(const client::AxisState&)>& done, std::chrono::milliseconds timeout);
-  // Streams a position ramp from the axis' position at `speed` user units per second for
-  // `duration`, one set-point every 10 ms as a motion controller would; returns the last target.
-  double stream_ramp(const std::string& axis, double speed, std::chrono::milliseconds duration);
-  // Every event so far, in arrival order.
-  const std::vector<client::AxisEvent>& events();
-  // An event of `axis` (empty: bus events) of `kind` whose text or state contains `what`.
-  bool wait_event(const std::string& axis, const std::string& kind, const std::string& what,
-                  std::chrono::milliseconds timeout);
-  [[nodiscard]] std::optional<client::BusStatus> bus_status() const;
+  using E2eClientTest::bus_status;
+  [[nodiscard]] std::optional<client::BusStatus> bus_status() const { return bus_status("can0"); }
 
   // What a failure message needs: axis states, the simulator's status, the ends of both logs.
   std::string diagnostics();
@@ -79,9 +55,6 @@ class CanopenE2e : public ::testing::Test {
   std::unique_ptr<SimProcess> sim_;
   std::unique_ptr<NotifySocket> notify_;
   std::unique_ptr<DaemonProcess> daemon_;
-  std::unique_ptr<client::Client> client_;
-  std::vector<client::AxisEvent> events_;
-  std::uint64_t event_cursor_ = 0;
 };
 
 // The same, for tests that start once every axis is up: link operational, switch on disabled.

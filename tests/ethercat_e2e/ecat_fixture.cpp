@@ -3,33 +3,10 @@
 #include <unistd.h>
 
 #include <filesystem>
-#include <fstream>
 #include <sstream>
 #include <thread>
 
 namespace drivegate::test {
-
-namespace {
-
-// The last `lines` lines of `text`.
-std::string tail(const std::string& text, std::size_t lines) {
-  std::size_t at = text.size();
-  for (std::size_t n = 0; n <= lines; ++n) {  // one more: the text ends with a newline
-    if (at == 0) return text;
-    at = text.rfind('\n', at - 1);
-    if (at == std::string::npos) return text;
-  }
-  return text.substr(at + 1);
-}
-
-std::string read_file(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-}  // namespace
 
 std::string EthercatE2e::config_text(const std::string& interface) const {
   std::ostringstream y;
@@ -90,11 +67,7 @@ void EthercatE2e::TearDown() {
   ns_sim_.reset();
   ns_gw_.reset();
   if (config_.empty()) return;  // skipped
-  for (const auto& log : {config_ + ".log", sim_config_ + ".sim.log"}) {
-    const std::string text = read_file(log);
-    EXPECT_EQ(text.find("Sanitizer"), std::string::npos) << log << ":\n" << text;
-    EXPECT_EQ(text.find("runtime error:"), std::string::npos) << log << ":\n" << text;
-  }
+  for (const auto& log : {config_ + ".log", sim_config_ + ".sim.log"}) expect_no_sanitizer_report(log);
   // The files stay for a failed test, whose messages name them.
   if (HasFailure()) return;
   for (const auto& f : {config_, config_ + ".log", sim_config_, sim_config_ + ".sim.log"}) std::filesystem::remove(f);
@@ -108,28 +81,9 @@ void EthercatE2e::start_gateway() {
 }
 
 void EthercatE2e::connect_client() {
-  client_.reset();
-  events_.clear();
-  event_cursor_ = 0;
   auto options = client::options_for(dds_.domain, dds_.ns, "ecat-e2e-client");
   options.interfaces = {"lo"};
-  client_ = std::make_unique<client::Client>(options);
-}
-
-client::CommandRequest EthercatE2e::request(const std::string& axis, const std::string& kind) const {
-  client::CommandRequest r;
-  r.axis = axis;
-  r.kind = kind;
-  return r;
-}
-
-client::CommandResult EthercatE2e::send(const client::CommandRequest& r, std::chrono::milliseconds timeout) {
-  return client_->send(r, true, timeout);
-}
-
-client::CommandResult EthercatE2e::send(const std::string& axis, const std::string& kind,
-                                        std::chrono::milliseconds timeout) {
-  return send(request(axis, kind), timeout);
+  open_client(options);
 }
 
 void EthercatE2e::enable(const std::string& axis) {
@@ -144,18 +98,6 @@ void EthercatE2e::set_mode(const std::string& axis, const std::string& mode) {
   m.mode = mode;
   const auto r = send(m);
   ASSERT_EQ(r.outcome, client::Outcome::Completed) << axis << " " << mode << ": " << r.reason << diagnostics();
-}
-
-client::AxisState EthercatE2e::state(const std::string& axis) const {
-  return client_->state(axis).value_or(client::AxisState{});
-}
-
-bool EthercatE2e::wait_axis(const std::string& axis, const std::function<bool(const client::AxisState&)>& done,
-                            std::chrono::milliseconds timeout) {
-  return client_->wait_until([&] {
-    const auto s = client_->state(axis);
-    return s && done(*s);
-  }, timeout);
 }
 
 bool EthercatE2e::wait_link(const std::string& axis, const std::string& link, const std::string& drive_state,
@@ -174,45 +116,6 @@ bool EthercatE2e::wait_all(const std::string& drive_state, std::chrono::millisec
     const auto p = panel();
     return p && p->valid;
   }, timeout);
-}
-
-double EthercatE2e::stream_ramp(const std::string& axis, double speed, std::chrono::milliseconds duration) {
-  constexpr auto kPeriod = 10ms;
-  const double start = state(axis).position;
-  double target = start;
-  auto next = std::chrono::steady_clock::now();
-  for (auto left = duration; left > 0ms; left -= kPeriod) {
-    target += speed * std::chrono::duration<double>(kPeriod).count();
-    const std::string error = client_->stream_setpoint(axis, {}, target, 0, 0);
-    EXPECT_TRUE(error.empty()) << error;
-    // The set-point generator's period (a controller's own clock), not a wait for the gateway.
-    next += kPeriod;
-    std::this_thread::sleep_until(next);
-  }
-  return target;
-}
-
-const std::vector<client::AxisEvent>& EthercatE2e::events() {
-  for (auto& e : client_->events_since(event_cursor_)) events_.push_back(std::move(e));
-  return events_;
-}
-
-bool EthercatE2e::wait_event(const std::string& axis, const std::string& kind, const std::string& what,
-                             std::chrono::milliseconds timeout) {
-  return client_->wait_until([&] {
-    for (const auto& e : events()) {
-      if (e.axis == axis && e.kind == kind &&
-          (e.text.find(what) != std::string::npos || e.state.find(what) != std::string::npos))
-        return true;
-    }
-    return false;
-  }, timeout);
-}
-
-std::optional<client::BusStatus> EthercatE2e::bus_status() const {
-  for (const auto& b : client_->buses())
-    if (b.bus == "ec0") return b;
-  return std::nullopt;
 }
 
 std::optional<client::IoState> EthercatE2e::panel() const { return client_->io_state("panel"); }

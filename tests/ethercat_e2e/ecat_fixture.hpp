@@ -12,26 +12,20 @@
 // namespaces and the pair are unique per process and removed by their destructors, also when a
 // test fails. Every wait is on a condition with a bounded timeout: the client's data, the
 // simulator's console answers, the daemon's notify socket.
-#include <gtest/gtest.h>
-
 #include <chrono>
-#include <cstdint>
 #include <functional>
 #include <memory>
 #include <optional>
 #include <string>
-#include <vector>
 
-#include "client/client.hpp"
 #include "tests/canopen_e2e/sim_process.hpp"
 #include "tests/daemon/daemon_process.hpp"
+#include "tests/support/e2e_client.hpp"
 #include "tests/support/netns.hpp"
 
 namespace drivegate::test {
 
-using namespace std::chrono_literals;
-
-class EthercatE2e : public ::testing::Test {
+class EthercatE2e : public E2eClientTest {
  protected:
   // Line boot, PDO set-up, DC set-up and DDS discovery on a loaded two-core machine (and under
   // the sanitizers): generous, but bounded.
@@ -48,30 +42,17 @@ class EthercatE2e : public ::testing::Test {
   void start_gateway();
   void connect_client();
 
-  client::CommandRequest request(const std::string& axis, const std::string& kind) const;
-  client::CommandResult send(const client::CommandRequest& r, std::chrono::milliseconds timeout = 15s);
-  client::CommandResult send(const std::string& axis, const std::string& kind,
-                             std::chrono::milliseconds timeout = 15s);
   // enable, with the final reply and the state checked.
   void enable(const std::string& axis);
   void set_mode(const std::string& axis, const std::string& mode);
 
-  [[nodiscard]] client::AxisState state(const std::string& axis) const;
-  bool wait_axis(const std::string& axis, const std::function<bool(const client::AxisState&)>& done,
-                 std::chrono::milliseconds timeout);
   // The axis' link is `link` and its drive in `drive_state` ("" any).
   bool wait_link(const std::string& axis, const std::string& link, const std::string& drive_state,
                  std::chrono::milliseconds timeout);
   // Every axis operational in `drive_state`, the panel's inputs valid.
   bool wait_all(const std::string& drive_state, std::chrono::milliseconds timeout);
-  // Streams a position ramp from the axis' position at `speed` user units per second for
-  // `duration`, one set-point every 10 ms as a motion controller would; returns the last target.
-  double stream_ramp(const std::string& axis, double speed, std::chrono::milliseconds duration);
-  // An event of `axis` (empty: bus events) of `kind` whose text or state contains `what`.
-  bool wait_event(const std::string& axis, const std::string& kind, const std::string& what,
-                  std::chrono::milliseconds timeout);
-  const std::vector<client::AxisEvent>& events();
-  [[nodiscard]] std::optional<client::BusStatus> bus_status() const;
+  using E2eClientTest::bus_status;
+  [[nodiscard]] std::optional<client::BusStatus> bus_status() const { return bus_status("ec0"); }
   [[nodiscard]] std::optional<client::IoState> panel() const;
 
   // One simulator console command, its answer.
@@ -95,9 +76,6 @@ class EthercatE2e : public ::testing::Test {
   std::unique_ptr<SimProcess> sim_;
   std::unique_ptr<NotifySocket> notify_;
   std::unique_ptr<DaemonProcess> daemon_;
-  std::unique_ptr<client::Client> client_;
-  std::vector<client::AxisEvent> events_;
-  std::uint64_t event_cursor_ = 0;
 };
 
 // The same, for tests that start once the line is in OP: both axes operational and disabled,
