@@ -180,7 +180,7 @@ bool AxisRunner::parameter(const ParamRequest& req, TimePoint now, RunnerOutput&
 void AxisRunner::observe_link(TimePoint now, LinkState link, std::string_view detail, RunnerOutput& out) noexcept {
   out_ = &out;
   now_ = now;
-  if (detail != link_detail_.view()) link_detail_.assign(detail);
+  if (detail != snapshot_.link_detail.view()) snapshot_.link_detail.assign(detail);
   if (!link_observed_ || link != last_link_) {
     link_observed_ = true;
     link_since_ns_ = to_ns(now);
@@ -324,7 +324,6 @@ void AxisRunner::build_snapshot(TimePoint now) noexcept {
   AxisSnapshot& s = snapshot_;
   s.axis = index_;
   s.link = last_link_;
-  s.link_detail = link_detail_;
   s.link_since_ns = link_since_ns_;
   s.state = fb.valid ? fb.state : AxisState::Unknown;
   s.mode = fb.mode;
@@ -332,7 +331,7 @@ void AxisRunner::build_snapshot(TimePoint now) noexcept {
   s.velocity = u.velocity_to_user(fb.velocity);
   s.torque = u.torque_to_user(fb.torque);
   s.fault_code = fb.fault_code;
-  s.fault_text = fb.fault_text;
+  if (s.fault_text.view() != fb.fault_text.view()) s.fault_text = fb.fault_text;  // copied only when it changed
   s.target_reached = fb.target_reached;
   s.homed = fb.homed;
   s.warning = fb.warning;

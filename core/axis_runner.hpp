@@ -100,7 +100,6 @@ class AxisRunner final : private ControllerSink {
   bool submit_finished_ = false;  // the command inside controller_.submit() completed or failed there
 
   LinkState last_link_ = LinkState::Offline;
-  LinkDetail link_detail_;
   std::int64_t link_since_ns_ = 0;
   bool link_observed_ = false;
   CommandId active_command_ = 0;

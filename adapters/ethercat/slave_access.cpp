@@ -16,6 +16,11 @@ constexpr bool profile_area(std::uint16_t index) noexcept { return index >= 0x60
 // [ETG.1000.6 SDO abort codes, as CiA 301].
 constexpr std::uint32_t kAbortDeviceState = 0x08000022;
 
+// The first cell of `key` in a table of mask + 1 cells (Fibonacci hashing).
+constexpr std::size_t first_cell(std::uint32_t key, std::size_t mask) noexcept {
+  return static_cast<std::size_t>((key * 0x9E3779B1U) >> 16) & mask;
+}
+
 }  // namespace
 
 SlaveAccess::SlaveAccess(std::size_t slave, std::vector<MappedObject> objects, int slave_axis,
@@ -27,7 +32,18 @@ SlaveAccess::SlaveAccess(std::size_t slave, std::vector<MappedObject> objects, i
       axis_offset_(axis_offset),
       coe_(coe),
       owned_(std::move(owned)),
-      faults_(faults) {}
+      faults_(faults) {
+  std::size_t size = 16;
+  while (size < 2 * objects_.size()) size *= 2;
+  lookup_.assign(size, 0);
+  lookup_mask_ = size - 1;
+  for (std::size_t i = 0; i < objects_.size() && i < 0xFFFF; ++i) {
+    std::size_t c = first_cell(objects_[i].id.key(), lookup_mask_);
+    // An object mapped twice: the first entry is the one found, as a scan in order would.
+    while (lookup_[c] != 0 && !(objects_[lookup_[c] - 1U].id == objects_[i].id)) c = (c + 1) & lookup_mask_;
+    if (lookup_[c] == 0) lookup_[c] = static_cast<std::uint16_t>(i + 1);
+  }
+}
 
 cia402::ObjectId SlaveAccess::on_slave(cia402::ObjectId id) const noexcept {
   if (slave_axis_ == 0 || !profile_area(id.index)) return id;
@@ -37,15 +53,17 @@ cia402::ObjectId SlaveAccess::on_slave(cia402::ObjectId id) const noexcept {
 
 const MappedObject* SlaveAccess::find(cia402::ObjectId id) const noexcept {
   const cia402::ObjectId on = on_slave(id);
-  for (const auto& m : objects_)
+  for (std::size_t c = first_cell(on.key(), lookup_mask_); lookup_[c] != 0; c = (c + 1) & lookup_mask_) {
+    const MappedObject& m = objects_[lookup_[c] - 1U];
     if (m.id == on) return &m;
+  }
   return nullptr;
 }
 
 void SlaveAccess::begin_cycle(bool operational, bool fresh) noexcept {
   operational_ = operational;
   fresh_ = fresh;
-  if (coe_ == nullptr) return;
+  if (coe_ == nullptr || cancelled_ == 0) return;
   // Cancelled requests are taken from the client once they end.
   for (auto& p : pending_) {
     if (p.id == 0 || !p.cancelled) continue;
@@ -54,6 +72,7 @@ void SlaveAccess::begin_cycle(bool operational, bool fresh) noexcept {
     if (st != CoeSdoStatus::Unknown) coe_->take(p.id);
     p.id = 0;
     p.cancelled = false;
+    --cancelled_;
   }
 }
 
@@ -64,6 +83,7 @@ void SlaveAccess::forget_requests() noexcept {
     p.cancelled = false;
     p.into = {};
   }
+  cancelled_ = 0;
   fault_valid_ = false;
 }
 
@@ -222,6 +242,7 @@ void SlaveAccess::cancel(cia402::RequestId id) noexcept {
   Pending* p = slot_for(id);
   if (p == nullptr) return;
   p->cancelled = true;  // the client has no cancel: the request runs out and is taken then
+  ++cancelled_;
   p->into = {};
 }
 

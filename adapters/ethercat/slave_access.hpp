@@ -116,6 +116,11 @@ class SlaveAccess final : public cia402::ObjectAccess {
 
   std::size_t slave_;
   std::vector<MappedObject> objects_;
+  // find()'s open-addressing table over objects_ (linear probing, power-of-two size, at most half
+  // full): 1 + the index into objects_, 0 for an empty cell. The profile looks objects up dozens
+  // of times per axis and cycle, so a lookup is one or two probes instead of a scan.
+  std::vector<std::uint16_t> lookup_;
+  std::size_t lookup_mask_ = 0;
   int slave_axis_;
   std::uint16_t axis_offset_;
   CoeSdoClient* coe_;
@@ -127,6 +132,7 @@ class SlaveAccess final : public cia402::ObjectAccess {
   bool cw_override_ = false;
   std::uint16_t cw_value_ = 0;
   std::array<Pending, kMaxPending> pending_{};
+  std::size_t cancelled_ = 0;  // pending_ entries cancelled and not yet taken (begin_cycle() looks only then)
   bool fault_valid_ = false;
   std::uint16_t fault_code_ = 0;
   core::FixedString<120> fault_text_{};

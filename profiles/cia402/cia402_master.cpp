@@ -306,6 +306,7 @@ Admission Cia402Master::parameter(const core::ParamRequest& req, core::TimePoint
   for (auto& p : params_) {
     if (p.active) continue;
     p.active = true;
+    ++params_active_;
     p.req = req;
     p.request = kNoRequest;
     return Admission::accept();
@@ -326,6 +327,7 @@ void Cia402Master::link_lost(core::TimePoint /*now*/, core::ControllerSink& sink
   for (auto& p : params_) {
     if (!p.active) continue;
     p.active = false;
+    --params_active_;
     io_.cancel(p.request);
     core::ParamReply reply;
     reply.id = p.req.id;

@@ -182,6 +182,8 @@ class Cia402Master final : public core::AxisController {
   bool control_lost_ = false;
 
   std::array<PendingParam, kMaxParameterRequests> params_{};
+  // How many of params_ are active: the cycle skips the array (4 KiB a request) while none is.
+  std::size_t params_active_ = 0;
   core::DriveFeedback fb_{};
 };
 

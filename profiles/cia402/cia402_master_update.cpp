@@ -303,6 +303,7 @@ void Cia402Master::write_outputs() noexcept {
 }
 
 void Cia402Master::run_parameters(core::ControllerSink& sink) noexcept {
+  if (params_active_ == 0) return;
   for (auto& p : params_) {
     if (!p.active) continue;
     const ObjectId id{p.req.index, p.req.sub};
@@ -346,6 +347,7 @@ void Cia402Master::run_parameters(core::ControllerSink& sink) noexcept {
       reply.error.assign("request lost by the bus adapter");
     }
     p.active = false;
+    --params_active_;
     sink.parameter_done(reply);
   }
 }

@@ -122,5 +122,31 @@ TEST(EthercatBusImage, MappedObjectsAndIoSizesFromTheSii) {
   EXPECT_TRUE(gen.inputs_fresh());
 }
 
+// SlaveAccess finds its objects through a hash table: every mapped object is found (also with
+// more objects than the table's first size, so that probes collide, and with one mapped twice),
+// unmapped ones are not, and the second axis of a multi-axis slave finds the profile objects at
+// its own offset.
+TEST(EthercatSlaveAccess, FindsEveryMappedObject) {
+  std::vector<MappedObject> objects;
+  for (std::uint16_t i = 0; i < 40; ++i)
+    objects.push_back(MappedObject{{static_cast<std::uint16_t>(0x6000 + i), 0}, cia402::DataType::U16, true,
+                                   static_cast<std::uint16_t>(2 * i)});
+  objects.push_back(MappedObject{{0x6005, 0}, cia402::DataType::U8, false, 99});  // 6005h again
+  objects.push_back(MappedObject{{0x2000, 7}, cia402::DataType::U8, false, 100});
+  const SlaveAccess a(0, objects, 0, 0x800, nullptr, {}, {});
+  for (std::uint16_t i = 0; i < 40; ++i) EXPECT_TRUE(a.mapped({static_cast<std::uint16_t>(0x6000 + i), 0})) << i;
+  EXPECT_TRUE(a.mapped({0x2000, 7}));
+  EXPECT_FALSE(a.mapped({0x2000, 6}));
+  EXPECT_FALSE(a.mapped({0x6000, 1}));
+  EXPECT_FALSE(a.mapped({0x6028, 0}));
+  EXPECT_FALSE(a.mapped({0x6805, 0}));
+
+  const std::vector<MappedObject> second{{{0x6840, 0}, cia402::DataType::U16, true, 0},
+                                         {{0x2000, 7}, cia402::DataType::U8, false, 0}};
+  const SlaveAccess b(0, second, 1, 0x800, nullptr, {}, {});
+  EXPECT_TRUE(b.mapped({0x6040, 0}));  // axis 1: 6040h + 800h
+  EXPECT_TRUE(b.mapped({0x2000, 7}));  // outside the profile area: not offset
+}
+
 }  // namespace
 }  // namespace drivegate::ethercat::test

@@ -54,6 +54,7 @@ CoeSdoId CoeSdoClient::submit(bool upload, std::uint16_t index, std::uint8_t sub
     s = Slot{};
     s.generation = gen;
     s.state = SlotState::Queued;
+    ++queued_;
     s.upload = upload;
     s.order = next_order_++;
     s.index = index;
@@ -184,6 +185,7 @@ void CoeSdoClient::reset() noexcept {
     s.result.abort_code = cia402::sdo_abort_code::kDeviceState;
     ++counters_.failed;
   }
+  queued_ = 0;
   active_ = nullptr;
   phase_ = Phase::Idle;
   expect_ = Expect::Initiate;
@@ -274,12 +276,14 @@ void CoeSdoClient::prepare_upload_segment() noexcept {
 }
 
 void CoeSdoClient::start_next(core::TimePoint now) noexcept {
+  if (queued_ == 0) return;
   Slot* next = nullptr;
   for (auto& s : slots_) {
     if (s.state == SlotState::Queued && (next == nullptr || s.order < next->order)) next = &s;
   }
   if (next == nullptr) return;
   active_ = next;
+  --queued_;
   next->state = SlotState::InFlight;
   next->result.status = CoeSdoStatus::InFlight;
   deadline_ = now + timing_.timeout;

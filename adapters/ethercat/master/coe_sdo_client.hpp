@@ -205,6 +205,7 @@ class CoeSdoClient final : public DatagramOwner {
   bool valid_ = false;
 
   std::array<Slot, kQueueDepth> slots_{};
+  std::size_t queued_ = 0;  // slots Queued: start_next() looks for the oldest only then
   std::uint64_t next_order_ = 0;
   Slot* active_ = nullptr;
   Phase phase_ = Phase::Idle;

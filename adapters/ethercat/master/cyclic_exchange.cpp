@@ -86,7 +86,11 @@ bool CyclicExchange::queue(Transactions& tx) noexcept {
 void CyclicExchange::copy_inputs(const CyclicDatagram& d, std::span<const std::uint8_t> data) noexcept {
   const std::uint32_t lo = d.image_offset;
   const std::uint32_t hi = lo + static_cast<std::uint32_t>(std::min<std::size_t>(data.size(), d.length));
-  for (std::size_t k = 0; k < image_.slave_count(); ++k) {
+  // A per-slave datagram covers its own slave only: no walk over the others (slaves x datagrams).
+  const bool own = d.slave < image_.slave_count();
+  const std::size_t first = own ? d.slave : 0;
+  const std::size_t last = own ? first + 1 : image_.slave_count();
+  for (std::size_t k = first; k < last; ++k) {
     const SlaveImage& s = image_.slave(k);
     if (s.input_bytes == 0) continue;
     const std::uint32_t a = std::max(lo, s.input_offset);
