@@ -308,6 +308,10 @@ TEST(PnDcpClient, ForeignAndMalformedFramesAreCountedAndDropped) {
                            [&](std::span<std::uint8_t> o) { return encode_hello(o, 5, other); }));
   seg.hub.inject(dcp_frame(kDcpIdentifyMulticast, stranger, frame_id::kDcpIdentifyRequest,
                            [&](std::span<std::uint8_t> o) { return encode_identify_all_request(o, 77, 1); }));
+  // What a port that sees all traffic may pass up: a response to another controller, with our Xid.
+  EXPECT_TRUE(seg.client.on_frame(dcp_frame(device_mac(0x5555), stranger, frame_id::kDcpIdentifyResponse,
+                                            [&](std::span<std::uint8_t> o) { return encode_identify_response(o, xid, other); }),
+                                  seg.hub.now));
   Bytes ipv4(60, 0);
   ipv4[12] = 0x08;
   EXPECT_FALSE(seg.client.on_frame(ipv4, seg.hub.now));
@@ -320,6 +324,7 @@ TEST(PnDcpClient, ForeignAndMalformedFramesAreCountedAndDropped) {
   EXPECT_EQ(c.wrong_service, 1U);
   EXPECT_EQ(c.malformed, 1U);
   EXPECT_EQ(c.requests_seen, 2U);  // the Hello and the other controller's Identify
+  EXPECT_EQ(c.not_for_us, 1U);
   EXPECT_EQ(c.responses, 1U);
   // The device answered the other controller's Identify too (to the other controller).
   EXPECT_EQ(d.counters().identify_answered, 2U);

@@ -268,6 +268,10 @@ bool DcpClient::on_frame(std::span<const std::uint8_t> frame, core::TimePoint) n
     ++counters_.requests_seen;  // an Identify of another controller, a Hello, a Get/Set not for us
     return true;
   }
+  if (e.header.dst != own_mac_) {
+    ++counters_.not_for_us;  // a response to another controller (a port that sees all traffic)
+    return true;
+  }
   Slot* s = in_flight();
   if (s == nullptr || s->result.frames_sent == 0) {
     ++counters_.unsolicited;

@@ -16,9 +16,10 @@
 //     Xid, so a device that saw the first frame answers again without acting twice.
 //
 // Every request has its own Xid (incremented per request from `first_xid`). Responses are matched
-// by FrameID, ServiceID, ServiceType, Xid and (Set) the source MAC; well-formed DCP frames that
-// do not match are counted by reason and dropped (another Xid, another service, a Hello, a request
-// of another controller), frames that do not decode are counted malformed.
+// by destination (our MAC), FrameID, ServiceID, ServiceType, Xid and (Set) the source MAC;
+// well-formed DCP frames that do not match are counted by reason and dropped (another Xid, another
+// service, a Hello, a request or response of another controller), frames that do not decode are
+// counted malformed.
 //
 // One request at a time, the others wait in a FIFO of kQueueDepth. Nothing here allocates.
 #include <array>
@@ -106,6 +107,7 @@ struct DcpClientCounters {
   std::uint64_t wrong_name = 0;         // an Identify-by-name response with another name
   std::uint64_t duplicate_answers = 0;  // a second Identify response from one MAC
   std::uint64_t unsolicited = 0;        // a response while nothing is in flight
+  std::uint64_t not_for_us = 0;         // a response addressed to another MAC
   std::uint64_t requests_seen = 0;      // DCP requests and Hellos (not for a controller)
   std::uint64_t malformed = 0;          // did not decode (Ethernet or DCP)
   std::uint64_t tx_too_small = 0;       // poll() was given a buffer shorter than the frame
