@@ -32,6 +32,8 @@ profinet_rpc:     PNIO DCE/RPC datagrams (UDP 34964) in both drep byte orders: C
                   index 47 (the AKD digest's PNU 930 request) and Read of I&M0 with responses,
                   PrmEnd, ApplicationReady, Release, a fault, a ping, a truncated one.
 profinet_blocks:  the block lists (NDR args) of those datagrams, one file each.
+profinet_dcp_engines: the profinet_dcp frames as records (format in fuzz_profinet_dcp_engines.cpp),
+                  one per file, and one file with them all 100 ms apart.
 """
 import struct
 import pathlib
@@ -321,6 +323,10 @@ def profinet_seeds():
     seeds.update({"lying_length": bytes(bad_len), "odd_ip_block": odd_ip, "truncated": seeds["identify_response"][:30]})
     for name, data in seeds.items():
         write("profinet_dcp", name, data)
+    records = {name: bytes([10]) + struct.pack(">H", len(data)) + data for name, data in seeds.items()}
+    for name, data in records.items():
+        write("profinet_dcp_engines", name, data)
+    write("profinet_dcp_engines", "all", b"".join(records.values()))
 
     out = bytes.fromhex("047F40008000000080808080") + bytes(28)
     status = bytes.fromhex("12343500")

@@ -382,5 +382,37 @@ TEST(PnDcp, Names) {
   EXPECT_EQ(to_string(static_cast<DcpBlockError>(9)), "unknown block error");
 }
 
+TEST(PnDcp, IpSuiteProblems) {
+  const auto suite = [](std::array<std::uint8_t, 4> a, std::array<std::uint8_t, 4> m, std::array<std::uint8_t, 4> g) {
+    IpSuite s;
+    s.address = a;
+    s.netmask = m;
+    s.gateway = g;
+    return s;
+  };
+  EXPECT_EQ(ip_suite_problem(suite({192, 168, 0, 10}, {255, 255, 255, 0}, {192, 168, 0, 1})), "");
+  EXPECT_EQ(ip_suite_problem(suite({192, 168, 0, 10}, {255, 255, 255, 0}, {0, 0, 0, 0})), "");
+  EXPECT_EQ(ip_suite_problem(suite({192, 168, 0, 10}, {255, 255, 255, 0}, {192, 168, 0, 10})), "");
+  EXPECT_EQ(ip_suite_problem(suite({10, 0, 0, 1}, {255, 255, 255, 254}, {0, 0, 0, 0})), "");
+  EXPECT_EQ(ip_suite_problem(IpSuite{}), "");
+  EXPECT_EQ(ip_suite_problem(suite({0, 0, 0, 0}, {255, 255, 255, 0}, {0, 0, 0, 0})),
+            "the address is 0.0.0.0 but netmask or gateway is not");
+  EXPECT_EQ(ip_suite_problem(suite({192, 168, 0, 10}, {255, 0, 255, 0}, {0, 0, 0, 0})),
+            "the netmask's ones are not contiguous");
+  EXPECT_EQ(ip_suite_problem(suite({192, 168, 0, 10}, {0, 0, 0, 0}, {0, 0, 0, 0})), "the netmask is 0.0.0.0");
+  EXPECT_EQ(ip_suite_problem(suite({0, 1, 2, 3}, {255, 0, 0, 0}, {0, 0, 0, 0})),
+            "the address is in 0.0.0.0/8 (this network)");
+  EXPECT_EQ(ip_suite_problem(suite({127, 0, 0, 1}, {255, 0, 0, 0}, {0, 0, 0, 0})),
+            "the address is a loopback address (127.0.0.0/8)");
+  EXPECT_EQ(ip_suite_problem(suite({239, 1, 1, 1}, {255, 255, 255, 0}, {0, 0, 0, 0})),
+            "the address is multicast or reserved (224.0.0.0 and above)");
+  EXPECT_EQ(ip_suite_problem(suite({192, 168, 0, 0}, {255, 255, 255, 0}, {0, 0, 0, 0})),
+            "the address is the subnet's network address");
+  EXPECT_EQ(ip_suite_problem(suite({192, 168, 0, 255}, {255, 255, 255, 0}, {0, 0, 0, 0})),
+            "the address is the subnet's broadcast address");
+  EXPECT_EQ(ip_suite_problem(suite({192, 168, 0, 10}, {255, 255, 255, 0}, {192, 168, 1, 1})),
+            "the gateway is outside the address's subnet");
+}
+
 }  // namespace
 }  // namespace drivegate::profinet

@@ -108,5 +108,9 @@ TEST(PnEthernet, MalformedFrames) {
   EXPECT_EQ(to_string(EthernetError::WrongEtherType), "EtherType is not 8892h (PROFINET)");
 }
 
+TEST(PnEthernet, MacText) {
+  EXPECT_STREQ(mac_text(MacAddress{0x00, 0x1B, 0x1B, 0x12, 0x34, 0xFE}).data(), "00:1b:1b:12:34:fe");
+}
+
 }  // namespace
 }  // namespace drivegate::profinet

@@ -344,6 +344,31 @@ DcpError read_ip_suite(std::span<const std::uint8_t> data, IpSuite& out) noexcep
   return DcpError::None;
 }
 
+std::string_view ip_suite_problem(const IpSuite& ip) noexcept {
+  const auto u32 = [](const std::array<std::uint8_t, 4>& a) {
+    return (std::uint32_t{a[0]} << 24) | (std::uint32_t{a[1]} << 16) | (std::uint32_t{a[2]} << 8) | a[3];
+  };
+  const std::uint32_t address = u32(ip.address);
+  const std::uint32_t mask = u32(ip.netmask);
+  const std::uint32_t gateway = u32(ip.gateway);
+  if (address == 0 && mask == 0 && gateway == 0) return {};
+  if (address == 0) return "the address is 0.0.0.0 but netmask or gateway is not";
+  if ((~mask & (~mask + 1)) != 0) return "the netmask's ones are not contiguous";
+  if (mask == 0) return "the netmask is 0.0.0.0";
+  const std::uint8_t first = ip.address[0];
+  if (first == 0) return "the address is in 0.0.0.0/8 (this network)";
+  if (first == 127) return "the address is a loopback address (127.0.0.0/8)";
+  if (first >= 224) return "the address is multicast or reserved (224.0.0.0 and above)";
+  if (mask < 0xFFFFFFFEU) {  // /31 and /32 have no network and broadcast address
+    if ((address & ~mask) == 0) return "the address is the subnet's network address";
+    if ((address & ~mask) == ~mask) return "the address is the subnet's broadcast address";
+  }
+  if (gateway != 0 && gateway != address && (gateway & mask) != (address & mask)) {
+    return "the gateway is outside the address's subnet";
+  }
+  return {};
+}
+
 DcpDeviceInfoView decode_device_info(const DcpPdu& pdu) noexcept {
   DcpDeviceInfoView v;
   if (!pdu.ok()) {

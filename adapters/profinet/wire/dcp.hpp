@@ -116,6 +116,12 @@ struct IpSuite {
   std::array<std::uint8_t, 4> gateway{};
   bool operator==(const IpSuite&) const = default;
 };
+// What makes an IP suite unusable for a device, or "" when it is usable: a netmask whose ones are
+// not contiguous, an address in 0/8 (but 0.0.0.0), 127/8, 224/3 or the subnet's network or
+// broadcast address, a gateway outside the subnet. 0.0.0.0/0.0.0.0/0.0.0.0 is "no address" (a
+// Set with it takes the address away) and passes; a gateway of 0.0.0.0 or equal to the address
+// means "no gateway" [IEC 61158-6-10 §4.3, coding of the IP parameter: StandardGateway].
+std::string_view ip_suite_problem(const IpSuite& ip) noexcept;
 
 struct DcpHeader {
   DcpService service = DcpService::Identify;

@@ -110,4 +110,15 @@ EthernetView decode_ethernet(std::span<const std::uint8_t> frame) noexcept {
   return v;
 }
 
+std::array<char, 18> mac_text(const MacAddress& mac) noexcept {
+  static constexpr char kHex[] = "0123456789abcdef";
+  std::array<char, 18> t{};
+  for (std::size_t i = 0; i < mac.size(); ++i) {
+    t[3 * i] = kHex[mac[i] >> 4];
+    t[3 * i + 1] = kHex[mac[i] & 0x0F];
+    t[3 * i + 2] = i + 1 < mac.size() ? ':' : '\0';
+  }
+  return t;
+}
+
 }  // namespace drivegate::profinet

@@ -107,4 +107,7 @@ struct EthernetView {
 };
 EthernetView decode_ethernet(std::span<const std::uint8_t> frame) noexcept;
 
+// "00:1b:1b:12:34:56" (17 characters and a terminating NUL), for reports and log lines.
+std::array<char, 18> mac_text(const MacAddress& mac) noexcept;
+
 }  // namespace drivegate::profinet
