@@ -257,6 +257,16 @@ RpcFaultView decode_rpc_fault(std::span<const std::uint8_t> body, ByteOrder orde
   return v;
 }
 
+std::size_t encode_rpc_fault(RpcHeader h, PacketType type, std::uint32_t status, std::span<std::uint8_t> out) noexcept {
+  if (type != PacketType::Fault && type != PacketType::Reject) return 0;
+  h.packet_type = static_cast<std::uint8_t>(type);
+  h.fragment_length = 4;
+  if (encode_rpc_header(h, out) == 0) return 0;
+  Writer w(out.subspan(kRpcHeaderSize), h.order);
+  w.u32(status);
+  return w.ok() ? kRpcHeaderSize + 4 : 0;
+}
+
 std::string_view nca_status_text(std::uint32_t status) noexcept {
   // [DCE 1.1 RPC Appendix E "Reject Status Codes"]: the ones a PNIO peer answers with.
   switch (status) {

@@ -185,6 +185,14 @@ struct RpcFaultView {
   std::uint32_t status = 0;
 };
 RpcFaultView decode_rpc_fault(std::span<const std::uint8_t> body, ByteOrder order) noexcept;
+// A fault or reject answering the call `h` names (response_header_for(request) gives it): the
+// header with `type` and fragment length 4, then `status` in drep order. 0 when `type` is neither.
+std::size_t encode_rpc_fault(RpcHeader h, PacketType type, std::uint32_t status, std::span<std::uint8_t> out) noexcept;
 std::string_view nca_status_text(std::uint32_t status) noexcept;
+namespace nca_status {
+inline constexpr std::uint32_t kOpRangeError = 0x1C010002;
+inline constexpr std::uint32_t kUnknownInterface = 0x1C010003;
+inline constexpr std::uint32_t kProtoError = 0x1C01000B;
+}  // namespace nca_status
 
 }  // namespace drivegate::profinet
