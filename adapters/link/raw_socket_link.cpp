@@ -184,9 +184,10 @@ bool RawSocketLink::bind_to(int ifindex) noexcept {
   }
   ifindex_ = ifindex;
   bound_ = true;
-  // Slaves pass a frame on with its destination unchanged: a master that sends to any address
-  // but broadcast or the port's own still gets its frames back. Promiscuous for as long as this
-  // socket lives (the kernel drops the membership with it); without it only such frames are lost.
+  // EtherCAT slaves pass a frame on with its destination unchanged: a master that sends to any
+  // address but broadcast or the port's own still gets its frames back; PROFINET devices send DCP
+  // Hello to a multicast address the port has not joined. Promiscuous for as long as this socket
+  // lives (the kernel drops the membership with it); without it only such frames are lost.
   packet_mreq promisc{};
   promisc.mr_ifindex = ifindex;
   promisc.mr_type = PACKET_MR_PROMISC;
