@@ -5,6 +5,7 @@
 // datagrams); masters send them untagged, so a tagged frame is a wrong EtherType here. Shorter than
 // an Ethernet header plus the EtherCAT header cannot be an EtherCAT frame.
 #include <cstddef>
+#include <cstdint>
 #include <span>
 #include <utility>
 
