@@ -36,7 +36,7 @@
 
 #include "adapters/ethercat/bus_type.hpp"
 #include "adapters/ethercat/ethercat_bus.hpp"
-#include "adapters/ethercat/link/raw_socket_link.hpp"
+#include "adapters/ethercat/link/ethercat_link.hpp"
 #include "adapters/ethercat/sim/line_builder.hpp"
 #include "adapters/ethercat/sim/sim_endpoint.hpp"
 #include "config/loader.hpp"

@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "adapters/ethercat/link/raw_socket_link.hpp"
+#include "adapters/ethercat/link/ethercat_link.hpp"
 #include "tests/ethercat_link/frames.hpp"
 #include "tests/support/netns.hpp"
 

@@ -14,7 +14,7 @@
 #include <span>
 #include <vector>
 
-#include "adapters/ethercat/link/memory_link.hpp"
+#include "adapters/ethercat/link/ethercat_link.hpp"
 #include "adapters/ethercat/sim/coe_test_slave.hpp"
 #include "adapters/ethercat/sim/esc_slave.hpp"
 #include "adapters/ethercat/sim/generic_io.hpp"

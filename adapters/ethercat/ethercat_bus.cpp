@@ -6,7 +6,7 @@
 #include <map>
 #include <thread>
 
-#include "adapters/ethercat/link/raw_socket_link.hpp"
+#include "adapters/ethercat/link/ethercat_link.hpp"
 #include "adapters/ethercat/wire/al_status.hpp"
 #include "core/bytes.hpp"
 #include "profiles/cia402/master_settings.hpp"

@@ -51,7 +51,7 @@
 
 #include "adapters/ethercat/bus_dc.hpp"
 #include "adapters/ethercat/bus_io.hpp"
-#include "adapters/ethercat/link/link.hpp"
+#include "adapters/ethercat/link/ethercat_link.hpp"
 #include "adapters/ethercat/master/coe_sdo_client.hpp"
 #include "adapters/ethercat/master/cyclic_exchange.hpp"
 #include "adapters/ethercat/master/line_boot.hpp"

@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <sstream>
 
-#include "adapters/ethercat/link/raw_socket_link.hpp"
+#include "adapters/ethercat/link/ethercat_link.hpp"
 #include "adapters/ethercat/wire/registers.hpp"
 #include "config/device_profile.hpp"
 #include "config/ethercat/plan.hpp"

@@ -37,7 +37,7 @@
 #include <string>
 #include <vector>
 
-#include "adapters/ethercat/link/link.hpp"
+#include "adapters/ethercat/link/ethercat_link.hpp"
 #include "adapters/ethercat/master/coe_sdo_client.hpp"
 #include "adapters/ethercat/master/line_boot.hpp"
 #include "adapters/ethercat/master/transactions.hpp"

@@ -7,7 +7,7 @@
 #include <memory>
 
 #include "adapters/ethercat/ethercat_bus.hpp"
-#include "adapters/ethercat/link/link.hpp"
+#include "adapters/ethercat/link/ethercat_link.hpp"
 #include "adapters/ethercat/sim/line_builder.hpp"
 #include "config/plan.hpp"
 

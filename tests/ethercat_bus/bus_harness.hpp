@@ -11,7 +11,7 @@
 
 #include "adapters/ethercat/bus_type.hpp"
 #include "adapters/ethercat/ethercat_bus.hpp"
-#include "adapters/ethercat/link/memory_link.hpp"
+#include "adapters/ethercat/link/ethercat_link.hpp"
 #include "adapters/ethercat/sim/cia402_slave.hpp"
 #include "adapters/ethercat/sim/generic_io.hpp"
 #include "adapters/ethercat/sim/sim_line.hpp"

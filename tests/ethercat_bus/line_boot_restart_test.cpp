@@ -7,7 +7,7 @@
 #include <memory>
 #include <vector>
 
-#include "adapters/ethercat/link/memory_link.hpp"
+#include "adapters/ethercat/link/ethercat_link.hpp"
 #include "adapters/ethercat/master/line_boot.hpp"
 #include "adapters/ethercat/master/transactions.hpp"
 #include "adapters/ethercat/sim/esc_slave.hpp"

@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "adapters/ethercat/link/link.hpp"
+#include "adapters/ethercat/link/ethercat_link.hpp"
 
 namespace drivegate::ethercat::test {
 

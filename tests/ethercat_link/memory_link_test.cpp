@@ -1,4 +1,4 @@
-#include "adapters/ethercat/link/memory_link.hpp"
+#include "adapters/ethercat/link/ethercat_link.hpp"
 
 #include <gtest/gtest.h>
 

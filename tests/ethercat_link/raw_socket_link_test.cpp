@@ -1,6 +1,6 @@
 // RawSocketLink over a veth pair whose ends sit in two network namespaces the test creates (and
 // always removes): end A is the master's port, end B stands for the first slave.
-#include "adapters/ethercat/link/raw_socket_link.hpp"
+#include "adapters/ethercat/link/ethercat_link.hpp"
 
 #include <arpa/inet.h>
 #include <linux/capability.h>

@@ -11,7 +11,7 @@
 #include <memory>
 #include <vector>
 
-#include "adapters/ethercat/link/memory_link.hpp"
+#include "adapters/ethercat/link/ethercat_link.hpp"
 #include "adapters/ethercat/master/coe_sdo_client.hpp"
 #include "adapters/ethercat/master/line_boot.hpp"
 #include "adapters/ethercat/master/transactions.hpp"

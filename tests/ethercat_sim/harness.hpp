@@ -10,7 +10,7 @@
 #include <span>
 #include <vector>
 
-#include "adapters/ethercat/link/memory_link.hpp"
+#include "adapters/ethercat/link/ethercat_link.hpp"
 #include "adapters/ethercat/sim/esc_slave.hpp"
 #include "adapters/ethercat/sim/generic_io.hpp"
 #include "adapters/ethercat/sim/sim_line.hpp"

@@ -4,7 +4,7 @@
 // answer goes back to the transactions, then `step` passes and what is still out is expired.
 #include <array>
 
-#include "adapters/ethercat/link/memory_link.hpp"
+#include "adapters/ethercat/link/ethercat_link.hpp"
 #include "adapters/ethercat/master/transactions.hpp"
 #include "adapters/ethercat/sim/sim_line.hpp"
 #include "core/clock.hpp"

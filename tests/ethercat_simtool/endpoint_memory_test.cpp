@@ -5,7 +5,7 @@
 
 #include <array>
 
-#include "adapters/ethercat/link/memory_link.hpp"
+#include "adapters/ethercat/link/ethercat_link.hpp"
 #include "adapters/ethercat/sim/sim_endpoint.hpp"
 #include "tests/ethercat_simtool/support.hpp"
 #include "tests/support/alloc_counter.hpp"

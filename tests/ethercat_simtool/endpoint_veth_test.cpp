@@ -8,7 +8,7 @@
 #include <memory>
 #include <thread>
 
-#include "adapters/ethercat/link/raw_socket_link.hpp"
+#include "adapters/ethercat/link/ethercat_link.hpp"
 #include "adapters/ethercat/sim/sim_endpoint.hpp"
 #include "tests/ethercat_simtool/support.hpp"
 #include "tests/support/netns.hpp"

@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "adapters/ethercat/link/raw_socket_link.hpp"
+#include "adapters/ethercat/link/ethercat_link.hpp"
 #include "tests/ethercat_simtool/support.hpp"
 #include "tests/support/netns.hpp"
 #include "tests/support/pipe_lines.hpp"

@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "adapters/ethercat/link/link.hpp"
+#include "adapters/ethercat/link/ethercat_link.hpp"
 #include "adapters/ethercat/master/line_boot.hpp"
 #include "adapters/ethercat/master/transactions.hpp"
 #include "adapters/ethercat/sim/line_builder.hpp"

@@ -19,7 +19,7 @@
 #include <string>
 #include <vector>
 
-#include "adapters/ethercat/link/memory_link.hpp"
+#include "adapters/ethercat/link/ethercat_link.hpp"
 #include "adapters/ethercat/sim/esc_slave.hpp"
 #include "adapters/ethercat/sim/sim_line.hpp"
 #include "adapters/ethercat/sim/sim_personas.hpp"

@@ -15,7 +15,7 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "adapters/ethercat/link/link.hpp"
+#include "adapters/ethercat/link/ethercat_link.hpp"
 #include "adapters/ethercat/sim/line_builder.hpp"
 #include "core/clock.hpp"
 

@@ -24,7 +24,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "adapters/ethercat/link/memory_link.hpp"
+#include "adapters/ethercat/link/ethercat_link.hpp"
 #include "adapters/ethercat/sim/esc_slave.hpp"
 #include "adapters/ethercat/wire/frame.hpp"
 

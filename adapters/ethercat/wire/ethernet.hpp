@@ -1,8 +1,9 @@
 #pragma once
 // The Ethernet II header an EtherCAT frame travels in and the EtherCAT header behind it
 // [ETG.1000.4 §5.3; IEEE 802.3 §3.1.1, §3.2.6; IEEE 802.1Q]: one home for the sizes and the
-// EtherType, shared by the codecs (wire/frame.hpp) and the link (link/link.hpp), which moves frames
-// as bytes and looks no further than these headers. Header-only: the link does not link the codecs.
+// EtherType, shared by the codecs (wire/frame.hpp) and the link (link/ethercat_link.hpp), which
+// moves frames as bytes and looks no further than these headers. Header-only: the link does not
+// link the codecs.
 //
 //   destination(6) source(6) [TPID 8100h + TCI] EtherType 88A4h (big-endian) | EtherCAT header u16 LE
 #include <cstddef>

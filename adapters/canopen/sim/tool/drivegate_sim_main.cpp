@@ -46,7 +46,7 @@
 #include "adapters/canopen/canopen_bus.hpp"
 #include "adapters/canopen/sim/sim_network.hpp"
 #include "adapters/canopen/sim/slave_config.hpp"
-#include "adapters/ethercat/link/raw_socket_link.hpp"
+#include "adapters/ethercat/link/ethercat_link.hpp"
 #include "adapters/ethercat/sim/line_builder.hpp"
 #include "adapters/ethercat/sim/line_console.hpp"
 #include "adapters/ethercat/sim/sim_endpoint.hpp"

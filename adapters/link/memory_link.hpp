@@ -4,7 +4,8 @@
 // MemoryLink's receive queue; what the sink or peer hands back with deliver() waits in this link's
 // receive queue. The queue has a fixed capacity given at construction; a frame that does not fit is
 // dropped and counted (rx_overflow), as a full socket buffer would. Received frames are checked like
-// the raw socket's (check_frame(): too short, too long, wrong EtherType are dropped and counted).
+// the raw socket's (check_frame() by the link's FrameRules: too short, too long, wrong EtherType are
+// dropped and counted). A tagged frame stays tagged, as RawSocketLink hands it up.
 //
 // One thread, no locks: the sink runs inside send() on the caller's thread and may call deliver()
 // from there. counters() and state() may be read from any thread.
@@ -13,9 +14,9 @@
 #include <string>
 #include <vector>
 
-#include "adapters/ethercat/link/link.hpp"
+#include "adapters/link/link.hpp"
 
-namespace drivegate::ethercat {
+namespace drivegate::link {
 
 // Where a MemoryLink's sent frames go. on_frame() runs inside MemoryLink::send().
 class FrameSink {
@@ -24,10 +25,11 @@ class FrameSink {
   virtual void on_frame(FrameView frame) noexcept = 0;
 };
 
-class MemoryLink final : public Link {
+// Not final: a protocol may name its own with its rules built in (ethercat::MemoryLink).
+class MemoryLink : public Link {
  public:
   // `capacity`: frames the receive queue holds (allocated here, never in the cyclic path).
-  explicit MemoryLink(std::size_t capacity = 256);
+  explicit MemoryLink(const FrameRules& rules, std::size_t capacity = 256);
   ~MemoryLink() override;
   MemoryLink(const MemoryLink&) = delete;
   MemoryLink& operator=(const MemoryLink&) = delete;
@@ -63,6 +65,7 @@ class MemoryLink final : public Link {
  private:
   void detach() noexcept;
 
+  FrameRules rules_;
   std::vector<FrameBuffer> slots_;
   std::size_t head_ = 0;   // oldest queued frame
   std::size_t count_ = 0;  // queued frames
@@ -73,4 +76,4 @@ class MemoryLink final : public Link {
   LinkCounterCells counters_;
 };
 
-}  // namespace drivegate::ethercat
+}  // namespace drivegate::link

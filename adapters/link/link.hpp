@@ -1,9 +1,11 @@
 #pragma once
-// The link an EtherCAT bus thread sends its frames on and reads them back from (DESIGN.md §2 rule 5,
-// §5): it moves whole Ethernet frames (destination, source, EtherType, payload; no FCS) as bytes and
-// does not interpret them beyond the Ethernet header. Implementations: RawSocketLink (AF_PACKET on a
-// named interface, production and veth tests) and MemoryLink (in-process, unit tests and the
-// in-process simulator).
+// The link a bus thread sends its raw Ethernet frames on and reads them back from (DESIGN.md §2
+// rule 5, §5), shared by EtherCAT (EtherType 88A4h) and PROFINET (8892h): it moves whole Ethernet
+// frames (destination, source, [802.1Q tag,] EtherType, payload; no FCS) as bytes and does not
+// interpret them beyond the Ethernet header. Which EtherType, how short a frame may be, whether
+// tagged frames belong to the protocol and the prefix of error lines are the protocol's FrameRules.
+// Implementations: RawSocketLink (AF_PACKET on a named interface, production and veth tests) and
+// MemoryLink (in-process, unit tests and the in-process simulators).
 //
 // send(), receive(), poll_state(), state() and counters() are the cyclic path: non-blocking, no heap
 // allocation, no lock, no logging. open() may allocate and throws LinkError with one line a person
@@ -15,42 +17,68 @@
 #include <stdexcept>
 #include <string>
 
-#include "adapters/ethercat/wire/ethernet.hpp"
 #include "core/clock.hpp"
 #include "core/counter_cell.hpp"
 
-namespace drivegate::ethercat {
+namespace drivegate::link {
 
 class LinkError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
 
-// EtherCAT frames are Ethernet II frames of EtherType 88A4h (ETG.1000.4, frame structure: Ethernet
-// header, then the 2-byte EtherCAT header, then the datagrams); the sizes and the EtherType are in
-// wire/ethernet.hpp. Shorter than an Ethernet header plus the EtherCAT header cannot be an EtherCAT
-// frame. Frames are not padded to the 60-byte Ethernet minimum here: veth does not pad, a NIC pads
-// on its own. The longest is kMaxFrameSize (1514, untagged, without FCS).
-inline constexpr std::size_t kMinFrameBytes = kEthernetHeaderSize + kEcatHeaderSize;
+// Ethernet II [IEEE 802.3 §3.2]: destination 6, source 6, EtherType 2 (big-endian at offset 12,
+// §3.2.6); an IEEE 802.1Q tag (TPID 8100h + TCI: PCP bits 13-15, DEI bit 12, VID bits 0-11) goes
+// between the source and the EtherType. Frames are not padded to the 60-byte minimum here: veth
+// does not pad, a NIC pads on its own. The FCS is never part of a frame here.
+inline constexpr std::size_t kEthernetHeaderBytes = 14;
+inline constexpr std::size_t kEtherTypeOffset = 12;
+inline constexpr std::uint16_t kVlanTpid = 0x8100;
+inline constexpr std::size_t kVlanTagBytes = 4;
+inline constexpr std::size_t kMaxUntaggedFrameBytes = 1514;  // 1500 bytes of payload [IEEE 802.3 §3.2.7]
+inline constexpr std::size_t kMaxFrameBytes = kMaxUntaggedFrameBytes + kVlanTagBytes;  // tagged
+
+// What a protocol's frames are, for the link that carries them.
+struct FrameRules {
+  std::uint16_t ether_type = 0;
+  // The shortest untagged frame of the protocol: the Ethernet header and the protocol's own header
+  // (a tagged one may be kVlanTagBytes longer).
+  std::size_t min_frame_bytes = kEthernetHeaderBytes;
+  // Whether frames with an 802.1Q tag (TPID 8100h) in front of `ether_type` are the protocol's:
+  // PROFINET's RT frames carry a priority tag, EtherCAT's frames are untagged.
+  bool vlan_tags = false;
+  // The first word of every error line ("ethercat" -> "ethercat: no network interface ...").
+  const char* name = "";
+  // What is on the other end of the cable, for the hints ("slaves", "devices").
+  const char* peers = "";
+};
 
 // One frame to send: the whole Ethernet frame.
 using FrameView = std::span<const std::uint8_t>;
 
-// Whether a frame's length lets it go on the link: kMinFrameBytes to kMaxFrameSize. send() skips
-// other frames (counted invalid); check_frame() refuses received ones by the same rule.
-constexpr bool sendable(FrameView frame) noexcept {
-  return frame.size() >= kMinFrameBytes && frame.size() <= kMaxFrameSize;
+// Whether `frame` carries an 802.1Q tag: TPID 8100h where the EtherType would be.
+constexpr bool has_vlan_tag(std::span<const std::uint8_t> frame) noexcept {
+  return frame.size() >= kEthernetHeaderBytes && frame[kEtherTypeOffset] == (kVlanTpid >> 8) &&
+         frame[kEtherTypeOffset + 1] == (kVlanTpid & 0xFF);
+}
+
+// Whether a frame's length lets it go on the link: rules.min_frame_bytes to kMaxUntaggedFrameBytes,
+// both kVlanTagBytes more for a tagged frame when the rules allow tags. send() skips other frames
+// (counted invalid); check_frame() refuses received ones by the same rule.
+constexpr bool sendable(FrameView frame, const FrameRules& rules) noexcept {
+  const std::size_t tag = rules.vlan_tags && has_vlan_tag(frame) ? kVlanTagBytes : 0;
+  return frame.size() >= rules.min_frame_bytes + tag && frame.size() <= kMaxUntaggedFrameBytes + tag;
 }
 
 // What a received frame is, by its length and EtherType only.
 enum class FrameCheck : std::uint8_t { Ok, TooShort, TooLong, WrongEtherType };
-// The EtherType is big-endian at offset 12 [IEEE 802.3 §3.2.6]. A VLAN-tagged frame (8100h) counts
-// as a wrong EtherType: EtherCAT masters send untagged frames.
-[[nodiscard]] FrameCheck check_frame(std::span<const std::uint8_t> frame) noexcept;
+// The EtherType is big-endian at offset 12 [IEEE 802.3 §3.2.6], or at 16 behind an 802.1Q tag when
+// the rules allow tags; without them a tagged frame (8100h) counts as a wrong EtherType.
+[[nodiscard]] FrameCheck check_frame(std::span<const std::uint8_t> frame, const FrameRules& rules) noexcept;
 
 // One received frame in memory the caller owns (the socket writes straight into `bytes`).
 struct FrameBuffer {
-  std::array<std::uint8_t, kMaxFrameSize> bytes{};
+  std::array<std::uint8_t, kMaxFrameBytes> bytes{};
   std::size_t size = 0;
 
   [[nodiscard]] std::span<const std::uint8_t> view() const noexcept { return {bytes.data(), size}; }
@@ -72,7 +100,7 @@ enum class SendStatus : std::uint8_t {
 };
 
 // What send() did with its frames, front first: sent + invalid + unsent == frames given. Invalid
-// frames (shorter than kMinFrameBytes or longer than kMaxFrameSize) are skipped and the rest go on.
+// frames (not sendable()) are skipped and the rest go on.
 struct SendResult {
   std::size_t sent = 0;
   std::size_t invalid = 0;
@@ -86,9 +114,9 @@ struct LinkCounters {
   std::uint64_t tx_busy = 0;            // not sent: transmit queue full
   std::uint64_t tx_down = 0;            // not sent: link down or closed
   std::uint64_t rx_frames = 0;          // delivered by receive()
-  std::uint64_t rx_too_short = 0;       // dropped: shorter than kMinFrameBytes
-  std::uint64_t rx_too_long = 0;        // dropped: longer than kMaxFrameSize
-  std::uint64_t rx_wrong_ethertype = 0; // dropped: not 88A4h
+  std::uint64_t rx_too_short = 0;       // dropped: shorter than the rules' minimum
+  std::uint64_t rx_too_long = 0;        // dropped: longer than an Ethernet frame
+  std::uint64_t rx_wrong_ethertype = 0; // dropped: not the rules' EtherType (or a tag they refuse)
   std::uint64_t rx_own = 0;             // dropped: an outgoing frame of this host seen back
   std::uint64_t rx_overflow = 0;        // dropped before we saw it: receive queue full
   std::uint64_t link_downs = 0;         // transitions from Up to any down state
@@ -124,8 +152,8 @@ class Link {
   SendResult send(FrameView frame) noexcept { return send(std::span<const FrameView>(&frame, 1)); }
 
   // Non-blocking: fills out[0..n) with everything pending (up to out.size()), oldest first, and
-  // returns n. Frames that check_frame() refuses, and our own outgoing frames, are dropped and
-  // counted, never returned.
+  // returns n, each frame as it was sent (a tagged frame with its tag). Frames that check_frame()
+  // refuses, and our own outgoing frames, are dropped and counted, never returned.
   virtual std::size_t receive(std::span<FrameBuffer> out) noexcept = 0;
 
   // A file descriptor that becomes readable when frames arrive (and reports POLLERR when the link
@@ -145,4 +173,4 @@ class Link {
   [[nodiscard]] virtual std::string describe() const = 0;
 };
 
-}  // namespace drivegate::ethercat
+}  // namespace drivegate::link

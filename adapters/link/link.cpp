@@ -1,12 +1,16 @@
-#include "adapters/ethercat/link/link.hpp"
+#include "adapters/link/link.hpp"
 
 #include "core/bytes.hpp"
 
-namespace drivegate::ethercat {
+namespace drivegate::link {
 
-FrameCheck check_frame(std::span<const std::uint8_t> frame) noexcept {
-  if (!sendable(frame)) return frame.size() < kMinFrameBytes ? FrameCheck::TooShort : FrameCheck::TooLong;
-  return core::get_be16(frame, kEtherTypeOffset) == kEtherType ? FrameCheck::Ok : FrameCheck::WrongEtherType;
+FrameCheck check_frame(std::span<const std::uint8_t> frame, const FrameRules& rules) noexcept {
+  const bool tagged = rules.vlan_tags && has_vlan_tag(frame);
+  if (!sendable(frame, rules)) {
+    return frame.size() < rules.min_frame_bytes + (tagged ? kVlanTagBytes : 0) ? FrameCheck::TooShort : FrameCheck::TooLong;
+  }
+  const std::size_t at = kEtherTypeOffset + (tagged ? kVlanTagBytes : 0);
+  return core::get_be16(frame, at) == rules.ether_type ? FrameCheck::Ok : FrameCheck::WrongEtherType;
 }
 
 const char* to_string(LinkState s) noexcept {
@@ -51,4 +55,4 @@ void LinkCounterCells::count_transition(LinkState before, LinkState after) noexc
   if (before != LinkState::Up && before != LinkState::Closed && after == LinkState::Up) link_ups.add();
 }
 
-}  // namespace drivegate::ethercat
+}  // namespace drivegate::link

@@ -1,11 +1,11 @@
-#include "adapters/ethercat/link/memory_link.hpp"
+#include "adapters/link/memory_link.hpp"
 
 #include <algorithm>
 #include <cstring>
 
-namespace drivegate::ethercat {
+namespace drivegate::link {
 
-MemoryLink::MemoryLink(std::size_t capacity) : slots_(std::max<std::size_t>(capacity, 1)) {}
+MemoryLink::MemoryLink(const FrameRules& rules, std::size_t capacity) : rules_(rules), slots_(std::max<std::size_t>(capacity, 1)) {}
 
 MemoryLink::~MemoryLink() { detach(); }
 
@@ -50,7 +50,7 @@ LinkState MemoryLink::poll_state(core::TimePoint /*now*/) noexcept { return stat
 
 bool MemoryLink::deliver(FrameView frame) noexcept {
   if (!is_open() || wire_.load(std::memory_order_relaxed) != LinkState::Up) return false;
-  if (const FrameCheck c = check_frame(frame); c != FrameCheck::Ok) {
+  if (const FrameCheck c = check_frame(frame, rules_); c != FrameCheck::Ok) {
     counters_.count_drop(c);
     return false;
   }
@@ -70,7 +70,7 @@ SendResult MemoryLink::send(std::span<const FrameView> frames) noexcept {
   const bool up = is_open() && wire_.load(std::memory_order_relaxed) == LinkState::Up;
   for (std::size_t i = 0; i < frames.size(); ++i) {
     const FrameView f = frames[i];
-    if (!sendable(f)) {
+    if (!sendable(f, rules_)) {
       ++r.invalid;
       counters_.tx_invalid.add();
       continue;
@@ -110,4 +110,4 @@ std::string MemoryLink::describe() const {
   return "memory link (" + std::to_string(slots_.size()) + " frames)";
 }
 
-}  // namespace drivegate::ethercat
+}  // namespace drivegate::link

@@ -1,6 +1,6 @@
 #pragma once
-// The production link: an AF_PACKET SOCK_RAW socket bound to one named Ethernet interface for
-// EtherType 88A4h (DESIGN.md §5), non-blocking, owned by the bus thread.
+// The production link: an AF_PACKET SOCK_RAW socket bound to one named Ethernet interface for the
+// EtherType of the protocol's FrameRules (DESIGN.md §5), non-blocking, owned by the bus thread.
 //
 // - Outgoing frames are not read back. The kernel never shows a packet socket its own frames, and
 //   shows the frames other local senders put out on the port only to sockets bound to every
@@ -13,6 +13,13 @@
 //   after ENETDOWN/ENXIO from a send or receive. An interface that went down and up keeps the socket
 //   (the kernel re-attaches it); one that disappeared and came back under the same name gets the
 //   socket bound to it again. The socket, and wait_fd(), stay the same from open() to close().
+// - 802.1Q tags (FrameRules::vlan_tags): the kernel takes the tag off every received frame before
+//   a packet socket sees it, and tells only sockets bound to every EtherType what it was (in
+//   PACKET_AUXDATA; for one bound to 8892h it clears the tag first). Such a link therefore binds to
+//   every EtherType with a kernel filter (classic BPF on the frame's EtherType behind the tag) that
+//   lets only the rules' EtherType through, and puts the tag back in front of it: receive() hands
+//   up each frame as it was sent, tagged or not. A tag of another TPID than 8100h (802.1ad) is
+//   dropped as a wrong EtherType. Sending a tagged frame is just its bytes.
 #include <linux/if_packet.h>
 #include <net/if.h>
 #include <sys/socket.h>
@@ -24,9 +31,10 @@
 #include <cstddef>
 #include <string>
 
-#include "adapters/ethercat/link/link.hpp"
+#include "adapters/link/interface.hpp"
+#include "adapters/link/link.hpp"
 
-namespace drivegate::ethercat {
+namespace drivegate::link {
 
 // Frames per sendmmsg / recvmmsg call.
 inline constexpr std::size_t kLinkBatch = 64;
@@ -42,21 +50,24 @@ struct RawSocketOptions {
   // PACKET_IGNORE_OUTGOING. Only a socket that sees every EtherType (below) is shown outgoing
   // frames at all; without the option (or before Linux 4.20) they are dropped by their pkttype.
   bool ignore_outgoing = true;
-  // Bind to every EtherType (ETH_P_ALL) instead of 88A4h and drop the others in receive(), counted:
-  // for diagnosis, and for tests of the drop counters. Costs a copy of every frame on the port.
+  // Bind to every EtherType (ETH_P_ALL) without a kernel filter and drop the others in receive(),
+  // counted: for diagnosis, and for tests of the drop counters. Costs a copy of every frame on the
+  // port.
   bool all_ethertypes = false;
 };
 
-class RawSocketLink final : public Link {
+// Not final: a protocol may name its own with its rules built in (ethercat::RawSocketLink).
+class RawSocketLink : public Link {
  public:
-  explicit RawSocketLink(RawSocketOptions options);
+  RawSocketLink(const FrameRules& rules, RawSocketOptions options);
   ~RawSocketLink() override;
   RawSocketLink(const RawSocketLink&) = delete;
   RawSocketLink& operator=(const RawSocketLink&) = delete;
 
-  // Fails (LinkError, one line starting "ethercat: ") without CAP_NET_RAW, for a name that is
-  // no interface, an interface that is not Ethernet, and one that is administratively down. An
-  // interface without carrier opens (state NoCarrier): the slaves may not be powered yet.
+  // Fails (LinkError, one line starting with the rules' name, "ethercat: ") without CAP_NET_RAW,
+  // for a name that is no interface, an interface that is not Ethernet, and one that is
+  // administratively down. An interface without carrier opens (state NoCarrier): the peers may not
+  // be powered yet.
   void open() override;
   void close() noexcept override;
   [[nodiscard]] bool is_open() const noexcept override { return fd_ >= 0; }
@@ -78,13 +89,21 @@ class RawSocketLink final : public Link {
   // back with another index, reads the kernel's drop count; returns the state seen.
   LinkState refresh() noexcept;
   bool bind_to(int ifindex) noexcept;
+  // The EtherType the socket is bound to: the rules' own, or every one (ETH_P_ALL) for tags and
+  // all_ethertypes.
+  [[nodiscard]] std::uint16_t bound_protocol() const noexcept;
+  // Puts the tag the kernel reported in m's control data back into `frame` (`length` grows by the
+  // tag); false when the tag's TPID is not 8100h. A frame that came untagged stays as it is.
+  static bool restore_tag(const msghdr& m, std::uint8_t* frame, std::size_t& length) noexcept;
+  [[noreturn]] void fail(const std::string& what) const;
   void set_state(LinkState s) noexcept;
   // A send or receive error: what it says about the link (ENETDOWN, ENXIO, ENODEV) makes the next
   // poll_state() ask the kernel at once.
   void note_error(int e) noexcept;
 
+  FrameRules rules_;
   RawSocketOptions options_;
-  std::array<char, IFNAMSIZ> name_{};
+  InterfaceName name_{};
   int fd_ = -1;
   int ifindex_ = -1;
   bool bound_ = false;
@@ -99,6 +118,12 @@ class RawSocketLink final : public Link {
   std::array<mmsghdr, kLinkBatch> rx_msgs_{};
   std::array<iovec, kLinkBatch> rx_iov_{};
   std::array<sockaddr_ll, kLinkBatch> rx_from_{};
+  // Per received message: room for one PACKET_AUXDATA control message (CMSG_SPACE of a 20-byte
+  // tpacket_auxdata is 40 on 64-bit Linux); used with tags only.
+  struct alignas(cmsghdr) Control {
+    std::array<unsigned char, 64> bytes{};
+  };
+  std::array<Control, kLinkBatch> rx_control_{};
 };
 
-}  // namespace drivegate::ethercat
+}  // namespace drivegate::link

@@ -1,6 +1,7 @@
-#include "adapters/ethercat/link/raw_socket_link.hpp"
+#include "adapters/link/raw_socket_link.hpp"
 
 #include <arpa/inet.h>
+#include <linux/filter.h>
 #include <linux/if_arp.h>
 #include <linux/if_ether.h>
 #include <sys/ioctl.h>
@@ -8,13 +9,16 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <utility>
 
+#include "adapters/link/interface.hpp"
+#include "core/bytes.hpp"
 #include "core/errno_text.hpp"
 #include "core/fd_guard.hpp"
 
-namespace drivegate::ethercat {
+namespace drivegate::link {
 namespace {
 
 // Older kernel headers: the option exists from Linux 4.20 on; an older kernel refuses it with
@@ -24,8 +28,6 @@ namespace {
 #endif
 
 using core::errno_text;
-
-[[noreturn]] void fail(const std::string& what) { throw LinkError("ethercat: " + what); }
 
 std::string link_type_name(unsigned type) {
   switch (type) {
@@ -42,31 +44,24 @@ std::string link_type_name(unsigned type) {
   }
 }
 
-std::string own_binary() {
-  std::array<char, 4096> path{};
-  const ssize_t n = ::readlink("/proc/self/exe", path.data(), path.size() - 1);
-  return n > 0 ? std::string(path.data(), static_cast<std::size_t>(n)) : std::string("/path/to/drivegated");
-}
-
-// An ifreq for `name` (already checked to fit).
-ifreq request_for(const std::array<char, IFNAMSIZ>& name) noexcept {
-  ifreq r{};
-  std::memcpy(r.ifr_name, name.data(), name.size());
-  return r;
-}
-
 bool is_link_error(int e) noexcept { return e == ENETDOWN || e == ENXIO || e == ENODEV || e == ENETUNREACH; }
 
-// The reason text of open() failing for lack of CAP_NET_RAW, with the binary's path in the hint.
-std::string no_raw_permission_text(const std::string& interface) {
-  return "ethercat: no permission to open a raw Ethernet socket on '" + interface +
-         "' (CAP_NET_RAW missing); run as root or give the binary cap_net_raw, e.g. setcap cap_net_raw+ep " +
-         own_binary();
+// The kernel filter of a link for tagged frames, bound to every EtherType: accept a frame whose
+// EtherType is `ether_type`, behind the tag the kernel took off or not (the skb's protocol, which
+// the ancillary load returns in host order), drop the rest before they are queued or copied.
+std::array<sock_filter, 4> ether_type_filter(std::uint16_t ether_type) noexcept {
+  return {{
+      {BPF_LD | BPF_H | BPF_ABS, 0, 0, static_cast<std::uint32_t>(SKF_AD_OFF + SKF_AD_PROTOCOL)},
+      {BPF_JMP | BPF_JEQ | BPF_K, 0, 1, ether_type},
+      {BPF_RET | BPF_K, 0, 0, 0xFFFFFFFFu},
+      {BPF_RET | BPF_K, 0, 0, 0},
+  }};
 }
 
 }  // namespace
 
-RawSocketLink::RawSocketLink(RawSocketOptions options) : options_(std::move(options)) {
+RawSocketLink::RawSocketLink(const FrameRules& rules, RawSocketOptions options)
+    : rules_(rules), options_(std::move(options)) {
   // The headers point into this object's own arrays for its whole life; receive() sets the iovec
   // bases to the caller's buffers on each call.
   for (std::size_t i = 0; i < kLinkBatch; ++i) {
@@ -78,23 +73,30 @@ RawSocketLink::RawSocketLink(RawSocketOptions options) : options_(std::move(opti
   }
 }
 
+void RawSocketLink::fail(const std::string& what) const { throw LinkError(std::string(rules_.name) + ": " + what); }
+
+std::uint16_t RawSocketLink::bound_protocol() const noexcept {
+  return options_.all_ethertypes || rules_.vlan_tags ? std::uint16_t{ETH_P_ALL} : rules_.ether_type;
+}
+
 RawSocketLink::~RawSocketLink() { close(); }
 
 void RawSocketLink::open() {
   if (is_open()) return;
   const std::string& name = options_.interface;
-  if (name.empty() || name.size() >= IFNAMSIZ || name.find('/') != std::string::npos) {
-    fail("'" + name + "' is not a network interface name (1 to " + std::to_string(IFNAMSIZ - 1) + " characters)");
-  }
-  name_.fill('\0');
-  std::memcpy(name_.data(), name.data(), name.size());
+  if (const std::string problem = interface_name_problem(name); !problem.empty()) fail(problem);
+  name_ = interface_name(name);
 
   // Protocol 0: no frames are queued until bind() names the interface and the EtherType, so none
   // from other interfaces slip in between.
   core::FdGuard fd(::socket(AF_PACKET, SOCK_RAW | SOCK_NONBLOCK | SOCK_CLOEXEC, 0));
   if (fd.get() < 0) {
     const int e = errno;
-    if (e == EPERM || e == EACCES) throw LinkError(no_raw_permission_text(name));
+    if (e == EPERM || e == EACCES) {
+      fail("no permission to open a raw Ethernet socket on '" + name +
+           "' (CAP_NET_RAW missing); run as root or give the binary cap_net_raw, e.g. setcap cap_net_raw+ep " +
+           own_binary());
+    }
     if (e == EAFNOSUPPORT) fail("this kernel has no packet sockets (socket(AF_PACKET): " + errno_text(e) + "); it needs CONFIG_PACKET");
     fail("cannot create a raw Ethernet socket (socket(AF_PACKET): " + errno_text(e) + ")");
   }
@@ -102,7 +104,7 @@ void RawSocketLink::open() {
   ifreq r = request_for(name_);
   if (::ioctl(fd.get(), SIOCGIFINDEX, &r) != 0) {
     const int e = errno;
-    if (e == ENODEV) fail("no network interface '" + name + "'; give the name of the Ethernet port the slaves are on");
+    if (e == ENODEV) fail(no_interface_text(name, rules_.peers));
     fail("cannot look up interface '" + name + "' (SIOCGIFINDEX: " + errno_text(e) + ")");
   }
   const int index = r.ifr_ifindex;
@@ -113,14 +115,14 @@ void RawSocketLink::open() {
   }
   if (r.ifr_hwaddr.sa_family != ARPHRD_ETHER) {
     fail("'" + name + "' is not an Ethernet interface (link type " + link_type_name(r.ifr_hwaddr.sa_family) +
-         "); give the name of the Ethernet port the slaves are on");
+         "); give the name of the Ethernet port the " + std::string(rules_.peers) + " are on");
   }
 
   r = request_for(name_);
   if (::ioctl(fd.get(), SIOCGIFFLAGS, &r) != 0) {
     fail("cannot read the flags of '" + name + "' (SIOCGIFFLAGS: " + errno_text(errno) + ")");
   }
-  if ((r.ifr_flags & IFF_UP) == 0) fail("interface '" + name + "' is down; bring it up with 'ip link set " + name + " up'");
+  if ((r.ifr_flags & IFF_UP) == 0) fail(interface_down_text(name));
 
   ignore_outgoing_ = false;
   if (options_.ignore_outgoing) {
@@ -136,12 +138,28 @@ void RawSocketLink::open() {
     ::setsockopt(fd.get(), SOL_SOCKET, SO_SNDBUF, &options_.send_buffer_bytes, sizeof(int));
   }
 
+  if (rules_.vlan_tags) {
+    // The tag of each frame comes as PACKET_AUXDATA; the filter goes on before bind() so that no
+    // frame of another EtherType is queued in between.
+    const int on = 1;
+    if (::setsockopt(fd.get(), SOL_PACKET, PACKET_AUXDATA, &on, sizeof on) != 0) {
+      fail("cannot ask for the VLAN tags of received frames (PACKET_AUXDATA: " + errno_text(errno) + ")");
+    }
+    if (!options_.all_ethertypes) {
+      std::array<sock_filter, 4> code = ether_type_filter(rules_.ether_type);
+      const sock_fprog program{static_cast<unsigned short>(code.size()), code.data()};
+      if (::setsockopt(fd.get(), SOL_SOCKET, SO_ATTACH_FILTER, &program, sizeof program) != 0) {
+        fail("cannot attach the EtherType filter (SO_ATTACH_FILTER: " + errno_text(errno) + ")");
+      }
+    }
+  }
+
   fd_ = fd.get();
   if (!bind_to(index)) {
     const int e = errno;
     fd_ = -1;
-    if (e == ENETDOWN) fail("interface '" + name + "' is down; bring it up with 'ip link set " + name + " up'");
-    if (e == ENODEV || e == ENXIO) fail("no network interface '" + name + "'; give the name of the Ethernet port the slaves are on");
+    if (e == ENETDOWN) fail(interface_down_text(name));
+    if (e == ENODEV || e == ENXIO) fail(no_interface_text(name, rules_.peers));
     fail("cannot bind to '" + name + "' (bind: " + errno_text(e) + ")");
   }
   fd_ = fd.release();
@@ -158,7 +176,7 @@ void RawSocketLink::open() {
 bool RawSocketLink::bind_to(int ifindex) noexcept {
   sockaddr_ll address{};
   address.sll_family = AF_PACKET;
-  address.sll_protocol = htons(options_.all_ethertypes ? std::uint16_t{ETH_P_ALL} : kEtherType);
+  address.sll_protocol = htons(bound_protocol());
   address.sll_ifindex = ifindex;
   if (::bind(fd_, reinterpret_cast<const sockaddr*>(&address), sizeof address) != 0) {
     bound_ = false;
@@ -166,9 +184,10 @@ bool RawSocketLink::bind_to(int ifindex) noexcept {
   }
   ifindex_ = ifindex;
   bound_ = true;
-  // Slaves pass a frame on with its destination unchanged: a master that sends to any address
-  // but broadcast or the port's own still gets its frames back. Promiscuous for as long as this
-  // socket lives (the kernel drops the membership with it); without it only such frames are lost.
+  // EtherCAT slaves pass a frame on with its destination unchanged: a master that sends to any
+  // address but broadcast or the port's own still gets its frames back; PROFINET devices send DCP
+  // Hello to a multicast address the port has not joined. Promiscuous for as long as this socket
+  // lives (the kernel drops the membership with it); without it only such frames are lost.
   packet_mreq promisc{};
   promisc.mr_ifindex = ifindex;
   promisc.mr_type = PACKET_MR_PROMISC;
@@ -247,7 +266,7 @@ SendResult RawSocketLink::send(std::span<const FrameView> frames) noexcept {
       cell.add();
     }
     for (std::size_t i = next; i < frames.size(); ++i) {
-      if (!sendable(frames[i])) {
+      if (!sendable(frames[i], rules_)) {
         ++r.invalid;
         counters_.tx_invalid.add();
       } else {
@@ -267,7 +286,7 @@ SendResult RawSocketLink::send(std::span<const FrameView> frames) noexcept {
     std::size_t count = 0;
     for (; next < frames.size() && count < kLinkBatch; ++next) {
       const FrameView f = frames[next];
-      if (!sendable(f)) {
+      if (!sendable(f, rules_)) {
         ++r.invalid;
         counters_.tx_invalid.add();
         continue;
@@ -308,9 +327,14 @@ std::size_t RawSocketLink::receive(std::span<FrameBuffer> out) noexcept {
   while (n < out.size()) {
     const std::size_t want = std::min(out.size() - n, kLinkBatch);
     for (std::size_t i = 0; i < want; ++i) {
-      rx_iov_[i] = iovec{out[n + i].bytes.data(), out[n + i].bytes.size()};
-      rx_msgs_[i].msg_hdr.msg_namelen = sizeof(sockaddr_ll);
-      rx_msgs_[i].msg_hdr.msg_flags = 0;
+      // The kernel hands every frame up without its tag: the longest is an untagged one, and with
+      // tags the room for putting the tag back stays free.
+      rx_iov_[i] = iovec{out[n + i].bytes.data(), kMaxUntaggedFrameBytes};
+      msghdr& m = rx_msgs_[i].msg_hdr;
+      m.msg_namelen = sizeof(sockaddr_ll);
+      m.msg_flags = 0;
+      m.msg_control = rules_.vlan_tags ? rx_control_[i].bytes.data() : nullptr;
+      m.msg_controllen = rules_.vlan_tags ? rx_control_[i].bytes.size() : 0;
     }
     // MSG_TRUNC: msg_len is the frame's real length even when it did not fit (too long).
     const int got = ::recvmmsg(fd_, rx_msgs_.data(), static_cast<unsigned>(want), MSG_DONTWAIT | MSG_TRUNC, nullptr);
@@ -324,15 +348,17 @@ std::size_t RawSocketLink::receive(std::span<FrameBuffer> out) noexcept {
     std::size_t kept = n;
     for (std::size_t i = 0; i < count; ++i) {
       const msghdr& m = rx_msgs_[i].msg_hdr;
-      const std::size_t length = rx_msgs_[i].msg_len;
+      std::size_t length = rx_msgs_[i].msg_len;
       if (rx_from_[i].sll_pkttype == PACKET_OUTGOING) {  // fallback for kernels before 4.20
         counters_.rx_own.add();
         continue;
       }
       FrameBuffer& slot = out[n + i];
-      const FrameCheck c = (m.msg_flags & MSG_TRUNC) != 0 || length > slot.bytes.size()
-                               ? FrameCheck::TooLong
-                               : check_frame({slot.bytes.data(), length});
+      const bool truncated = (m.msg_flags & MSG_TRUNC) != 0 || length > rx_iov_[i].iov_len;
+      const FrameCheck c = truncated ? FrameCheck::TooLong
+                           : rules_.vlan_tags && !restore_tag(m, slot.bytes.data(), length)
+                               ? FrameCheck::WrongEtherType
+                               : check_frame({slot.bytes.data(), length}, rules_);
       if (c != FrameCheck::Ok) {
         counters_.count_drop(c);
         continue;
@@ -348,6 +374,30 @@ std::size_t RawSocketLink::receive(std::span<FrameBuffer> out) noexcept {
   return n;
 }
 
-std::string RawSocketLink::describe() const { return "raw ethernet " + options_.interface + " (AF_PACKET, EtherType 88A4h)"; }
+bool RawSocketLink::restore_tag(const msghdr& m, std::uint8_t* frame, std::size_t& length) noexcept {
+  // msg_control is const in a const msghdr, CMSG_NXTHDR takes a mutable one; it only reads.
+  auto& header = const_cast<msghdr&>(m);
+  for (cmsghdr* c = CMSG_FIRSTHDR(&header); c != nullptr; c = CMSG_NXTHDR(&header, c)) {
+    if (c->cmsg_level != SOL_PACKET || c->cmsg_type != PACKET_AUXDATA) continue;
+    tpacket_auxdata aux{};
+    std::memcpy(&aux, CMSG_DATA(c), sizeof aux);
+    if ((aux.tp_status & TP_STATUS_VLAN_VALID) == 0 || length < kEtherTypeOffset) return true;
+    const std::uint16_t tpid = (aux.tp_status & TP_STATUS_VLAN_TPID_VALID) != 0 ? aux.tp_vlan_tpid : kVlanTpid;
+    if (tpid != kVlanTpid) return false;
+    std::memmove(frame + kEtherTypeOffset + kVlanTagBytes, frame + kEtherTypeOffset, length - kEtherTypeOffset);
+    const std::span<std::uint8_t> tag(frame + kEtherTypeOffset, kVlanTagBytes);
+    core::put_be16(tag, 0, kVlanTpid);
+    core::put_be16(tag, 2, aux.tp_vlan_tci);
+    length += kVlanTagBytes;
+    return true;
+  }
+  return true;
+}
 
-}  // namespace drivegate::ethercat
+std::string RawSocketLink::describe() const {
+  std::array<char, 8> type{};
+  std::snprintf(type.data(), type.size(), "%04Xh", rules_.ether_type);
+  return "raw ethernet " + options_.interface + " (AF_PACKET, EtherType " + type.data() + ")";
+}
+
+}  // namespace drivegate::link
