@@ -173,7 +173,7 @@ class Demo {
       client_.wait_until(
           [&] {
             for (const auto& st : client_.states())
-              if (st.axis == axis && st.gateway == req.gateway) return st.velocity == 0.0;
+              if (st.axis == req.axis && st.gateway == req.gateway) return st.velocity == 0.0;
             return false;
           },
           timeout_);

@@ -189,7 +189,6 @@ TEST(SdoClientVectors, NordTvARemapTxPdo3) {
 // caller (stoeber-sd6-canopen.md §6.4, §11.2 D-1).
 TEST(SdoClientExpedited, Sd6ResponseWithoutSizeTakesExpectedSize) {
   SdoClient c = client_for(5);
-  TxQueue tx;
   const auto device_type = c.read(0, {0x1000, 0}, 4);
   play_client(c, {{true, {0x40, 0x00, 0x10, 0x00, 0, 0, 0, 0}}, {false, {0x42, 0x00, 0x10, 0x00, 0x92, 0x01, 0x02, 0x00}}},
               0x605, 0x585);
@@ -439,7 +438,6 @@ TEST(SdoClientRequests, ResetChannelDropsEverythingWithoutAnAbort) {
 
 TEST(SdoClientRequests, ResultsAreHeldUntilTaken) {
   SdoClient c = client_for(5);
-  TxQueue tx;
   const auto id = c.read(0, kTvObject);
   play_client(c, sd6_tv2(), 0x605, 0x585);
   for (int i = 0; i < 3; ++i) EXPECT_EQ(c.result(id).status, SdoStatus::Done);
