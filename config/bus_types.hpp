@@ -55,6 +55,9 @@ struct ParameterRef {
   core::ParamType type = core::ParamType::Unknown;  // Unknown: the bus type does not know it
   std::string type_source;  // where `type` comes from ("the EDS", "device profile kollmorgen-akd")
   std::string error;
+  // `error` says only that the type's files do not know the name: the bus may still know it from
+  // the device itself (core::Bus::find_object).
+  bool name_unknown = false;
 };
 
 // Looks for devices on a bus of this type (`drivegated --scan TYPE:WHERE`, daemon/scan.hpp): `plan`

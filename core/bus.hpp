@@ -17,6 +17,7 @@
 #include "core/command.hpp"
 #include "core/clock.hpp"
 #include "core/io.hpp"
+#include "core/param_value.hpp"
 
 namespace drivegate::core {
 
@@ -42,6 +43,18 @@ struct ClockSync {
   bool valid = false;
   std::int64_t max_difference_ns = 0;          // largest |device - reference clock| of the last round
   std::int64_t master_minus_reference_ns = 0;  // the master's clock minus the reference clock
+};
+
+// A parameter named by the device itself (EtherCAT: its object dictionary read over SDO
+// Information), for a name the axis' configuration files do not know.
+struct NamedObject {
+  bool found = false;
+  std::uint16_t index = 0;  // as the axis numbers it (a multi-axis slave's offset taken off)
+  std::uint8_t sub = 0;
+  ParamType type = ParamType::Unknown;
+  std::string source;  // where the name came from, for messages
+  // Not found: why, in words a person can act on; empty when the bus keeps no names for the axis.
+  std::string error;
 };
 
 class Bus {
@@ -94,6 +107,9 @@ class Bus {
   [[nodiscard]] virtual BusCounters counters() const noexcept = 0;
   // Same threading as counters(). The default: the bus synchronises no clocks.
   [[nodiscard]] virtual ClockSync clock_sync() const noexcept { return {}; }
+  // The object the device names `name` (control plane, any thread, may allocate; safe while the
+  // bus runs). The default: the bus keeps no names of its own.
+  [[nodiscard]] virtual NamedObject find_object(std::size_t /*axis*/, std::string_view /*name*/) const { return {}; }
 };
 
 }  // namespace drivegate::core

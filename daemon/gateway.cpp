@@ -353,7 +353,8 @@ std::vector<std::string> Gateway::scheduling_notes() const {
 }
 
 // The axis' bus type resolves names and knows types from its own files (canopen: EDS, device
-// profile); else the standards give the type. A bus type without parameter names takes INDEX:SUB.
+// profile; ethercat: ESI); a name they do not know is asked of the bus (the device's own
+// dictionary, ethercat); else the standards give the type. Without names: INDEX:SUB.
 ParameterLookup Gateway::lookup_parameter(std::size_t axis_id, std::string_view name, std::uint16_t index,
                                           std::uint8_t sub) const {
   ParameterLookup out;
@@ -372,6 +373,17 @@ ParameterLookup Gateway::lookup_parameter(std::size_t axis_id, std::string_view 
   else
     p.error = "axis '" + axis.spec.name + "' has no object named '" + std::string(name) +
               "' (give the axis an EDS file to use names, or use INDEX:SUB)";
+  if (!p.id && !name.empty() && (p.name_unknown || !bus.type_info || !bus.type_info->find_parameter)) {
+    // The device's own names (EtherCAT: its dictionary read over SDO Information).
+    core::NamedObject named = buses_[ref.bus].bus->find_object(ref.axis, name);
+    if (named.found) {
+      p.id = cia402::ObjectId{named.index, named.sub};
+      p.type = named.type;
+      p.type_source = std::move(named.source);
+    } else if (!named.error.empty()) {
+      p.error = "axis '" + axis.spec.name + "': " + named.error;
+    }
+  }
   if (!p.id) {
     out.error = std::move(p.error);
     return out;

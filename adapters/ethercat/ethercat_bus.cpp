@@ -141,6 +141,7 @@ EthercatBus::EthercatBus(const config::BusPlan& plan, std::unique_ptr<Link> link
         s->startup.push_back(CoeStartupWrite{w.def.id.index, w.def.id.sub, static_cast<std::uint32_t>(w.value & 0xFFFFFFFF),
                                              cia402::size_of(w.def.type)});
       for (const auto& o : dev.ignored_writes) s->ignored.push_back(CoeObjectId{o.index, o.sub});
+      s->dict = std::make_unique<SlaveDictionary>(static_cast<std::uint16_t>(s->plan.position + 1));
     } else if (const config::EthercatIoSlave* io = s->plan.io) {
       if (io->vendor_id && io->product_code)
         s->identities.push_back(SiiIdentity{*io->vendor_id, *io->product_code, 0, 0});
@@ -186,6 +187,7 @@ EthercatBus::EthercatBus(const config::BusPlan& plan, std::unique_ptr<Link> link
     const auto& dev = a.device.section<config::EthercatDeviceSpec>();
     Axis x;
     x.slave = k;
+    x.names = DictionaryAxis{a.section<config::EthercatAxisSpec>().slave_axis, dev.axes, dev.axis_offset};
     for (const auto& [code, text] : a.device.fault_texts) x.faults.push_back({static_cast<std::uint16_t>(code), text});
     std::vector<MappedObject> objects;
     std::uint32_t bits = 0;
@@ -253,6 +255,7 @@ void EthercatBus::open(core::TimePoint now) {
 void EthercatBus::start_boot(core::TimePoint now) noexcept {
   for (auto& s : slaves_) {
     if (s->coe) s->coe->reset();
+    if (s->dict) s->dict->stop(s->coe ? &*s->coe : nullptr);
     for (std::size_t a : s->axes) axes_[a].io->forget_requests();
     enter(*s, Phase::Boot, now);
   }
@@ -610,6 +613,7 @@ void EthercatBus::configure(std::size_t k, core::TimePoint now) noexcept {
       s.coe.emplace(s.station, mb, CoeSdoTiming{options_.sdo_timeout, std::chrono::milliseconds(1)}, sink);
     }
   }
+  if (s.dict) s.dict->stop(s.coe ? &*s.coe : nullptr);
   for (std::size_t a : s.axes) {
     axes_[a].io->set_coe(s.coe ? &*s.coe : nullptr);
     axes_[a].io->forget_requests();
@@ -652,6 +656,7 @@ void EthercatBus::lose(std::size_t k, core::TimePoint now) noexcept {
     axes_[a].io->override_controlword(false);
   }
   if (s.coe) s.coe->reset();
+  if (s.dict) s.dict->stop(s.coe ? &*s.coe : nullptr);
   s.missing = 0;
   s.left_op_waiting = false;
   enter(s, Phase::Lost, now);
@@ -755,6 +760,7 @@ void EthercatBus::advance(std::size_t k, core::TimePoint now) noexcept {
       s.missing = 0;
       s.backoff = core::Duration::zero();
       s.op_cycle = cx_ ? cx_->counters().cycles : 0;
+      s.dict_due = s.dict != nullptr;
       set_detail(s, "in OP");
       enter(s, Phase::Op, now);
       break;
@@ -769,6 +775,7 @@ void EthercatBus::advance(std::size_t k, core::TimePoint now) noexcept {
           return;
         }
       }
+      read_names(k);
       if (!cx_) break;
       switch (cx_->answered(k)) {
         case SlaveAnswer::Missing:
@@ -821,6 +828,36 @@ void EthercatBus::advance(std::size_t k, core::TimePoint now) noexcept {
     }
     case Phase::SafeStop: run_safe_stop(k, now); break;
   }
+}
+
+void EthercatBus::read_names(std::size_t k) noexcept {
+  Slave& s = *slaves_[k];
+  if (!s.dict) return;
+  if (s.dict_due) {
+    // SDO Information only where the SII offers it: a slave without it may not answer at all
+    // [ETG.1000.6 Table 21, CoE details bit 1].
+    const SiiInfo& sii = boot_->sii(k);
+    const bool sdo_info = s.coe && s.coe->valid() && sii.has_general && (sii.general.coe_details & coe_details::kSdoInfo) != 0;
+    if (!s.dict->start(sdo_info)) return;
+    s.dict_due = false;
+  }
+  if (s.coe) s.dict->step(*s.coe);
+}
+
+core::NamedObject EthercatBus::find_object(std::size_t axis, std::string_view name) const {
+  core::NamedObject out;
+  if (axis >= axes_.size()) return out;
+  const Axis& x = axes_[axis];
+  const SlaveDictionary* dict = slaves_[x.slave]->dict.get();
+  if (dict == nullptr) return out;
+  DictionaryMatch m = dict->find(name, x.names);
+  out.found = m.found;
+  out.index = m.index;
+  out.sub = m.sub;
+  out.type = m.type;
+  out.source = "the object dictionary of slave " + std::to_string(x.slave + 1) + " (SDO Information)";
+  out.error = std::move(m.error);
+  return out;
 }
 
 void EthercatBus::on_result(std::uint32_t tag, const DatagramAnswer& a) noexcept {

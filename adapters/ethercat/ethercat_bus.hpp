@@ -26,6 +26,9 @@
 //                power loss, INIT, SII, identity, mailbox, PRE-OP), CoeSdoClient::reset(), the whole
 //                configuration again (a DC slave: its offset, delay and SYNC0 again, on its own),
 //                SAFE-OP, OP; the axes come back disabled.
+//   names:       in OP, while its CoE mailbox is otherwise idle, a drive's object names are read
+//                over SDO Information (slave_dictionary.hpp), from the start after every
+//                reconfiguration; find_object() looks names up in them.
 //   safe stop:   the profile found the drive not following its controlword: link Degraded,
 //                controlword quick stop (0002h) in the process data until the drive left
 //                operation enabled (3 s at most), disable voltage (0000h), the slave to SAFE-OP,
@@ -59,6 +62,7 @@
 #include "adapters/ethercat/master/process_image.hpp"
 #include "adapters/ethercat/master/transactions.hpp"
 #include "adapters/ethercat/slave_access.hpp"
+#include "adapters/ethercat/slave_dictionary.hpp"
 #include "config/ethercat/plan.hpp"
 #include "config/plan.hpp"
 #include "core/bus.hpp"
@@ -155,6 +159,10 @@ class EthercatBus final : public core::Bus, private EmergencySink, private Datag
     return dc_master_offset_.load(std::memory_order_relaxed);
   }
   // Both figures for the bus status: valid once a 092Ch round completed (-1 before, without DC).
+  // A name of the axis' slave's own dictionary (slave_dictionary.hpp); any thread.
+  core::NamedObject find_object(std::size_t axis, std::string_view name) const override;
+  // Diagnostics, any thread: the dictionary of a drive (null for a slave without axes).
+  [[nodiscard]] const SlaveDictionary* dictionary(std::size_t slave) const noexcept { return slaves_[slave]->dict.get(); }
   core::ClockSync clock_sync() const noexcept override {
     core::ClockSync s;
     const std::int64_t d = dc_max_difference_ns();
@@ -192,11 +200,14 @@ class EthercatBus final : public core::Bus, private EmergencySink, private Datag
     CoeSdoId sync_mode_sdo = 0;  // Sync: the 1C32h:01 = 2 download
     bool sync_mode_done = false;
     std::vector<std::size_t> axes;
+    std::unique_ptr<SlaveDictionary> dict;  // drives: the names read over SDO Information
+    bool dict_due = false;                  // in OP: the reading is to start (again)
     core::FixedString<200> detail;
     std::atomic<core::LinkState> link{core::LinkState::Offline};
   };
   struct Axis {
     std::size_t slave = 0;
+    DictionaryAxis names;
     std::vector<cia402::FaultText> faults;  // views into the plan
     std::unique_ptr<SlaveAccess> io;
     std::unique_ptr<cia402::Cia402Master> master;
@@ -214,6 +225,8 @@ class EthercatBus final : public core::Bus, private EmergencySink, private Datag
   void lose(std::size_t k, core::TimePoint now) noexcept;   // detail set by the caller
   void fail(std::size_t k, core::TimePoint now) noexcept;   // a failed step: back-off doubles
   void run_safe_stop(std::size_t k, core::TimePoint now) noexcept;
+  // In OP: the dictionary reading started (once a lookup no longer holds the table) and stepped.
+  void read_names(std::size_t k) noexcept;
   void handle_link(core::TimePoint now) noexcept;
   void push_event(const core::Event& e) noexcept;
   void bus_event(core::EventKind kind, std::string_view text) noexcept;

@@ -50,6 +50,7 @@ ParameterRef find_ethercat_parameter(const AxisPlan& axis, std::string_view name
       return out;
     }
     if (found.empty()) {
+      out.name_unknown = true;
       out.error = "axis '" + axis.spec.name + "' has no object named '" + std::string(name) + "'" +
                   (ax.esi.empty() ? " (give the axis an ESI file to use names, or use INDEX:SUB)"
                                   : " in its ESI (a sub-item is named OBJECT:SUB)");

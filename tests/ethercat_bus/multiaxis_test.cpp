@@ -180,6 +180,24 @@ TEST(EthercatMultiAxis, ParameterOfAxisOneIsItsOffsetObject) {
   EXPECT_EQ(core::get_u32(p1.data, 0), 0x00020192U);
 }
 
+// Names read over SDO Information: the slave names 6040h and 6840h both "Controlword"; each axis
+// finds its own (in its own numbering, as a parameter request gives it), shared objects on both.
+TEST(EthercatMultiAxis, NamesOfEachAxisComeFromItsOwnObjects) {
+  MultiHarness h;
+  up(h);
+  if (HasFatalFailure()) return;
+  ASSERT_TRUE(h.run_until([&] { return h.bus->dictionary(1)->state() == SlaveDictionary::State::Done; }, 60s));
+  for (const char* axis : {"left", "right"}) {
+    const core::NamedObject cw = h.bus->find_object(h.axis(axis), "Controlword");
+    ASSERT_TRUE(cw.found) << axis << ": " << cw.error;
+    EXPECT_EQ(cw.index, 0x6040) << axis;
+    const core::NamedObject id = h.bus->find_object(h.axis(axis), "Identity:Product code");
+    ASSERT_TRUE(id.found) << axis << ": " << id.error;
+    EXPECT_EQ(id.index, 0x1018) << axis;
+    EXPECT_EQ(id.sub, 2) << axis;
+  }
+}
+
 // A fault on axis 1: that axis goes to Fault, with its EMCY event and fault report; axis 0 and the
 // other drive stay as they were. The fault is reset on axis 1 alone.
 TEST(EthercatMultiAxis, FaultOnOneAxisIsReportedOnThatAxisOnly) {

@@ -46,7 +46,8 @@ TEST_F(EthercatE2eBringUp, EverySlaveInOpAndEachDriveEnables) {
 }
 
 // Drive parameters over CoE through the DDS client while the process data runs: a write read back
-// on each drive, the identity object read, and the cyclic exchange not disturbed by it.
+// on each drive, the identity object read, an object named as the drive's dictionary names it, and
+// the cyclic exchange not disturbed by it.
 TEST_F(EthercatE2eBringUp, ParametersOverDdsWhileCycling) {
   ASSERT_NO_FATAL_FAILURE(enable("gen"));
   const auto before = bus_status();
@@ -86,6 +87,18 @@ TEST_F(EthercatE2eBringUp, ParametersOverDdsWhileCycling) {
   const auto abort = client_->param(missing, 10s);
   EXPECT_FALSE(abort.ok);
   EXPECT_NE(abort.error_code, 0U) << abort.error;
+  // By name without an ESI: the ESR's manufacturer object from its own dictionary, read over SDO
+  // Information after OP (the answer says so while it is being read).
+  client::ParamRequest named;
+  named.axis = "esr";
+  named.name = "acceleration_time";
+  client::ParamResult by_name;
+  ASSERT_TRUE(client_->wait_until([&] {
+    by_name = client_->param(named, 10s);
+    return by_name.ok || by_name.error.find("still being read") == std::string::npos;
+  }, 30s)) << by_name.error;
+  ASSERT_TRUE(by_name.ok) << by_name.error << diagnostics();
+  EXPECT_EQ(by_name.integer(), 100);  // 5EF4h's power-on value in the simulated ESR
   // The cycle ran on meanwhile: the enabled drive stayed enabled, the frames kept returning.
   EXPECT_EQ(state("gen").state, "operation_enabled");
   EXPECT_EQ(state("gen").link, "operational");

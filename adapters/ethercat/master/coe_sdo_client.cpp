@@ -147,6 +147,12 @@ std::span<const std::uint8_t> CoeSdoClient::data(CoeSdoId id) const noexcept {
   return {s->into, s->done};
 }
 
+std::size_t CoeSdoClient::pending() const noexcept {
+  return static_cast<std::size_t>(std::count_if(slots_.begin(), slots_.end(), [](const Slot& s) {
+    return s.state == SlotState::Queued || s.state == SlotState::InFlight;
+  }));
+}
+
 CoeSdoResult CoeSdoClient::take(CoeSdoId id) noexcept {
   const Slot* s = find(id);
   if (s == nullptr || (s->state != SlotState::Done && s->state != SlotState::Failed)) return result(id);

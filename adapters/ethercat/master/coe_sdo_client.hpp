@@ -141,6 +141,8 @@ class CoeSdoClient final : public DatagramOwner {
 
   [[nodiscard]] const CoeSdoCounters& counters() const noexcept { return counters_; }
   [[nodiscard]] bool idle() const noexcept { return phase_ == Phase::Idle; }
+  // Requests queued or running (a background reader waits for 0 so that others go first).
+  [[nodiscard]] std::size_t pending() const noexcept;
 
  private:
   enum class SlotState : std::uint8_t { Free, Queued, InFlight, Done, Failed };

@@ -128,6 +128,74 @@ std::string_view object_name(std::uint16_t index) noexcept {
   }
 }
 
+// The names of the sub-indexes where the standards give them [CiA 301 identity object 1018h and
+// store parameters 1010h; ETG.1020 SM synchronisation 1C32h/1C33h; CiA 402 interpolation objects],
+// else "SubIndex 001" as ESI files (and the slave stacks that generate them) name them, sub-index 0
+// too: each entry has its own name in the entry description
+// [ETG.1000.6 §5.6.3.6], so a client can name it OBJECT:SUB.
+constexpr auto kSubIndexNames = [] {
+  std::array<std::array<char, 12>, 256> names{};
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    constexpr std::string_view kPrefix = "SubIndex ";
+    for (std::size_t c = 0; c < kPrefix.size(); ++c) names[i][c] = kPrefix[c];
+    names[i][9] = static_cast<char>('0' + i / 100);
+    names[i][10] = static_cast<char>('0' + i / 10 % 10);
+    names[i][11] = static_cast<char>('0' + i % 10);
+  }
+  return names;
+}();
+
+std::string_view entry_name(std::uint16_t index, std::uint8_t sub) noexcept {
+  constexpr std::array<std::string_view, 5> kIdentity{"", "Vendor ID", "Product code", "Revision number", "Serial number"};
+  constexpr std::array<std::string_view, 7> kBuffer{"",
+                                                    "Maximum buffer size",
+                                                    "Actual buffer size",
+                                                    "Buffer organization",
+                                                    "Buffer position",
+                                                    "Size of data record",
+                                                    "Buffer clear"};
+  switch (index) {
+    case 0x1010:
+      if (sub == 1) return "Save all parameters";
+      break;
+    case 0x1018:
+      if (sub >= 1 && std::size_t{sub} < kIdentity.size()) return kIdentity[sub];
+      break;
+    case 0x1C32:
+    case 0x1C33:
+      switch (sub) {
+        case 0x01: return "Synchronization type";
+        case 0x02: return "Cycle time";
+        case 0x03: return "Shift time";
+        case 0x04: return "Synchronization types supported";
+        case 0x05: return "Minimum cycle time";
+        case 0x06: return "Calc and copy time";
+        case 0x09: return "Delay time";
+        case 0x0B: return "SM event missed";
+        case 0x0C: return "Cycle time too small";
+        case 0x20: return "Sync error";
+        default: break;
+      }
+      break;
+    case 0x60C1:
+      if (sub == 1) return "Interpolation data record 1";
+      break;
+    case 0x60C2:
+      if (sub == 1) return "Interpolation time period value";
+      if (sub == 2) return "Interpolation time index";
+      break;
+    case 0x60C3:
+      if (sub == 1) return "Synchronize on group";
+      if (sub == 2) return "Ip sync every n event";
+      break;
+    case 0x60C4:
+      if (sub >= 1 && std::size_t{sub} < kBuffer.size()) return kBuffer[sub];
+      break;
+    default: break;
+  }
+  return {kSubIndexNames[sub].data(), kSubIndexNames[sub].size()};
+}
+
 cia402::sim::DriveModelConfig model_config(const EthercatPersona& p, const Cia402SlaveOptions& o, std::size_t axis) {
   cia402::sim::DriveModelConfig c = axis >= 1 && axis - 1 < o.more_drives.size() ? o.more_drives[axis - 1] : o.drive;
   c.supported_modes.assign(p.modes.begin(), p.modes.end());
@@ -183,7 +251,7 @@ Cia402Slave::Cia402Slave(const EthercatPersona& persona, Cia402SlaveOptions opti
     refuse(p, "default process data larger than its capacity");
   }
   build_entries();
-  build_sii(options.serial, options.station_alias);
+  build_sii(options.serial, options.station_alias, options.sdo_information);
 }
 
 Cia402Slave::~Cia402Slave() = default;
@@ -685,7 +753,7 @@ bool Cia402Slave::describe_object(std::uint16_t index, SdoInfoObjectDescription&
   if (first == entries_.end() || first->id.index != index) return false;
   out = SdoInfoObjectDescription{};
   out.index = index;
-  out.name = object_name(locate({index, 0}).local.index);
+  out.name = name_of(index);
   for (auto it = first; it != entries_.end() && it->id.index == index; ++it) {
     out.max_subindex = std::max(out.max_subindex, it->id.sub);
     if (it->id.sub <= 1) out.data_type = it->data_type;  // sub-index 1's for arrays and records
@@ -705,9 +773,14 @@ bool Cia402Slave::describe_entry(std::uint16_t index, std::uint8_t subindex, Sdo
   out.data_type = e->data_type;
   out.bit_length = e->bits;
   out.object_access = e->access;
-  out.name = (subindex == 0 && sub1 != nullptr) ? std::string_view("Number of entries")
-                                                 : object_name(locate({index, 0}).local.index);
+  // A variable: the object's name; an array's or record's entry: its own.
+  out.name = sub1 == nullptr ? name_of(index) : entry_name(locate({index, 0}).local.index, subindex);
   return true;
+}
+
+std::string_view Cia402Slave::name_of(std::uint16_t index) const noexcept {
+  if (const EcatVendorObject* v = vendor_object({index, 0}); v != nullptr && !v->name.empty()) return v->name;
+  return object_name(locate({index, 0}).local.index);
 }
 
 void Cia402Slave::build_entries() {
@@ -780,7 +853,7 @@ void Cia402Slave::build_entries() {
                  entries_.end());
 }
 
-void Cia402Slave::build_sii(std::uint32_t serial, std::uint16_t alias) {
+void Cia402Slave::build_sii(std::uint32_t serial, std::uint16_t alias, bool sdo_information) {
   const auto& p = persona_;
   // The power-on assigned PDOs as TXPDO/RXPDO categories [ETG.1000.6 §5.4], SM2/SM3 lengths from
   // them. Entry data types are the CoE codes (low byte).
@@ -830,7 +903,8 @@ void Cia402Slave::build_sii(std::uint32_t serial, std::uint16_t alias) {
   profile.image = "";
   profile.order = p.sii_order;
   profile.name = p.device_name;
-  profile.general.coe_details = coe_details::kSdo | coe_details::kSdoInfo | coe_details::kPdoAssign | coe_details::kPdoConfig;
+  profile.general.coe_details = static_cast<std::uint8_t>(coe_details::kSdo | (sdo_information ? coe_details::kSdoInfo : 0) |
+                                                         coe_details::kPdoAssign | coe_details::kPdoConfig);
   profile.general.ds402_channels = static_cast<std::uint8_t>(axes_.size());
   profile.general.physical_ports = 0x0011;  // ports 0 and 1 MII
   profile.fmmus = fmmus;

@@ -76,6 +76,9 @@ struct Cia402SlaveOptions {
   // Axes 1.. of a multi-axis persona: their mechanics, in axis order; an axis without one takes
   // `drive`'s.
   std::vector<cia402::sim::DriveModelConfig> more_drives;
+  // The SII's CoE details offer SDO Information (bit 1); false: a drive whose SII does not, so a
+  // master does not ask it for its object names [ETG.1000.6 Table 21].
+  bool sdo_information = true;
 };
 
 struct Cia402SlaveCounters {
@@ -215,6 +218,8 @@ class Cia402Slave final : public SlaveApplication, private ObjectDictionary {
   bool hidden(cia402::ObjectId id) const noexcept;
   bool ignored(cia402::ObjectId id) const noexcept;
   const EcatVendorObject* vendor_object(cia402::ObjectId id) const noexcept;
+  // The object's name in SDO Information: the persona's for a manufacturer object, else the CiA name.
+  std::string_view name_of(std::uint16_t index) const noexcept;
   std::string_view text_of(cia402::ObjectId id) const noexcept;
   Pdo* pdo(std::uint16_t index, bool* receive) noexcept;
   const Pdo* pdo(std::uint16_t index, bool* receive) const noexcept;
@@ -222,7 +227,7 @@ class Cia402Slave final : public SlaveApplication, private ObjectDictionary {
   std::size_t assigned_bytes(bool receive) const noexcept;
   const Entry* find_entry(cia402::ObjectId id) const noexcept;
   void build_entries();
-  void build_sii(std::uint32_t serial, std::uint16_t alias);
+  void build_sii(std::uint32_t serial, std::uint16_t alias, bool sdo_information);
 
   // Cycle.
   void apply_outputs(std::span<const std::uint8_t> outputs) noexcept;

@@ -14,11 +14,13 @@ using cia402::sim::Access;
 constexpr std::uint32_t map(std::uint16_t index, std::uint8_t sub, std::uint8_t bits) noexcept {
   return (static_cast<std::uint32_t>(index) << 16) | (static_cast<std::uint32_t>(sub) << 8) | bits;
 }
-constexpr EcatVendorObject stored(std::uint16_t index, std::uint8_t sub, DataType type, std::int64_t value) noexcept {
-  return {{{index, sub}, type}, Access::ReadWrite, value, EcatVendorSource::Stored};
+constexpr EcatVendorObject stored(std::uint16_t index, std::uint8_t sub, DataType type, std::int64_t value,
+                                  std::string_view name = {}) noexcept {
+  return {{{index, sub}, type}, Access::ReadWrite, value, EcatVendorSource::Stored, name};
 }
-constexpr EcatVendorObject constant(std::uint16_t index, std::uint8_t sub, DataType type, std::int64_t value) noexcept {
-  return {{{index, sub}, type}, Access::ReadOnly, value, EcatVendorSource::Stored};
+constexpr EcatVendorObject constant(std::uint16_t index, std::uint8_t sub, DataType type, std::int64_t value,
+                                    std::string_view name = {}) noexcept {
+  return {{{index, sub}, type}, Access::ReadOnly, value, EcatVendorSource::Stored, name};
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -58,23 +60,24 @@ constexpr std::array<EcatTypeOverride, 3> kEsrTypes{{
     {{0x6081, 0}, DataType::I32},
 }};
 
-// Whitelisted manufacturer objects and CiA objects the model lacks (§7.3; types from there).
+// Whitelisted manufacturer objects and CiA objects the model lacks (§7.3; types and the
+// manufacturer objects' names from there).
 // Values are illustrative (6710.101 is not available): they are stored, the model ignores them.
 // 60C0h, 60C3h, 60C4h (§11.2): constants whose writes are accepted and ignored.
 constexpr std::array<EcatVendorObject, 28> kEsrObjects{{
-    constant(0x5E93, 0, DataType::U16, 0),      // I2t utilisation
-    constant(0x5E95, 0, DataType::I32, 0),      // position encoder measured value 2
-    constant(0x5E96, 0, DataType::I32, 0),      // the same in LE
-    constant(0x5E9F, 0, DataType::I32, 0),      // position encoder measured value 1 in LE
-    constant(0x5F03, 0, DataType::U32, 1000),   // motor temperature sensor resistance
-    constant(0x5F0B, 0, DataType::I16, 35),     // heatsink temperature
-    constant(0x5F0C, 0, DataType::I16, 40),     // motor temperature
-    constant(0x5F1C, 0, DataType::I32, 0),      // position encoder measured value
-    stored(0x5E9C, 0, DataType::U16, 1000),     // maximum current magnitude 2
-    stored(0x5EF4, 0, DataType::U32, 100),      // acceleration time
-    stored(0x5EF5, 0, DataType::U32, 100),      // deceleration time
-    stored(0x5EF6, 0, DataType::U32, 50),       // quick-stop time
-    stored(0x5EF7, 0, DataType::U32, 3000),     // velocity reference value
+    constant(0x5E93, 0, DataType::U16, 0, "I2t utilisation"),
+    constant(0x5E95, 0, DataType::I32, 0, "Position encoder measured value 2"),
+    constant(0x5E96, 0, DataType::I32, 0, "Position encoder measured value 2 in LE"),
+    constant(0x5E9F, 0, DataType::I32, 0, "Position encoder measured value 1 in LE"),
+    constant(0x5F03, 0, DataType::U32, 1000, "Motor temperature sensor resistance"),
+    constant(0x5F0B, 0, DataType::I16, 35, "Heatsink temperature"),
+    constant(0x5F0C, 0, DataType::I16, 40, "Motor temperature"),
+    constant(0x5F1C, 0, DataType::I32, 0, "Position encoder measured value"),
+    stored(0x5E9C, 0, DataType::U16, 1000, "Maximum current magnitude 2"),
+    stored(0x5EF4, 0, DataType::U32, 100, "Acceleration time"),
+    stored(0x5EF5, 0, DataType::U32, 100, "Deceleration time"),
+    stored(0x5EF6, 0, DataType::U32, 50, "Quick-stop time"),
+    stored(0x5EF7, 0, DataType::U32, 3000, "Velocity reference value"),
     stored(0x6073, 0, DataType::U16, 1000),     // maximum current magnitude
     {{{0x6078, 0}, DataType::I16}, Access::ReadOnly, 0, EcatVendorSource::TorqueActual},  // current actual
     constant(0x6079, 0, DataType::U16, 325),    // DC-link voltage, U16 (quirk 2)

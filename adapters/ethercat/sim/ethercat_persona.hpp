@@ -54,6 +54,7 @@ struct EcatVendorObject {
   cia402::sim::Access access = cia402::sim::Access::ReadWrite;
   std::int64_t value = 0;  // power-on value of a Stored object
   EcatVendorSource source = EcatVendorSource::Stored;
+  std::string_view name{};  // its name in SDO Information (empty: the CiA name, where it has one)
 };
 
 struct EthercatPersona {
