@@ -20,7 +20,7 @@ constexpr milliseconds kHold{6};  // 3 × 2 ms
 
 constexpr std::uint8_t without(std::uint8_t bit) { return static_cast<std::uint8_t>(data_status::kGood & ~bit); }
 
-struct Consumer : ::testing::Test {
+struct PnRtConsumer : ::testing::Test {
   RtConsumer c{iocr(kInputFrameId)};
   core::TimePoint now = kArm;
   std::uint16_t cycle = 100;
@@ -39,7 +39,7 @@ struct Consumer : ::testing::Test {
   }
 };
 
-TEST_F(Consumer, TakesValidFramesAndReportsData) {
+TEST_F(PnRtConsumer, TakesValidFramesAndReportsData) {
   EXPECT_EQ(c.state(), RtConsumerState::Waiting);
   EXPECT_FALSE(c.all_iops_good());  // nothing received yet
   ASSERT_TRUE(next());
@@ -57,7 +57,7 @@ TEST_F(Consumer, TakesValidFramesAndReportsData) {
   EXPECT_EQ(c.next_deadline(), now + kHold);
 }
 
-TEST_F(Consumer, BadIopsOnOneSubmoduleIsReported) {
+TEST_F(PnRtConsumer, BadIopsOnOneSubmoduleIsReported) {
   ASSERT_TRUE(next({.sensor_iops = iox_status::kBadByDevice}));
   EXPECT_EQ(c.counters().frames, 1U);
   EXPECT_EQ(c.iops(kDrive), iox_status::kGood);
@@ -67,7 +67,7 @@ TEST_F(Consumer, BadIopsOnOneSubmoduleIsReported) {
   EXPECT_TRUE(c.all_iops_good());
 }
 
-TEST_F(Consumer, ProviderStopAndStationProblemAreTakenAndReported) {
+TEST_F(PnRtConsumer, ProviderStopAndStationProblemAreTakenAndReported) {
   ASSERT_TRUE(next({.data_status = without(data_status::kProviderRun)}));
   EXPECT_EQ(c.counters().frames, 1U);
   EXPECT_EQ(c.counters().provider_stop, 1U);
@@ -79,7 +79,7 @@ TEST_F(Consumer, ProviderStopAndStationProblemAreTakenAndReported) {
   EXPECT_EQ(c.counters().station_problem, 1U);
 }
 
-TEST_F(Consumer, RefusesFramesPerReason) {
+TEST_F(PnRtConsumer, RefusesFramesPerReason) {
   ASSERT_TRUE(next());
   const std::uint16_t good = cycle;
   const core::TimePoint valid_at = now;
@@ -129,7 +129,7 @@ TEST_F(Consumer, RefusesFramesPerReason) {
   EXPECT_EQ(c.state(), RtConsumerState::Running);
 }
 
-TEST_F(Consumer, WatchdogFiresAtExactlyTheDataHoldTime) {
+TEST_F(PnRtConsumer, WatchdogFiresAtExactlyTheDataHoldTime) {
   for (int i = 0; i < 10; ++i) ASSERT_TRUE(next());
   const core::TimePoint last = now;
   EXPECT_EQ(c.next_deadline(), last + kHold);
@@ -158,7 +158,7 @@ TEST_F(Consumer, WatchdogFiresAtExactlyTheDataHoldTime) {
   EXPECT_EQ(c.counters().frames, 11U);
 }
 
-TEST_F(Consumer, FrameAtTheDeadlineIsTooLate) {
+TEST_F(PnRtConsumer, FrameAtTheDeadlineIsTooLate) {
   ASSERT_TRUE(next());
   now += kHold - kPeriod;
   EXPECT_TRUE(next());  // arrives exactly kHold after the last valid one
@@ -167,15 +167,15 @@ TEST_F(Consumer, FrameAtTheDeadlineIsTooLate) {
   EXPECT_EQ(c.counters().inactive, 1U);
 }
 
-TEST_F(Consumer, SilentDeviceAfterArmTimesOut) {
+TEST_F(PnRtConsumer, SilentDeviceAfterArmTimesOut) {
   EXPECT_EQ(c.next_deadline(), kArm + kHold);
   EXPECT_FALSE(c.poll(kArm + kHold - nanoseconds(1)));
   EXPECT_TRUE(c.poll(kArm + kHold));
   EXPECT_EQ(c.reason(), "no input frame 0x8002 from the device within the data hold time (6 ms)");
 }
 
-TEST(PnRtConsumer, IdleConsumerTakesNothing) {
-  RtConsumer c(iocr(kInputFrameId));
+TEST_F(PnRtConsumer, DisarmedConsumerTakesNothing) {
+  c.disarm();
   EXPECT_EQ(c.state(), RtConsumerState::Idle);
   EXPECT_EQ(c.next_deadline(), core::TimePoint::max());
   EXPECT_FALSE(c.poll(core::TimePoint{std::chrono::hours(5)}));
