@@ -64,6 +64,9 @@ struct FoundDevice {
   // Without a profile: what to do so that it becomes an axis ("add a device profile for it ...").
   std::string next_step;
   bool drive = false;          // an axis in the configuration skeleton (it has a profile to run it)
+  // A device that carries more than one axis (an EtherCAT multi-axis slave): per axis, the
+  // bus-specific key that picks it, as a YAML line ("ethercat: { axis: 1 }"). Empty: one axis.
+  std::vector<std::string> axis_keys;
   // Why its identity cannot be trusted (more than one device answers at its address: a conflict);
   // "" when it can. Such a device has no profile and is no axis.
   std::string conflict;

@@ -187,17 +187,23 @@ std::string skeleton_text(const core::ScanResult& result, core::Duration cycle_t
       y << "  #   not an axis here" << (d.next_step.empty() ? "" : ": " + d.next_step) << "\n";
       continue;
     }
-    y << "  - name: " << d.profile << "-" << d.address.number << "    # CHECK: the name clients use\n"
-      << "    bus: " << result.bus_name << "\n"
-      << "    address: " << d.address.number << "\n"
-      << "    device: " << d.profile << "\n"
-      << "    unit: rev                 # CHECK: the user unit (mm, deg, rev, ...)\n"
-      << "    mechanics:                # CHECK: all three, from the motor and the mechanics\n"
-      << "      encoder_counts_per_rev: 131072\n"
-      << "      gear_ratio: 1\n"
-      << "      feed: 1\n"
-      << "    # limits: { min_position: ..., max_position: ..., max_velocity: ..., max_acceleration: ... }  "
-         "# CHECK: the machine's limits\n";
+    // One entry per axis the device carries (a multi-axis slave: each picked by its key).
+    const std::vector<std::string> keys = d.axis_keys.empty() ? std::vector<std::string>{""} : d.axis_keys;
+    for (std::size_t n = 0; n < keys.size(); ++n) {
+      y << "  - name: " << d.profile << "-" << d.address.number << (keys.size() > 1 ? "-" + std::to_string(n) : "")
+        << "    # CHECK: the name clients use\n"
+        << "    bus: " << result.bus_name << "\n"
+        << "    address: " << d.address.number << "\n"
+        << "    device: " << d.profile << "\n";
+      if (!keys[n].empty()) y << "    " << keys[n] << "\n";
+      y << "    unit: rev                 # CHECK: the user unit (mm, deg, rev, ...)\n"
+        << "    mechanics:                # CHECK: all three, from the motor and the mechanics\n"
+        << "      encoder_counts_per_rev: 131072\n"
+        << "      gear_ratio: 1\n"
+        << "      feed: 1\n"
+        << "    # limits: { min_position: ..., max_position: ..., max_velocity: ..., max_acceleration: ... }  "
+           "# CHECK: the machine's limits\n";
+    }
   }
   return y.str();
 }

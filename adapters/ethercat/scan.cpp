@@ -552,6 +552,8 @@ core::ScanResult ethercat_scan_result(const std::vector<ScannedSlave>& slaves, c
     } else if (const auto* p = match(s, profiles, d.profile_reason)) {
       d.profile = p->name;
       d.drive = true;
+      if (const int axes = p->section<config::EthercatDeviceSpec>().axes; axes > 1)
+        for (int n = 0; n < axes; ++n) d.axis_keys.push_back("ethercat: { axis: " + std::to_string(n) + " }");
       role[k] = 2;
     } else {
       d.profile_reason = identity_words(s.identity) + " matches no profile" +

@@ -198,7 +198,6 @@ TEST(Burst, TenThousandCommandsAndParameterRequestsFromSeveralClientsGetOneReply
   const auto start = Clock::now();
   std::vector<std::thread> writers;
   std::atomic<bool> done{false};
-  std::mutex m;
   for (auto& c : clients)
     writers.emplace_back([&c] { c->send_all("burst"); });
   // Replies are taken while the writers write: a client that reads nothing would hold the gateway.

@@ -162,6 +162,34 @@ TEST(EthercatScan, ProfilesMatchedAndTheSkeletonPassesTheConfigurationChecks) {
   ASSERT_EQ(plan.buses[0].section<config::EthercatBusOptions>().io.size(), 1U);
 }
 
+// A two-axis slave (objects 800h apart per axis) becomes two axes of the skeleton, each picked by
+// its `ethercat: { axis: N }`, and the configuration checks take both.
+TEST(EthercatScan, MultiAxisSlaveGivesOneSkeletonAxisPerAxis) {
+  const Scanned s = scan(R"(gateway: { name: scan-test }
+buses:
+  - { name: ec0, type: ethercat, cycle_time: 1ms, options: { transport: sim } }
+axes:
+  - { name: x, bus: ec0, address: 1, device: generic-cia402-2axis, ethercat: { axis: 0 },
+      mechanics: { encoder_counts_per_rev: 4096 } }
+  - { name: y, bus: ec0, address: 1, device: generic-cia402-2axis, ethercat: { axis: 1 },
+      mechanics: { encoder_counts_per_rev: 4096 } }
+)");
+  core::ScanResult r = ethercat_scan_result(s.slaves, s.line_text, "ecs0", profiles());
+  ASSERT_EQ(r.devices.size(), 1U);
+  EXPECT_EQ(r.devices[0].profile, "generic-cia402-2axis") << r.devices[0].profile_reason;
+  EXPECT_EQ(r.devices[0].axis_keys, (std::vector<std::string>{"ethercat: { axis: 0 }", "ethercat: { axis: 1 }"}));
+  const std::string yaml = daemon::scan_skeleton(r, load_options());
+  EXPECT_NE(yaml.find("  - name: generic-cia402-2axis-1-0 "), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("  - name: generic-cia402-2axis-1-1 "), std::string::npos) << yaml;
+  const config::Plan plan = config::load_plan_from_string(yaml, "skeleton.yaml", load_options());
+  ASSERT_EQ(plan.buses.at(0).axes.size(), 2U);
+  for (int n = 0; n < 2; ++n) {
+    const auto& axis = plan.buses[0].axes[static_cast<std::size_t>(n)];
+    EXPECT_EQ(axis.address, 1);
+    EXPECT_EQ(axis.section<config::EthercatAxisSpec>().slave_axis, n);
+  }
+}
+
 // SDO Information [ETG.1000.6 §5.6.3]: the drives' SIIs offer it (CoE details bit 1), so their
 // object lists are read (counted by area in the table); with objects=1 every object's name too.
 // The I/O slave has no mailbox: nothing to list.
