@@ -97,12 +97,21 @@ TEST(Realtime, FifoAppliesOrSaysWhatIsMissing) {
   }
 }
 
+// AddressSanitizer is on (gcc says so with __SANITIZE_ADDRESS__, clang 14 only through __has_feature).
+#if defined(__SANITIZE_ADDRESS__)
+#define DRIVEGATE_TEST_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define DRIVEGATE_TEST_ASAN 1
+#endif
+#endif
+
 // Without a message the process' memory is locked (VmLck covers what is resident); with one, it
 // names mlockall and nothing is locked.
 TEST(Realtime, LockMemoryLocksOrSaysWhatIsMissing) {
   const std::string note = lock_memory();
   if (note.empty()) {
-#if defined(__SANITIZE_ADDRESS__)
+#if defined(DRIVEGATE_TEST_ASAN)
     // AddressSanitizer turns mlockall into a no-op (locking its shadow memory would take the
     // machine's RAM): nothing to read back in that build.
     munlockall();
