@@ -5,6 +5,7 @@ set -euo pipefail
 
 PACKAGES=(
   build-essential cmake pkg-config       # toolchain
+  clang libclang-rt-dev lld ninja-build  # the test build (scripts/test.sh): clang + sanitizers, lld, Ninja
   libfastrtps-dev libfastcdr-dev fastddsgen  # Fast DDS and its IDL code generator
   libyaml-cpp-dev                        # configuration files
   libtinyxml2-dev                        # EtherCAT ESI files (XML) given for slaves
