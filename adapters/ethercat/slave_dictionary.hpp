@@ -129,7 +129,6 @@ class SlaveDictionary {
   std::size_t entries_used_ = 0;
   std::size_t names_used_ = 0;
   Object building_{};
-  std::uint32_t list_abort_ = 0;
 
   // Shared.
   std::atomic<State> state_{State::NotYet};
