@@ -62,3 +62,18 @@ TEST(Seqlock, CarriesAxisSnapshots) {
   EXPECT_DOUBLE_EQ(r.position, 12.5);
   EXPECT_EQ(r.fault_text.view(), "overcurrent");
 }
+
+// A payload whose size is not a whole number of words: the last bytes travel in a partial word,
+// every byte arrives and nothing beyond the payload is read.
+TEST(Seqlock, CarriesPayloadsOfOddSize) {
+  struct Odd {
+    unsigned char bytes[21];
+  };
+  static_assert(sizeof(Odd) % sizeof(std::uint64_t) != 0);
+  Seqlock<Odd> lock;
+  Odd o{};
+  for (unsigned i = 0; i < sizeof(o.bytes); ++i) o.bytes[i] = static_cast<unsigned char>(0xA0 + i);
+  lock.store(o);
+  const Odd r = lock.load();
+  for (unsigned i = 0; i < sizeof(o.bytes); ++i) EXPECT_EQ(r.bytes[i], 0xA0 + i) << "byte " << i;
+}
