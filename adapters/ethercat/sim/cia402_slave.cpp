@@ -267,6 +267,7 @@ EscConfig Cia402Slave::esc_config() const noexcept {
 
 void Cia402Slave::restore_defaults() noexcept {
   const auto& p = persona_;
+  plan_valid_ = false;
   for (std::size_t i = 0; i < rx_.size(); ++i) {
     rx_[i] = Pdo{};
     rx_[i].index = p.rx_pdos[i].index;
@@ -425,53 +426,91 @@ std::size_t Cia402Slave::assigned_bytes(bool receive) const noexcept {
   return n;
 }
 
-std::optional<std::int64_t> Cia402Slave::app_value(ObjectId id) const noexcept {
-  if (const EcatVendorObject* v = vendor_object(id)) {
-    if (v->source == EcatVendorSource::TorqueActual) {
-      return std::clamp<std::int64_t>(std::llround(axes_[0].model->torque()), cia402::sim::type_min(v->def.type),
-                                      cia402::sim::type_max(v->def.type));
-    }
-    return vendor_.get(id);
-  }
-  const Located at = locate(id);
-  return axes_[at.axis].model->dictionary().get(at.local);
+Cia402Slave::Resolved Cia402Slave::resolve(ObjectId id) const noexcept {
+  Resolved r;
+  r.id = id;
+  r.at = locate(id);
+  r.type = type_of(id);
+  r.access = access_of(id);
+  r.model_type = axes_[r.at.axis].model->dictionary().type_of(r.at.local);
+  r.vendor = vendor_object(id);
+  r.hidden = hidden(id);
+  r.ignored = ignored(id);
+  return r;
 }
 
-Cia402Slave::Value Cia402Slave::get(ObjectId id) const noexcept {
-  const auto type = type_of(id);
-  if (!type) {
-    if (hidden(id)) return {abort::kNoObject, 0, 0};
+const Cia402Slave::Plan& Cia402Slave::plan() const noexcept {
+  if (!plan_valid_) build_plan();
+  return plan_;
+}
+
+void Cia402Slave::build_plan() const noexcept {
+  // The walk of apply_outputs()/fill_inputs(): each assigned mapping object found by its index.
+  const auto flatten = [this](const Assign& a, std::array<MappedEntry, kMaxAssign * kMaxEntries>& out) {
+    std::size_t n = 0;
+    for (std::size_t k = 0; k < a.count; ++k) {
+      const Pdo* d = pdo(a.pdos[k], nullptr);
+      if (d == nullptr) continue;
+      for (std::size_t e = 0; e < d->count && n < out.size(); ++e) {
+        const std::uint32_t m = d->entries[e];
+        out[n].object = resolve({static_cast<std::uint16_t>(m >> 16), static_cast<std::uint8_t>(m >> 8)});
+        out[n].bytes = static_cast<std::uint8_t>((m & 0xFFU) / 8);
+        ++n;
+      }
+    }
+    return n;
+  };
+  plan_.rx_n = flatten(rx_assign_, plan_.rx);
+  plan_.tx_n = flatten(tx_assign_, plan_.tx);
+  plan_.output_bytes = assigned_bytes(true);
+  plan_.input_bytes = assigned_bytes(false);
+  plan_valid_ = true;
+}
+
+Cia402Slave::Value Cia402Slave::get(const Resolved& r) const noexcept {
+  const ObjectId id = r.id;
+  const Located at = r.at;
+  if (!r.type) {
+    if (r.hidden) return {abort::kNoObject, 0, 0};
     const bool vendor_index = std::any_of(persona_.vendor_objects.begin(), persona_.vendor_objects.end(),
                                           [&](const EcatVendorObject& v) { return v.def.id.index == id.index; });
-    const Located at = locate(id);
     return {vendor_index ? abort::kNoSubIndex : axes_[at.axis].model->dictionary().missing_code(at.local), 0, 0};
   }
-  if (access_of(id) == Access::WriteOnly) return {abort::kWriteOnly, 0, 0};
-  const Located at = locate(id);
+  if (r.access == Access::WriteOnly) return {abort::kWriteOnly, 0, 0};
   const AxisState& axis = axes_[at.axis];
-  std::int64_t value = app_value(id).value_or(0);
+  std::int64_t value = 0;
+  if (r.vendor != nullptr) {
+    if (r.vendor->source == EcatVendorSource::TorqueActual) {
+      value = std::clamp<std::int64_t>(std::llround(axes_[0].model->torque()), cia402::sim::type_min(r.vendor->def.type),
+                                       cia402::sim::type_max(r.vendor->def.type));
+    } else {
+      value = vendor_.get(id).value_or(0);
+    }
+  } else {
+    value = axis.model->dictionary().get(at.local).value_or(0);
+  }
   if (at.local == kControlword) value = from_model_controlword(axis, static_cast<std::uint16_t>(value));
   // ESR: no "ip mode active" bit in ip (quirk 7).
   if (at.local == kStatusword && !persona_.ip_status_bit12 &&
       axis.model->active_mode() == cia402::op_mode::kInterpolatedPosition) {
     value &= ~std::int64_t{0x1000};
   }
-  const std::uint8_t size = cia402::size_of(*type);
+  const std::uint8_t size = cia402::size_of(*r.type);
   return {0, to_raw(value, size), size};
 }
 
-std::uint32_t Cia402Slave::put_app(ObjectId id, std::int64_t value) noexcept {
-  const Located at = locate(id);
+std::uint32_t Cia402Slave::put_app(const Resolved& r, std::int64_t value) noexcept {
+  const Located at = r.at;
   AxisState& axis = axes_[at.axis];
-  for (const auto& r : persona_.ranges) {
-    if (r.id == at.local) {
-      if (value > r.max) return abort::kValueTooHigh;
-      if (value < r.min) return abort::kValueTooLow;
+  for (const auto& range : persona_.ranges) {
+    if (range.id == at.local) {
+      if (value > range.max) return abort::kValueTooHigh;
+      if (value < range.min) return abort::kValueTooLow;
     }
   }
-  if (vendor_object(id) != nullptr) return vendor_.set(id, value);
-  const auto model_type = axis.model->dictionary().type_of(at.local);
-  if (!model_type || hidden(id)) return abort::kNoObject;
+  if (r.vendor != nullptr) return vendor_.set(r.id, value);
+  const auto model_type = r.model_type;
+  if (!model_type || r.hidden) return abort::kNoObject;
   // A wider type on the wire than in the model (ESR 6060h as INTEGER16): values the model's type
   // cannot hold are out of range.
   if (value < cia402::sim::type_min(*model_type) || value > cia402::sim::type_max(*model_type)) {
@@ -630,6 +669,7 @@ std::optional<std::uint32_t> Cia402Slave::put_comm(ObjectId id, std::uint32_t ra
 std::uint32_t Cia402Slave::put_pdo(Pdo& d, bool receive, std::uint8_t sub, std::uint32_t raw, std::size_t size,
                                    AlState state) noexcept {
   const auto& p = persona_;
+  plan_valid_ = false;
   if (sub > p.max_entries) return abort::kNoSubIndex;  // a 9th entry on ESR (§7.2)
   if (size != (sub == 0 ? 1U : 4U)) return abort::kTypeMismatch;
   // Mapping in PRE-OP; ESR RxPDO mapping also in SAFE-OP (quirk 4).
@@ -656,6 +696,7 @@ std::uint32_t Cia402Slave::put_pdo(Pdo& d, bool receive, std::uint8_t sub, std::
 std::uint32_t Cia402Slave::put_assign(Assign& a, bool receive, std::uint8_t sub, std::uint32_t raw, std::size_t size,
                                       AlState state) noexcept {
   const auto& p = persona_;
+  plan_valid_ = false;
   if (sub > p.assign_slots) return abort::kNoSubIndex;
   if (size != (sub == 0 ? 1U : 2U)) return abort::kTypeMismatch;
   if (state != AlState::PreOp) return abort::kDeviceState;  // [ETG.1000.6: assignment in PRE-OP]
@@ -987,38 +1028,30 @@ void Cia402Slave::exchange(std::span<const std::uint8_t> outputs, std::span<std:
 }
 
 void Cia402Slave::apply_outputs(std::span<const std::uint8_t> outputs) noexcept {
+  const Plan& pl = plan();
   std::size_t at = 0;
-  for (std::size_t k = 0; k < rx_assign_.count; ++k) {
-    const Pdo* d = pdo(rx_assign_.pdos[k], nullptr);
-    if (d == nullptr) continue;
-    for (std::size_t e = 0; e < d->count; ++e) {
-      const std::uint32_t m = d->entries[e];
-      const std::size_t n = (m & 0xFFU) / 8;
-      if (at + n > outputs.size()) return;
-      std::uint32_t raw = 0;
-      for (std::size_t b = 0; b < n; ++b) raw |= static_cast<std::uint32_t>(outputs[at + b]) << (8U * b);
-      at += n;
-      const ObjectId id{static_cast<std::uint16_t>(m >> 16), static_cast<std::uint8_t>(m >> 8)};
-      const auto type = type_of(id);
-      if (!type || ignored(id)) continue;
-      if (put_app(id, cia402::normalise(*type, raw)) != 0) ++counters_.refused_pdo_values;
-    }
+  for (std::size_t k = 0; k < pl.rx_n; ++k) {
+    const MappedEntry& m = pl.rx[k];
+    const std::size_t n = m.bytes;
+    if (at + n > outputs.size()) return;
+    std::uint32_t raw = 0;
+    for (std::size_t b = 0; b < n; ++b) raw |= static_cast<std::uint32_t>(outputs[at + b]) << (8U * b);
+    at += n;
+    if (!m.object.type || m.object.ignored) continue;
+    if (put_app(m.object, cia402::normalise(*m.object.type, raw)) != 0) ++counters_.refused_pdo_values;
   }
 }
 
 void Cia402Slave::fill_inputs(std::span<std::uint8_t> inputs) const noexcept {
+  const Plan& pl = plan();
   std::size_t at = 0;
-  for (std::size_t k = 0; k < tx_assign_.count; ++k) {
-    const Pdo* d = pdo(tx_assign_.pdos[k], nullptr);
-    if (d == nullptr) continue;
-    for (std::size_t e = 0; e < d->count; ++e) {
-      const std::uint32_t m = d->entries[e];
-      const std::size_t n = (m & 0xFFU) / 8;
-      if (at + n > inputs.size()) return;
-      const Value v = get({static_cast<std::uint16_t>(m >> 16), static_cast<std::uint8_t>(m >> 8)});
-      for (std::size_t b = 0; b < n; ++b) inputs[at + b] = static_cast<std::uint8_t>(v.raw >> (8U * b));
-      at += n;
-    }
+  for (std::size_t k = 0; k < pl.tx_n; ++k) {
+    const MappedEntry& m = pl.tx[k];
+    const std::size_t n = m.bytes;
+    if (at + n > inputs.size()) return;
+    const Value v = get(m.object);
+    for (std::size_t b = 0; b < n; ++b) inputs[at + b] = static_cast<std::uint8_t>(v.raw >> (8U * b));
+    at += n;
   }
 }
 

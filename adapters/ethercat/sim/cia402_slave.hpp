@@ -104,8 +104,8 @@ class Cia402Slave final : public SlaveApplication, private ObjectDictionary {
   ~Cia402Slave() override;
 
   // --- SlaveApplication ------------------------------------------------------------------------
-  std::size_t output_size() const noexcept override { return assigned_bytes(true); }
-  std::size_t input_size() const noexcept override { return assigned_bytes(false); }
+  std::size_t output_size() const noexcept override { return plan().output_bytes; }
+  std::size_t input_size() const noexcept override { return plan().input_bytes; }
   void attach(EscSlave& esc) noexcept override { esc_ = &esc; }
   std::uint16_t on_state_change(AlState from, AlState to) noexcept override;
   void on_state_entered(AlState from, AlState to) noexcept override;
@@ -180,6 +180,33 @@ class Cia402Slave final : public SlaveApplication, private ObjectDictionary {
     cia402::ObjectId local;
   };
   Located locate(cia402::ObjectId id) const noexcept;
+  // What the object lookups give for one object: all fixed for the life of the slave (the persona
+  // and the models' dictionaries do not change), so a mapped entry is looked up once per mapping
+  // instead of on every frame (a line of 64 drives did it some thousand times per cycle).
+  struct Resolved {
+    cia402::ObjectId id;
+    Located at;
+    std::optional<cia402::DataType> type;        // type_of()
+    std::optional<cia402::sim::Access> access;   // access_of()
+    std::optional<cia402::DataType> model_type;  // the axis model dictionary's own type
+    const EcatVendorObject* vendor = nullptr;
+    bool hidden = false;
+    bool ignored = false;
+  };
+  struct MappedEntry {
+    Resolved object;
+    std::uint8_t bytes = 0;
+  };
+  // The assigned PDOs' entries in order (as apply_outputs()/fill_inputs() walk them) and the
+  // assigned sizes; rebuilt after any change of a mapping or an assignment.
+  struct Plan {
+    std::array<MappedEntry, kMaxAssign * kMaxEntries> rx{};
+    std::array<MappedEntry, kMaxAssign * kMaxEntries> tx{};
+    std::size_t rx_n = 0;
+    std::size_t tx_n = 0;
+    std::size_t output_bytes = 0;  // assigned_bytes(true)
+    std::size_t input_bytes = 0;   // assigned_bytes(false)
+  };
   // One entry as SDO information describes it (built at construction).
   struct Entry {
     cia402::ObjectId id;
@@ -199,7 +226,11 @@ class Cia402Slave final : public SlaveApplication, private ObjectDictionary {
   bool describe_entry(std::uint16_t index, std::uint8_t subindex, SdoInfoEntryDescription& out) const noexcept override;
 
   // Values (SDO and PDO).
-  Value get(cia402::ObjectId id) const noexcept;
+  Value get(cia402::ObjectId id) const noexcept { return get(resolve(id)); }
+  Value get(const Resolved& r) const noexcept;
+  Resolved resolve(cia402::ObjectId id) const noexcept;
+  const Plan& plan() const noexcept;
+  void build_plan() const noexcept;
   std::uint32_t put(cia402::ObjectId id, std::uint32_t raw, std::size_t size, AlState state) noexcept;
   std::optional<Value> get_comm(cia402::ObjectId id) const noexcept;
   std::optional<std::uint32_t> put_comm(cia402::ObjectId id, std::uint32_t raw, std::size_t size, AlState state) noexcept;
@@ -207,8 +238,8 @@ class Cia402Slave final : public SlaveApplication, private ObjectDictionary {
                         AlState state) noexcept;
   std::uint32_t put_assign(Assign& a, bool receive, std::uint8_t sub, std::uint32_t raw, std::size_t size,
                            AlState state) noexcept;
-  std::uint32_t put_app(cia402::ObjectId id, std::int64_t value) noexcept;  // typed value into vendor/model
-  std::optional<std::int64_t> app_value(cia402::ObjectId id) const noexcept;
+  std::uint32_t put_app(cia402::ObjectId id, std::int64_t value) noexcept { return put_app(resolve(id), value); }
+  std::uint32_t put_app(const Resolved& r, std::int64_t value) noexcept;  // typed value into vendor/model
 
   // Objects.
   std::optional<cia402::DataType> type_of(cia402::ObjectId id) const noexcept;
@@ -247,6 +278,8 @@ class Cia402Slave final : public SlaveApplication, private ObjectDictionary {
   std::vector<Pdo> tx_;
   Assign rx_assign_;
   Assign tx_assign_;
+  mutable Plan plan_;
+  mutable bool plan_valid_ = false;  // cleared wherever rx_, tx_ or the assignments change
   std::vector<Entry> entries_;  // sorted by index, sub-index
   std::vector<std::uint8_t> sii_;
   EscSlave* esc_ = nullptr;

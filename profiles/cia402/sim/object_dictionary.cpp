@@ -29,11 +29,35 @@ std::int64_t type_max(DataType t) noexcept {
   return 0;
 }
 
-ObjectDictionary::ObjectDictionary(std::size_t capacity) { entries_.reserve(capacity); }
+namespace {
+
+constexpr std::size_t first_cell(std::uint32_t key, std::size_t mask) noexcept {
+  return static_cast<std::size_t>((key * 0x9E3779B1U) >> 16) & mask;
+}
+
+}  // namespace
+
+ObjectDictionary::ObjectDictionary(std::size_t capacity) {
+  capacity_ = std::min<std::size_t>(capacity, 0xFFFF);  // positions travel as 16-bit cells
+  entries_.reserve(capacity_);
+  std::size_t size = 16;
+  while (size < 2 * capacity_) size *= 2;
+  index_.assign(size, 0);
+  index_mask_ = size - 1;
+}
+
+void ObjectDictionary::rebuild_index() noexcept {
+  std::fill(index_.begin(), index_.end(), std::uint16_t{0});
+  for (std::size_t i = 0; i < entries_.size(); ++i) {
+    std::size_t c = first_cell(entries_[i].id.key(), index_mask_);
+    while (index_[c] != 0) c = (c + 1) & index_mask_;
+    index_[c] = static_cast<std::uint16_t>(i + 1);
+  }
+}
 
 bool ObjectDictionary::add(ObjectDef def, Access access, std::int64_t default_value, std::optional<std::int64_t> min,
                            std::optional<std::int64_t> max) {
-  if (entries_.size() == entries_.capacity()) return false;
+  if (entries_.size() >= capacity_) return false;
   ObjectEntry e;
   e.id = def.id;
   e.type = def.type;
@@ -47,13 +71,16 @@ bool ObjectDictionary::add(ObjectDef def, Access access, std::int64_t default_va
                                     [](const ObjectEntry& x, std::uint32_t k) { return x.id.key() < k; });
   if (pos != entries_.end() && pos->id == def.id) return false;
   entries_.insert(pos, e);
+  rebuild_index();  // positions after pos moved
   return true;
 }
 
 const ObjectEntry* ObjectDictionary::find(ObjectId id) const noexcept {
-  const auto pos = std::lower_bound(entries_.begin(), entries_.end(), id.key(),
-                                    [](const ObjectEntry& x, std::uint32_t k) { return x.id.key() < k; });
-  return (pos != entries_.end() && pos->id == id) ? &*pos : nullptr;
+  for (std::size_t c = first_cell(id.key(), index_mask_); index_[c] != 0; c = (c + 1) & index_mask_) {
+    const ObjectEntry& e = entries_[index_[c] - 1U];
+    if (e.id == id) return &e;
+  }
+  return nullptr;
 }
 
 ObjectEntry* ObjectDictionary::find(ObjectId id) noexcept {
