@@ -189,6 +189,7 @@ struct Harness {
   CoeSdoClient client;
   core::TimePoint now{};
   bool drop_next_sm1_read = false;
+  std::vector<core::TimePoint> status_reads;  // when the client read SM1 status (080Dh)
 
   explicit Harness(CoeSdoTiming timing = {}, bool sink = true)
       : client(0x1001, kMailbox, timing, sink ? &emcy : nullptr) {
@@ -209,6 +210,9 @@ struct Harness {
     for (auto& f : out) {
       const bool reads_sm1 = f.size() > 20 && f[16] == static_cast<std::uint8_t>(Command::FPRD) &&
                              get_u16(f, 20) == kMailbox.tx_offset;
+      if (f.size() > 20 && f[16] == static_cast<std::uint8_t>(Command::FPRD) && get_u16(f, 20) == reg::sm_status(1)) {
+        status_reads.push_back(now);
+      }
       line.process(f);
       if (reads_sm1 && drop_next_sm1_read) {
         drop_next_sm1_read = false;
@@ -362,6 +366,34 @@ TEST(EthercatCoeSdo, EmergencyFoundWhenEmptyingSm1StillGoesToTheSink) {
   ASSERT_EQ(h.emcy.got.size(), 1U);
   EXPECT_EQ(h.emcy.got[0].second.error_code, 0x8100);
   EXPECT_EQ(h.client.counters().stale_replies, 0U);
+}
+
+TEST(EthercatCoeSdo, IdleClientReadsSm1ForEmergenciesOnItsStationsGrid) {
+  // Nothing asked: SM1 status is read every idle_poll_interval (10 ms), at the station's offset
+  // (0x1001 x 1 ms mod 10 ms = 7 ms), not every cycle; an emergency is still delivered.
+  Harness h;
+  for (int i = 0; i < 100; ++i) h.cycle();
+  ASSERT_EQ(h.status_reads.size(), 11U);  // at once, then 7, 17, ..., 97 ms
+  EXPECT_EQ(h.status_reads[0], core::TimePoint{});
+  for (std::size_t k = 1; k < h.status_reads.size(); ++k) {
+    EXPECT_EQ(h.status_reads[k].time_since_epoch(), 7ms + (k - 1) * 10ms) << "read " << k;
+  }
+  std::array<std::uint8_t, 64> emcy{};
+  const std::size_t n = encode_emergency(emcy, 3, CoeEmergency{0x8100, 0x11, {}});
+  h.line.slaves[0].reply(std::span<const std::uint8_t>(emcy.data(), n));
+  const auto placed = h.now;
+  while (h.emcy.got.empty() && h.now - placed < 50ms) h.cycle();
+  ASSERT_EQ(h.emcy.got.size(), 1U);
+  EXPECT_LE(h.now - placed, 11ms);
+  EXPECT_EQ(h.emcy.got[0].second.error_code, 0x8100);
+}
+
+TEST(EthercatCoeSdo, IdlePollingEveryCycleWhenAskedFor) {
+  CoeSdoTiming t;
+  t.idle_poll_interval = 1ms;
+  Harness h(t);
+  for (int i = 0; i < 20; ++i) h.cycle();
+  EXPECT_EQ(h.status_reads.size(), 20U);
 }
 
 TEST(EthercatCoeSdo, LostReplyIsFetchedAgainWithTheRepeatBit) {

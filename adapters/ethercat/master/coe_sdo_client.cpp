@@ -305,6 +305,19 @@ bool CoeSdoClient::queue(Transactions& tx, Command c, std::uint16_t ado, std::ui
   return true;
 }
 
+core::TimePoint CoeSdoClient::next_idle_poll(core::TimePoint now) const noexcept {
+  const auto interval = timing_.idle_poll_interval.count();
+  if (interval <= timing_.poll_interval.count()) return now + timing_.poll_interval;
+  // The next point of this station's grid: interval apart, offset by the station address in
+  // steps of poll_interval.
+  const auto step = std::max<core::Duration::rep>(timing_.poll_interval.count(), 1);
+  const auto offset = (static_cast<core::Duration::rep>(station_) * step) % interval;
+  const auto t = now.time_since_epoch().count();
+  auto next = t - ((t - offset) % interval + interval) % interval + interval;
+  if (next - t < step) next += interval;  // never twice within poll_interval
+  return core::TimePoint(core::Duration(next));
+}
+
 void CoeSdoClient::poll(core::TimePoint now, Transactions& tx) noexcept {
   now_ = now;
   if (waiting_) return;
@@ -319,7 +332,7 @@ void CoeSdoClient::poll(core::TimePoint now, Transactions& tx) noexcept {
       // Nothing of ours in flight: still look for emergencies now and then (and empty SM1 after a
       // timeout); what SM1 holds now is no answer to anything.
       if ((emergencies_ != nullptr || drain_due_) && now >= next_status_poll_) {
-        if (queue(tx, Command::FPRD, reg::sm_status(1), 1)) next_status_poll_ = now + timing_.poll_interval;
+        if (queue(tx, Command::FPRD, reg::sm_status(1), 1)) next_status_poll_ = next_idle_poll(now);
       }
       return;
     case Phase::Drain:

@@ -18,7 +18,8 @@
 //             is taken from the slave each time (another master or a restart may have left it set).
 //   transfers: expedited / normal / segmented upload and download, toggle checked; a server abort
 //             fails the request with its code (cia402::sdo_abort_text() for the words).
-//   emergencies (CoE service 1) arriving in the mailbox go to the EmergencySink, any time.
+//   emergencies (CoE service 1) arriving in the mailbox go to the EmergencySink, any time; while
+//             no request runs, SM1 status is read every idle_poll_interval for them.
 //   SDO Information [ETG.1000.6 §5.6.3]: Get OD List (the indexes of one list type), Get Object
 //             Description and Get Entry Description (fixed fields and the name), through the same
 //             queue, mailbox handling and timeout as the transfers. A response may come in
@@ -62,6 +63,12 @@ class EmergencySink {
 struct CoeSdoTiming {
   core::Duration timeout = std::chrono::seconds(1);             // per request
   core::Duration poll_interval = std::chrono::milliseconds(1);  // SM1 status reads at most this often
+  // While nothing is asked, SM1 is read only for emergencies: this often, on a grid staggered by
+  // station address so that a line's slaves spread their reads over the interval instead of
+  // adding one datagram per slave to every cycle. A drive's fault shows in its statusword at
+  // once; the emergency only adds the code, so 10 ms is soon enough (IgH and SOEM read
+  // emergencies only when they read the mailbox for something else).
+  core::Duration idle_poll_interval = std::chrono::milliseconds(10);
 };
 
 using CoeSdoId = std::uint32_t;  // 0 = refused
@@ -199,6 +206,8 @@ class CoeSdoClient final : public DatagramOwner {
   void finish(Slot& s, SlotState state, std::uint32_t abort_code) noexcept;
   bool queue(Transactions& tx, Command c, std::uint16_t ado, std::uint16_t length,
              std::span<const std::uint8_t> data = {}) noexcept;
+
+  [[nodiscard]] core::TimePoint next_idle_poll(core::TimePoint now) const noexcept;
 
   std::uint16_t station_;
   SiiMailbox mailbox_;
