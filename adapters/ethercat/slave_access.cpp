@@ -23,25 +23,25 @@ constexpr std::size_t first_cell(std::uint32_t key, std::size_t mask) noexcept {
 
 }  // namespace
 
-SlaveAccess::SlaveAccess(std::size_t slave, std::vector<MappedObject> objects, int slave_axis,
+SlaveAccess::SlaveAccess(std::size_t slave, const std::vector<MappedObject>& objects, int slave_axis,
                          std::uint16_t axis_offset, CoeSdoClient* coe, std::vector<EcatOwnedObject> owned,
                          std::span<const cia402::FaultText> faults)
     : slave_(slave),
-      objects_(std::move(objects)),
       slave_axis_(slave_axis),
       axis_offset_(axis_offset),
       coe_(coe),
       owned_(std::move(owned)),
       faults_(faults) {
   std::size_t size = 16;
-  while (size < 2 * objects_.size()) size *= 2;
-  lookup_.assign(size, 0);
-  lookup_mask_ = size - 1;
-  for (std::size_t i = 0; i < objects_.size() && i < 0xFFFF; ++i) {
-    std::size_t c = first_cell(objects_[i].id.key(), lookup_mask_);
+  while (size < 2 * objects.size()) size *= 2;
+  table_.assign(size, MappedObject{});
+  table_mask_ = size - 1;
+  for (const MappedObject& m : objects) {
+    if (m.id.index == 0) continue;
+    std::size_t c = first_cell(m.id.key(), table_mask_);
     // An object mapped twice: the first entry is the one found, as a scan in order would.
-    while (lookup_[c] != 0 && !(objects_[lookup_[c] - 1U].id == objects_[i].id)) c = (c + 1) & lookup_mask_;
-    if (lookup_[c] == 0) lookup_[c] = static_cast<std::uint16_t>(i + 1);
+    while (table_[c].id.index != 0 && !(table_[c].id == m.id)) c = (c + 1) & table_mask_;
+    if (table_[c].id.index == 0) table_[c] = m;
   }
 }
 
@@ -53,9 +53,9 @@ cia402::ObjectId SlaveAccess::on_slave(cia402::ObjectId id) const noexcept {
 
 const MappedObject* SlaveAccess::find(cia402::ObjectId id) const noexcept {
   const cia402::ObjectId on = on_slave(id);
-  for (std::size_t c = first_cell(on.key(), lookup_mask_); lookup_[c] != 0; c = (c + 1) & lookup_mask_) {
-    const MappedObject& m = objects_[lookup_[c] - 1U];
-    if (m.id == on) return &m;
+  if (on.index == 0) return nullptr;
+  for (std::size_t c = first_cell(on.key(), table_mask_); table_[c].id.index != 0; c = (c + 1) & table_mask_) {
+    if (table_[c].id == on) return &table_[c];
   }
   return nullptr;
 }

@@ -50,7 +50,7 @@ class SlaveAccess final : public cia402::ObjectAccess {
 
   // `slave`: its index in the process image; `objects`: its mapped objects (axis 0's numbering);
   // `coe` may be null (no mailbox: every acyclic request is refused).
-  SlaveAccess(std::size_t slave, std::vector<MappedObject> objects, int slave_axis, std::uint16_t axis_offset,
+  SlaveAccess(std::size_t slave, const std::vector<MappedObject>& objects, int slave_axis, std::uint16_t axis_offset,
               CoeSdoClient* coe, std::vector<EcatOwnedObject> owned, std::span<const cia402::FaultText> faults);
 
   // The bus, once the image exists (before the first begin_cycle()).
@@ -115,12 +115,12 @@ class SlaveAccess final : public cia402::ObjectAccess {
   [[nodiscard]] bool can_request() const noexcept { return operational_ && coe_ != nullptr && coe_->valid(); }
 
   std::size_t slave_;
-  std::vector<MappedObject> objects_;
-  // find()'s open-addressing table over objects_ (linear probing, power-of-two size, at most half
-  // full): 1 + the index into objects_, 0 for an empty cell. The profile looks objects up dozens
-  // of times per axis and cycle, so a lookup is one or two probes instead of a scan.
-  std::vector<std::uint16_t> lookup_;
-  std::size_t lookup_mask_ = 0;
+  // find()'s open-addressing table of the mapped objects themselves (linear probing, power-of-two
+  // size, at most half full; index 0, which no object has [CiA 301 §7.4.1], marks an empty cell).
+  // The profile looks objects up dozens of times per axis and cycle, so a lookup is one or two
+  // probes of one small array, with no second indirection.
+  std::vector<MappedObject> table_;
+  std::size_t table_mask_ = 0;
   int slave_axis_;
   std::uint16_t axis_offset_;
   CoeSdoClient* coe_;
