@@ -566,6 +566,24 @@ TEST(ProfidriveSimFreeTelegram, Telegram0MappedThroughPnu915And916) {
   EXPECT_EQ(busy.blocks[0].error_number(), 0x11);
 }
 
+TEST(ProfidriveSimFreeTelegram, ConfigurationErrorsAreReported) {
+  DriveModelConfig c = config_for(2);  // no such telegram
+  EXPECT_EQ(DriveModel(c).layout_error(), TelegramError::UnknownTelegram);
+  c = config_for(0);
+  c.free_setpoint_words = 2;
+  c.pnu915[0] = 1;
+  c.pnu915[1] = 34;  // MDI_TARPOS needs two words
+  DriveModel d(c);
+  EXPECT_EQ(d.layout_error(), TelegramError::SplitSignal);
+  const std::array<std::uint8_t, 4> image{0x04, 0x06, 0x00, 0x00};
+  std::array<std::uint8_t, 2> actual{};
+  d.step(1ms, image, actual);
+  EXPECT_EQ(d.counters().wrong_setpoint_length, 1U);
+  EXPECT_EQ(d.state(), State::S1SwitchingOnInhibited);
+  c.pnu915[1] = 0;
+  EXPECT_EQ(DriveModel(c).layout_error(), TelegramError::None);  // STW1 / ZSW1 and an unused word
+}
+
 // --- Cycle-thread rules --------------------------------------------------------------------------
 
 TEST(ProfidriveSimCycle, StepAndRecordsDoNotAllocate) {

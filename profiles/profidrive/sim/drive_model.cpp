@@ -20,6 +20,10 @@ constexpr bool is_free(std::uint16_t telegram) noexcept { return telegram == 0 |
 constexpr std::array<std::uint16_t, 10> kDefault915{1, 32, 3, 34, 34, 35, 35, 36, 37, 38};
 constexpr std::array<std::uint16_t, 5> kDefault916{2, 33, 4, 28, 28};
 
+// Telegram 0 has no default [§13]: without a configured list it carries STW1 / ZSW1 only [sim].
+constexpr std::array<std::uint16_t, 1> kMinimal915{1};
+constexpr std::array<std::uint16_t, 1> kMinimal916{2};
+
 template <std::size_t N>
 void fill_default(std::array<std::uint16_t, kMaxTelegramWords>& list, const std::array<std::uint16_t, N>& def) noexcept {
   if (std::any_of(list.begin(), list.end(), [](std::uint16_t v) { return v != 0; })) return;
@@ -41,8 +45,13 @@ DriveModel::DriveModel(const DriveModelConfig& config) noexcept : config_(config
     free_actual_words_ = t == 400 ? 12 : std::min<std::uint8_t>(config_.free_actual_words, kMaxTelegramWords);
     pnu915_ = config_.pnu915;
     pnu916_ = config_.pnu916;
-    fill_default(pnu915_, kDefault915);
-    fill_default(pnu916_, kDefault916);
+    if (t == 400) {
+      fill_default(pnu915_, kDefault915);
+      fill_default(pnu916_, kDefault916);
+    } else {
+      fill_default(pnu915_, kMinimal915);
+      fill_default(pnu916_, kMinimal916);
+    }
   }
   rebuild_layout();
   single_turn_bits_ = kDefaultSingleTurnBits;
@@ -65,10 +74,13 @@ void DriveModel::rebuild_layout() noexcept {
     const LayoutResult r = free_layout(config_.telegram, std::span<const std::uint16_t>(pnu915_).first(free_setpoint_words_),
                                        free_setpoint_words_, std::span<const std::uint16_t>(pnu916_).first(free_actual_words_),
                                        free_actual_words_);
+    layout_error_ = r.error;
     layout_ = r.error == TelegramError::None ? r.layout : TelegramLayout{};
     return;
   }
-  layout_ = standard_layout(config_.telegram).value_or(TelegramLayout{});
+  const auto fixed = standard_layout(config_.telegram);
+  layout_error_ = fixed ? TelegramError::None : TelegramError::UnknownTelegram;
+  layout_ = fixed.value_or(TelegramLayout{});
 }
 
 void DriveModel::step(core::Duration dt, std::span<const std::uint8_t> setpoint_image,

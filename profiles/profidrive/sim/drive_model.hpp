@@ -75,7 +75,8 @@ struct DriveModelConfig {
   // Telegram 0: image words per direction, fixed by its module [§13]. Telegram 400: 12 each [§14.9].
   std::uint8_t free_setpoint_words = 12;
   std::uint8_t free_actual_words = 12;
-  // Initial PNU 915/916 of telegrams 0 and 400; empty = "similar to telegram 9" [§13, §14.9].
+  // Initial PNU 915/916 of telegrams 0 and 400; empty: telegram 400 "similar to telegram 9"
+  // [§13, §14.9], telegram 0 STW1 / ZSW1 only.
   std::array<std::uint16_t, kMaxTelegramWords> pnu915{};
   std::array<std::uint16_t, kMaxTelegramWords> pnu916{};
   std::optional<OperatingMode> operating_mode;  // nullopt: speed for 1/350/351, position otherwise
@@ -178,6 +179,9 @@ class DriveModel {
   [[nodiscard]] const Actuals& actuals() const noexcept { return actuals_; }
   [[nodiscard]] const Setpoints& setpoints() const noexcept { return sp_; }
   [[nodiscard]] const TelegramLayout& layout() const noexcept { return layout_; }
+  // Why the configured telegram has no layout (an unknown number, a PNU 915/916 list free_layout
+  // refuses); every cycle is then a counted drop.
+  [[nodiscard]] TelegramError layout_error() const noexcept { return layout_error_; }
   [[nodiscard]] double position_rev() const noexcept { return pos_; }
   [[nodiscard]] double velocity_rps() const noexcept { return vel_; }
   [[nodiscard]] std::uint16_t fault_counter() const noexcept { return fault_counter_; }
@@ -228,6 +232,7 @@ class DriveModel {
 
   DriveModelConfig config_;
   TelegramLayout layout_;
+  TelegramError layout_error_ = TelegramError::None;
   std::array<std::uint16_t, kMaxTelegramWords> pnu915_{};
   std::array<std::uint16_t, kMaxTelegramWords> pnu916_{};
   std::uint8_t free_setpoint_words_ = 0;  // 0 for the fixed telegrams
