@@ -509,13 +509,18 @@ TEST(ProfidriveSimPositionMode, RealTimeJogUsesTheMdiSignals) {
 }
 
 TEST(ProfidriveSimPositionMode, BlockedMotorRaisesFollowingError) {
-  // PL.ERRFTHRESH exceeded: F439 into the fault buffer, ZSW1 bit 3 [§9.3, §18.2].
+  // PL.ERRWTHRESH exceeded: ZSW1 bit 8 low; PL.ERRFTHRESH exceeded: F439 into the fault buffer, ZSW1
+  // bit 3 [§9.3, §18.2].
   Harness h(config_for(9));
   enable_and_home(h);
+  EXPECT_TRUE(bit(h.act.zsw1, zsw1::kFollowingErrorInTolerance));
   h.drive.set_motor_blocked(true);
   load_mdi(h, 10 * 65536, 600.0, 6000.0, true);
   h.send(kTaskReady);
   h.send(kTaskGo);
+  // Past PL.ERRWTHRESH ZSW1 bit 8 drops first (1 = within tolerance, the standard's polarity [§9.3]).
+  ASSERT_TRUE(h.until([&] { return !bit(h.act.zsw1, zsw1::kFollowingErrorInTolerance); }, 1000));
+  EXPECT_FALSE(bit(h.act.zsw1, zsw1::kFault));
   ASSERT_TRUE(h.until([&] { return bit(h.act.zsw1, zsw1::kFault); }, 1000));
   EXPECT_EQ(h.drive.fault_numbers()[0], fault_number::kFollowingError);
 }
