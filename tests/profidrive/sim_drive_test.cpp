@@ -484,6 +484,35 @@ TEST(ProfidriveSimPositionMode, HomingOnTheSwitchWithHomeDistFromTelegram353) {
   EXPECT_FALSE(h.drive.homed());
 }
 
+TEST(ProfidriveSimPositionMode, Telegram352TakesHomeModeFromPnu1001) {
+  // Telegram 352 carries HOME_DIST but not HOME_MODE [§14.7]: the mode is PNU 1001 (= HOME.MODE).
+  DriveModelConfig c = config_for(352);
+  c.home_switch_rev = -0.75;  // behind the motor: found at once, as the search runs upwards
+  Harness h(c);
+  EXPECT_TRUE(h.change(1001, format::kWord, 4).positive());
+  EXPECT_EQ(h.value(2203), 4U);
+  EXPECT_EQ(h.change(1001, format::kWord, 7).blocks[0].error_number(), 0x02);  // not modelled
+  h.enable();
+  h.sp.home_dist = -32768;
+  h.send(kHoming);
+  ASSERT_TRUE(h.until([&] { return bit(h.act.zsw1, zsw1::kHomed); }, 3000));
+  EXPECT_NEAR(h.act.xist_a, -32768, 50);
+  EXPECT_EQ(h.value(2198), static_cast<std::uint32_t>(-32768));  // HOME.DIST as last used
+}
+
+TEST(ProfidriveSimSpeedMode, Telegram350ReportsTheCurrent) {
+  // §14.5, §17.4: ITIST_GLATT, 2^14 = DRV.IPEAK, signed: negative while braking.
+  Harness h(config_for(350));
+  ASSERT_EQ(h.drive.layout().actual_bytes(), 6U);
+  h.enable(stw1::kSpeedRunBits);
+  h.sp.stw1 = kRun;
+  h.sp.nsoll_a = 0x2000;
+  h.cycles(200);
+  h.sp.nsoll_a = 0;
+  h.cycles(10);
+  EXPECT_LT(h.act.itist_glatt, -1000);
+}
+
 TEST(ProfidriveSimPositionMode, UnsupportedHomingModeWarns) {
   Harness h(config_for(353));
   h.enable();
