@@ -175,14 +175,10 @@ void DriveModel::motor_update(double dt) noexcept {
       vel_ *= std::exp(-friction * dt);
       break;
     case Control::Position:
-    case Control::Velocity: {
-      // Velocity loop as a first-order lag; the position loop gain 1/(4 tau) makes the pair
-      // critically damped.
-      const double kp = control_ == Control::Position ? 1.0 / (4.0 * tau) : 0.0;
-      v_cmd = std::clamp(demand_vel_ + kp * (demand_pos_ - pos_), -vmax, vmax);
-      vel_ += (v_cmd - vel_) * (1.0 - std::exp(-dt / tau));
+    case Control::Velocity:
+      v_cmd = servo_command(demand_pos_, demand_vel_, pos_, control_ == Control::Position, tau, vmax);
+      vel_ = follow_velocity(vel_, v_cmd, tau, dt);
       break;
-    }
     case Control::Torque:
       vel_ = std::clamp(vel_ + (torque_demand_ / 1000.0 * accel_per_rated - friction * vel_) * dt, -vmax, vmax);
       break;

@@ -52,4 +52,14 @@ bool trapezoid_step(double& p, double& v, double target, double vmax, double acc
   return false;
 }
 
+double servo_command(double demand_pos, double demand_vel, double pos, bool position_loop, double tau,
+                     double vmax) noexcept {
+  const double kp = position_loop ? 1.0 / (4.0 * tau) : 0.0;
+  return std::clamp(demand_vel + kp * (demand_pos - pos), -vmax, vmax);
+}
+
+double follow_velocity(double v, double command, double tau, double dt) noexcept {
+  return v + (command - v) * (1.0 - std::exp(-dt / tau));
+}
+
 }  // namespace drivegate::cia402::sim
