@@ -212,7 +212,11 @@ void ProfidriveMaster::write_outputs() noexcept {
 }
 
 bool ProfidriveMaster::at_standstill() const noexcept {
-  if (caps_.speed) return actual_.nist_a == 0;
+  // Speed mode: NIST_A at 0, or "speed reached" with the set-point at 0 (a real drive's NIST_A
+  // jitters a count or two around 0). Position mode: ZSW1 bit 13 "drive stopped" [§9.3; §23.7
+  // for the MDI section's other wording].
+  if (caps_.speed)
+    return actual_.nist_a == 0 || ((actual_.zsw1 & zsw1::kSpeedReached) != 0 && (out_.nsoll_a == 0 || halt_));
   return (actual_.zsw1 & zsw1::kDriveStopped) != 0;
 }
 
