@@ -1,6 +1,7 @@
 #pragma once
 // What the PROFIdrive master needs to know about its axis besides the telegram: timeouts and the
 // settle time of the handshakes. Built from the axis spec before the cycle thread starts.
+#include <algorithm>
 #include <chrono>
 #include <cstdint>
 
@@ -14,6 +15,10 @@ struct MasterSettings {
   core::Duration step_timeout = std::chrono::seconds(2);
   // While the drive ramps or coasts down (S5, OFF2) towards the state a disable or quick stop asks for.
   core::Duration stop_timeout = std::chrono::seconds(10);
+  // A drive that shows more power than the STW1 sent allows (operation enabled under OFF3 or a
+  // cleared bit 3, switched on under OFF2) for longer than this no longer follows the gateway.
+  // Under OFF1 the drive ramps first, so stop_timeout applies there.
+  core::Duration follow_timeout = std::chrono::seconds(1);
   // The task handshakes: ZSW1 bit 12 following STW1 bit 6 (MDI, program mode), a homing run
   // starting, the previous acknowledge dropping [§16.2, §16.3, §16.4].
   core::Duration ack_timeout = std::chrono::milliseconds(500);
@@ -33,6 +38,7 @@ struct MasterSettings {
 inline MasterSettings settings_from(const core::AxisSpec& spec) {
   MasterSettings s;
   s.step_timeout = spec.enable_step_timeout;
+  s.follow_timeout = std::min(spec.enable_step_timeout, s.follow_timeout);
   s.homing_timeout = spec.homing.timeout;
   return s;
 }

@@ -369,6 +369,9 @@ void ProfidriveMaster::drop_drive(std::string_view reason, core::ControllerSink&
   actual_ = Actuals{};
   state_ = DriveState{};
   warning_ = false;
+  control_requested_ = true;
+  follow_pending_ = false;
+  control_lost_ = false;
   stw1_ = stw1_word::kQuickStop;
   write_outputs();
   fb_ = core::DriveFeedback{};

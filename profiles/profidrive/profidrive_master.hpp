@@ -135,6 +135,7 @@ class ProfidriveMaster final : public core::AxisController {
   bool read_inputs(core::TimePoint now, core::ControllerSink& sink) noexcept;
   void track_state(core::ControllerSink& sink) noexcept;
   void run_device(core::TimePoint now, core::ControllerSink& sink) noexcept;
+  void supervise_control(core::TimePoint now, core::ControllerSink& sink) noexcept;
   void write_outputs() noexcept;
   [[nodiscard]] bool at_standstill() const noexcept;
   void fill_feedback() noexcept;
@@ -180,6 +181,12 @@ class ProfidriveMaster final : public core::AxisController {
   std::uint64_t telegrams_ = 0;  // fresh actual telegrams decoded
   DriveState state_{};
   bool warning_ = false;
+  bool control_requested_ = true;  // ZSW1 bit 9 as last seen
+
+  // Control supervision: since when the drive shows more power than the STW1 sent allows.
+  bool follow_pending_ = false;
+  core::TimePoint follow_since_{};
+  bool control_lost_ = false;  // reported; again only after the drive was dropped
   std::uint64_t bad_telegrams_ = 0;
 
   // Device control.

@@ -43,6 +43,7 @@ void ProfidriveMaster::update(core::TimePoint now, core::ControllerSink& sink) n
   ++cycle_;
   if (read_inputs(now, sink)) {
     track_state(sink);
+    supervise_control(now, sink);
     run_device(now, sink);
     run_motion(now, sink);
     if (halt_slot_.active && telegrams_ >= halt_settle_until_ && at_standstill()) complete_slot(halt_slot_, sink);
@@ -92,6 +93,14 @@ void ProfidriveMaster::track_state(core::ControllerSink& sink) noexcept {
     sink.event(EventKind::Warning, warning ? 1U : 0U,
                warning ? "drive reports a warning (ZSW1 bit 7)" : "drive warning cleared");
     warning_ = warning;
+  }
+  // Bit 9 low: the drive is not taking the controller's commands (local control) [§9.1].
+  const bool requested = (actual_.zsw1 & zsw1::kControlRequested) != 0;
+  if (requested != control_requested_) {
+    sink.event(EventKind::Info, requested ? 1U : 0U,
+               requested ? "drive takes the controller's commands again (ZSW1 bit 9 control requested)"
+                         : "drive does not take the controller's commands (ZSW1 bit 9 control requested = 0)");
+    control_requested_ = requested;
   }
   if (s == state_) return;
   const DriveState prev = state_;
@@ -196,6 +205,54 @@ void ProfidriveMaster::run_device(core::TimePoint now, core::ControllerSink& sin
     goal_ = DeviceGoal::Hold;
   }
   device_stw1_ = hold_stw1_;
+}
+
+namespace {
+
+// How much power ZSW1 shows: 2 operation enabled, 1 switched on, 0 below - or stopping as told
+// (ZSW1 bit 4 or 5 low: OFF2 or OFF3 under way). And the most the STW1 sent allows once the drive
+// obeyed it [§7]: OFF1, OFF2 and OFF3 nothing switched on (OFF1 after its ramp), bit 3 low no
+// operation.
+int power_shown(std::uint16_t z) noexcept {
+  if ((z & (zsw1::kFault | zsw1::kSwitchingOnInhibited)) != 0) return 0;
+  if ((z & (zsw1::kNoCoastStop | zsw1::kNoQuickStop)) != (zsw1::kNoCoastStop | zsw1::kNoQuickStop)) return 0;
+  if ((z & (zsw1::kReadyToSwitchOn | zsw1::kReadyToOperate)) != (zsw1::kReadyToSwitchOn | zsw1::kReadyToOperate))
+    return 0;
+  return (z & zsw1::kOperationEnabled) != 0 ? 2 : 1;
+}
+int power_allowed(std::uint16_t w) noexcept {
+  if ((w & (stw1::kOn | stw1::kNoCoastStop | stw1::kNoQuickStop)) != (stw1::kOn | stw1::kNoCoastStop | stw1::kNoQuickStop))
+    return 0;
+  return (w & stw1::kEnableOperation) != 0 ? 2 : 1;
+}
+
+}  // namespace
+
+// A drive that does not follow STW1 (local control, another master, a firmware that ignores bit
+// 10) is out of the gateway's control: an event and a safe stop by the bus, not a stale state
+// (DESIGN.md §4). Judged on fresh telegrams against the STW1 already sent.
+void ProfidriveMaster::supervise_control(core::TimePoint now, core::ControllerSink& sink) noexcept {
+  if (control_lost_ || fresh_at_ != now) return;
+  if (power_shown(actual_.zsw1) <= power_allowed(stw1_)) {
+    follow_pending_ = false;
+    return;
+  }
+  if (!follow_pending_) {
+    follow_pending_ = true;
+    follow_since_ = now;
+    return;
+  }
+  // OFF1 ramps down before the drive leaves S4 [§7]; the others act at once.
+  const bool off1_only = (stw1_ & stw1::kOn) == 0 && (stw1_ & stw1::kNoCoastStop) != 0 && (stw1_ & stw1::kNoQuickStop) != 0;
+  const core::Duration limit = off1_only ? settings_.stop_timeout : settings_.follow_timeout;
+  if (now - follow_since_ <= limit) return;
+  control_lost_ = true;
+  core::Text why;
+  why.format("drive does not follow STW1: still %s %lld ms after STW1 0x%04X told it to leave (ZSW1 0x%04X)",
+             state_name(state_), ms(now - follow_since_), static_cast<unsigned>(stw1_),
+             static_cast<unsigned>(actual_.zsw1));
+  sink.event(EventKind::ControlLost, 0, why.view());
+  port_.control_lost(why.view());
 }
 
 void ProfidriveMaster::write_outputs() noexcept {

@@ -5,6 +5,7 @@
 // Called only from the bus' cycle thread; nothing here may allocate or block.
 #include <cstdint>
 #include <span>
+#include <string_view>
 
 namespace drivegate::profidrive {
 
@@ -19,6 +20,10 @@ class TelegramPort {
   // The setpoint image (controller -> drive) the bus sends next, exactly the telegram's size. The
   // master rewrites all of it every cycle.
   [[nodiscard]] virtual std::span<std::uint8_t> setpoint() noexcept = 0;
+  // The drive does not follow the STW1 the master sends (it stays in more power than STW1 allows):
+  // the bus takes over, stops it over the acyclic channel and reconfigures it, so the axis comes
+  // back disabled (DESIGN.md §4). Called once per loss.
+  virtual void control_lost(std::string_view /*why*/) noexcept {}
 
  protected:
   ~TelegramPort() = default;

@@ -177,6 +177,51 @@ TEST(ProfidriveMaster, DriveLeavingS4OnItsOwnFailsTheMotionAndStaysOff) {
   EXPECT_EQ(h.drive.stw1(), 0x0402);
 }
 
+TEST(ProfidriveMaster, DriveNotFollowingStw1IsControlLost) {
+  MasterSettings s;
+  s.follow_timeout = 30ms;
+  s.stop_timeout = 100ms;
+  Harness h(1, s);
+  h.enable();
+  ASSERT_TRUE(h.submit(velocity(2, kOneRps)).accepted);
+  ASSERT_TRUE(h.wait(2));
+  h.drive.ignores_stw1 = true;  // taken over locally: ZSW1 bit 9 drops, STW1 does nothing
+  ASSERT_TRUE(h.submit(command(3, CommandKind::QuickStop)).accepted);
+  h.run(20);
+  EXPECT_EQ(h.sink.count(EventKind::ControlLost), 0U);  // not yet: within follow_timeout
+  EXPECT_GE(h.sink.count(EventKind::Info), 1U);       // bit 9 went low
+  h.run(20);
+  ASSERT_EQ(h.sink.count(EventKind::ControlLost), 1U);
+  EXPECT_EQ(h.drive.control_lost_calls, 1);
+  for (const auto& e : h.sink.events) {
+    if (e.kind == EventKind::ControlLost) {
+      EXPECT_NE(e.text.find("does not follow STW1"), std::string::npos) << e.text;
+    }
+  }
+  ASSERT_TRUE(h.wait(3, 200));
+  EXPECT_NE(h.sink.failure(3).find("quick_stop: drive stayed in"), std::string::npos) << h.sink.failure(3);
+  EXPECT_NE(h.sink.failure(3).find("OFF3 to S1"), std::string::npos) << h.sink.failure(3);
+  h.run(100);
+  EXPECT_EQ(h.drive.control_lost_calls, 1);  // once per loss
+}
+
+TEST(ProfidriveMaster, Off1RampIsNotControlLoss) {
+  MasterSettings s;
+  s.follow_timeout = 2ms;
+  Harness h(1, s);
+  h.drive.stop_cycles = 50;
+  h.enable();
+  ASSERT_TRUE(h.submit(command(2, CommandKind::QuickStop)).accepted);
+  ASSERT_TRUE(h.wait(2));
+  ASSERT_TRUE(h.submit(command(3, CommandKind::Enable)).accepted);
+  ASSERT_TRUE(h.wait(3));
+  ASSERT_TRUE(h.submit(command(4, CommandKind::Disable)).accepted);
+  ASSERT_TRUE(h.wait(4));
+  EXPECT_TRUE(h.sink.done(2));
+  EXPECT_TRUE(h.sink.done(4));
+  EXPECT_EQ(h.sink.count(EventKind::ControlLost), 0U);
+}
+
 TEST(ProfidriveMaster, StaleTelegramLosesTheAxisAndItComesBackDisabled) {
   MasterSettings s;
   s.stale_timeout = 20ms;

@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <initializer_list>
 #include <span>
+#include <string_view>
 #include <vector>
 
 #include "profiles/profidrive/control_words.hpp"
@@ -47,6 +48,7 @@ class ScriptedDrive final : public TelegramPort, public ParamChannel {
   bool stuck_in_s1 = false;      // never leaves S1 (STO, hardware enable off)
   bool refuse_tasks = false;     // MDI/program edges are not acknowledged (ZSW1 bit 12 stays 0)
   bool fault_persists = false;   // the fault acknowledge does not clear the fault
+  bool ignores_stw1 = false;     // local control: STW1 changes nothing (ZSW1 bit 9 low)
   bool warning = false;
   int param_delay = 2;           // cycles before a response is ready
   bool param_hang = false;       // responses never become ready
@@ -80,6 +82,7 @@ class ScriptedDrive final : public TelegramPort, public ParamChannel {
   std::array<std::uint16_t, kFaultBufferEntries> fault_buffer{};
   int requests = 0;
   int cancels = 0;
+  int control_lost_calls = 0;
   std::array<std::uint8_t, kMaxParamRecord> last_request{};
   std::size_t last_request_size = 0;
 
@@ -115,7 +118,7 @@ class ScriptedDrive final : public TelegramPort, public ParamChannel {
     if (decode_setpoints(layout, setpoint_, sp) != TelegramError::None) return;
     const std::uint16_t prev = last.stw1;
     last = sp;
-    if ((sp.stw1 & stw1::kControlByPlc) != 0) run_state_machine(sp.stw1, prev);  // bit 10 [§8.1]
+    if ((sp.stw1 & stw1::kControlByPlc) != 0 && !ignores_stw1) run_state_machine(sp.stw1, prev);  // bit 10 [§8.1]
     if (state == State::S4 || state == State::S5Off1 || state == State::S5Off3)
       run_motion(sp, prev);
     else
@@ -130,6 +133,7 @@ class ScriptedDrive final : public TelegramPort, public ParamChannel {
   }
   [[nodiscard]] bool actual_fresh() const noexcept override { return fresh; }
   [[nodiscard]] std::span<std::uint8_t> setpoint() noexcept override { return setpoint_; }
+  void control_lost(std::string_view /*why*/) noexcept override { ++control_lost_calls; }
 
   // --- ParamChannel ---
   ParamTicket submit(std::span<const std::uint8_t> request) noexcept override {
@@ -276,7 +280,7 @@ class ScriptedDrive final : public TelegramPort, public ParamChannel {
   }
 
   std::uint16_t zsw1() const {
-    std::uint16_t z = zsw1::kControlRequested;
+    std::uint16_t z = ignores_stw1 ? std::uint16_t{0} : zsw1::kControlRequested;
     switch (state) {
       case State::S1:
         z |= zsw1::kSwitchingOnInhibited;
