@@ -251,6 +251,19 @@ TEST(ProfidriveMasterProgram, UnknownBlockIsNotAcknowledged) {
       << h.sink.failure(3);
 }
 
+TEST(ProfidriveMasterProgram, AktsatzWithTaskActiveAlsoAcknowledges) {
+  MasterSettings s;
+  s.ack_timeout = 30ms;
+  Harness h(7, s);
+  h.drive.program_without_ack = true;
+  h.drive.move_step = 10;  // long enough for bit 14 to show
+  h.enable_and_home();
+  ASSERT_TRUE(h.submit(run_block(3, 1)).accepted);
+  ASSERT_TRUE(h.wait(3, 1000));
+  EXPECT_TRUE(h.sink.done(3)) << h.sink.failure(3);
+  EXPECT_EQ(h.drive.position, 2000);
+}
+
 TEST(ProfidriveMasterJog, VelocityOnAnMdiTelegramIsRealTimeJog) {
   Harness h(9);
   h.enable();
@@ -271,6 +284,27 @@ TEST(ProfidriveMasterJog, VelocityOnAnMdiTelegramIsRealTimeJog) {
   const std::int32_t at = h.drive.position;
   h.run(10);
   EXPECT_EQ(h.drive.position, at);
+}
+
+TEST(ProfidriveMaster, CapabilitiesFollowTheTelegram) {
+  const auto caps = [](std::uint16_t t) { return capabilities_of(*standard_layout(t)); };
+  EXPECT_TRUE(caps(1).speed);
+  EXPECT_FALSE(caps(1).position);
+  EXPECT_TRUE(caps(351).position_actual);
+  EXPECT_TRUE(caps(7).position);
+  EXPECT_FALSE(caps(7).mdi);
+  EXPECT_TRUE(caps(9).mdi);
+  EXPECT_FALSE(caps(9).home_dist);
+  EXPECT_TRUE(caps(352).home_dist);
+  EXPECT_FALSE(caps(352).home_mode);
+  EXPECT_TRUE(caps(353).home_mode);
+  // A free layout with NSOLL_A and SATZANW is taken as position mode.
+  const std::uint16_t out[] = {1, 5, 32};
+  const std::uint16_t in[] = {2, 6, 33};
+  const LayoutResult both = free_layout(400, out, 12, in, 12);
+  ASSERT_EQ(both.error, TelegramError::None);
+  EXPECT_TRUE(capabilities_of(both.layout).position);
+  EXPECT_FALSE(capabilities_of(both.layout).speed);
 }
 
 TEST(ProfidriveMaster, SetModeIsRememberedAndStreamingSetpointsAreDropped) {

@@ -47,6 +47,7 @@ class ScriptedDrive final : public TelegramPort, public ParamChannel {
   bool short_actual = false;     // actual() one byte short of the telegram
   bool stuck_in_s1 = false;      // never leaves S1 (STO, hardware enable off)
   bool refuse_tasks = false;     // MDI/program edges are not acknowledged (ZSW1 bit 12 stays 0)
+  bool program_without_ack = false;  // program mode shows AKTSATZ and bit 14 only, never bit 12
   bool fault_persists = false;   // the fault acknowledge does not clear the fault
   bool ignores_stw1 = false;     // local control: STW1 changes nothing (ZSW1 bit 9 low)
   bool warning = false;
@@ -275,7 +276,7 @@ class ScriptedDrive final : public TelegramPort, public ParamChannel {
   void start_task(std::uint16_t satzanw) {
     moving = true;
     reached_ = false;
-    ack = true;
+    ack = (satzanw & 0x8000U) != 0 || !program_without_ack;
     aktsatz = satzanw;
   }
 
