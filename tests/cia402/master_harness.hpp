@@ -1,6 +1,6 @@
 #pragma once
 // Shared test fixture: a Cia402Master over FakeObjectAccess, virtual time in 1 ms cycles, and a
-// sink that records every reply and event.
+// sink that records every reply and event (tests/support/recording_sink.hpp).
 #include <chrono>
 #include <string>
 #include <vector>
@@ -9,53 +9,13 @@
 #include "profiles/cia402/cia402_master.hpp"
 #include "profiles/cia402/objects.hpp"
 #include "tests/cia402/fake_object_access.hpp"
+#include "tests/support/recording_sink.hpp"
 
 namespace drivegate::cia402::test {
 
 using namespace std::chrono_literals;
 
-struct RecordingSink final : core::ControllerSink {
-  struct Failure {
-    core::CommandId id;
-    std::string reason;
-  };
-  struct Ev {
-    core::EventKind kind;
-    std::uint32_t code;
-    std::string text;
-  };
-  std::vector<core::CommandId> completed_ids;
-  std::vector<Failure> failures;
-  std::vector<Ev> events;
-  std::vector<core::ParamReply> params;
-
-  void completed(core::CommandId id) noexcept override { completed_ids.push_back(id); }
-  void failed(core::CommandId id, std::string_view reason) noexcept override {
-    failures.push_back({id, std::string(reason)});
-  }
-  void event(core::EventKind kind, std::uint32_t code, std::string_view text) noexcept override {
-    events.push_back({kind, code, std::string(text)});
-  }
-  void parameter_done(const core::ParamReply& reply) noexcept override { params.push_back(reply); }
-
-  [[nodiscard]] bool done(core::CommandId id) const {
-    for (auto c : completed_ids) {
-      if (c == id) return true;
-    }
-    return false;
-  }
-  [[nodiscard]] std::string failure(core::CommandId id) const {
-    for (const auto& f : failures) {
-      if (f.id == id) return f.reason;
-    }
-    return {};
-  }
-  [[nodiscard]] std::size_t count(core::EventKind kind) const {
-    std::size_t n = 0;
-    for (const auto& e : events) n += e.kind == kind ? 1U : 0U;
-    return n;
-  }
-};
+using drivegate::test::RecordingSink;
 
 // Statuswords as the AKD digest shows them (bit 9 remote set).
 inline constexpr std::uint16_t kSwSwitchOnDisabled = 0x0240;
