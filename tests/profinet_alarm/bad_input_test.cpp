@@ -1,7 +1,8 @@
 // Frames the controller's AlarmChannel must count and drop without taking an alarm: foreign
 // sources and endpoints, RTA-PDUs and blocks that do not decode, blocks of the wrong priority or
-// kind, DATA out of sequence (NACKed), and notifications beyond its AlarmAck queue (not
-// acknowledged, so the device sends them again). The channel keeps working afterwards.
+// kind, DATA out of sequence (NACKed), stale ACKs, and notifications beyond its AlarmAck queue (not
+// acknowledged, so the device sends them again); a NACK sends the AlarmAck again at once. The
+// channel keeps working afterwards.
 #include <gtest/gtest.h>
 
 #include "tests/profinet_alarm/alarm_wire.hpp"
@@ -127,6 +128,26 @@ TEST(PnAlarmBadInput, ForeignAndMalformedFramesAreCountedAndDropped) {
   ASSERT_EQ(sent.size(), 2U);  // ACK, AlarmAck
   EXPECT_EQ(rta_of(sent[0]).header.type, RtaPduType::Ack);
   EXPECT_TRUE(is_block(sent[1], alarm_block::kAckHigh));
+
+  // A NACK sends the AlarmAck in flight again at once; an ACK of another number confirms nothing;
+  // the ACK of its number does.
+  p = {};
+  p.type = RtaPduType::Nack;
+  EXPECT_TRUE(c.on_frame(frame_of(p, {}), now));
+  sent = drain(c, now);
+  ASSERT_EQ(sent.size(), 1U);
+  EXPECT_TRUE(is_block(sent[0], alarm_block::kAckHigh));
+  EXPECT_EQ(c.rta_counters(AlarmPriority::High).nacks_received, 1U);
+  EXPECT_EQ(c.rta_counters(AlarmPriority::High).retransmissions, 1U);
+  p.type = RtaPduType::Ack;
+  p.ack_seq = 0x0000;
+  EXPECT_TRUE(c.on_frame(frame_of(p, {}), now));
+  EXPECT_EQ(c.rta_counters(AlarmPriority::High).stale_acks, 1U);
+  EXPECT_EQ(c.counters().acks_confirmed, 0U);
+  p.ack_seq = 0xFFFF;
+  EXPECT_TRUE(c.on_frame(frame_of(p, {}), now));
+  EXPECT_EQ(c.counters().acks_confirmed, 1U);
+  EXPECT_EQ(c.next_deadline(), core::TimePoint::max());
   EXPECT_EQ(c.state(), AlarmChannelState::Open);
 }
 

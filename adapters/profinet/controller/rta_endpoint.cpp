@@ -81,7 +81,7 @@ RtaEndpointConfig rta_endpoint_config(const AlarmCrBlockReq& cr, AlarmPriority p
 }
 
 RtaEndpoint::RtaEndpoint(const RtaEndpointConfig& config) noexcept
-    : config_(config), frame_id_(header_for(config).frame_id) {
+    : config_(config) {
   pdu_offset_ = encode_ethernet_header(header_for(config_), data_frame_);
 }
 

@@ -133,8 +133,6 @@ class RtaEndpoint {
   bool send_data(std::size_t block_length) noexcept;
   // An ERR-RTA-PDU with `status` goes out at the next poll(); the endpoint closes.
   void send_error(const RtaPnioStatus& status) noexcept;
-  // How many times the DATA in flight went out (0 when none).
-  [[nodiscard]] int sends() const noexcept { return in_flight_ ? sends_ : 0; }
 
   // At most one frame into `out`: ERR, then ACK/NACK, then the DATA when due. Moves to TimedOut
   // when the DATA was not acknowledged after 1 + retries sends.
@@ -149,7 +147,6 @@ class RtaEndpoint {
   std::size_t send_in_flight(core::TimePoint now, std::span<std::uint8_t> out) noexcept;
 
   RtaEndpointConfig config_;
-  std::uint16_t frame_id_;
   RtaState state_ = RtaState::Closed;
   // APMS
   std::uint16_t send_seq_ = kRtaInitialSendSeq;   // of the DATA in flight or the next one

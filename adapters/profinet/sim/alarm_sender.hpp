@@ -70,7 +70,6 @@ class AlarmSender {
   bool on_frame(std::span<const std::uint8_t> frame, core::TimePoint now) noexcept;
   std::size_t poll(core::TimePoint now, std::span<std::uint8_t> out) noexcept;
   [[nodiscard]] core::TimePoint next_deadline() const noexcept;
-  [[nodiscard]] const MacAddress& mac() const noexcept { return config_.device_mac; }
 
   [[nodiscard]] const AlarmSenderCounters& counters() const noexcept { return counters_; }
   [[nodiscard]] const RtaCounters& rta_counters(AlarmPriority p) const noexcept { return side(p).rta.counters(); }
