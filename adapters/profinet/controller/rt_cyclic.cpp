@@ -13,6 +13,10 @@ constexpr std::uint16_t kMaxDataHoldFactor = 7680;  // 1E00h [IEC 61158-6-10, Da
 
 double ms(core::Duration d) noexcept { return static_cast<double>(d.count()) / 1e6; }
 
+// The CR a provider on `role`'s side sends (the consumer takes the other).
+CrDirection provided(RtRole role) noexcept { return role == RtRole::Controller ? CrDirection::Output : CrDirection::Input; }
+CrDirection consumed(RtRole role) noexcept { return role == RtRole::Controller ? CrDirection::Input : CrDirection::Output; }
+
 // Shared by both engines: validates the config and lays out its CR.
 RtConfigError lay_out(const RtIocrConfig& c, CrDirection direction, CsduLayout& layout,
                       std::array<IoPlacement, kMaxRtSubmodules>& placements, std::size_t& count) noexcept {
@@ -66,11 +70,12 @@ RtConfigError validate(const RtIocrConfig& c) noexcept {
 RtProvider::RtProvider(const RtIocrConfig& config) noexcept
     : period_(rt_period(config)), offset_(kSendClockUnit * config.send_clock_factor * (config.phase - 1)) {
   // In the body: the layout members are initialised after error_.
-  error_ = lay_out(config, CrDirection::Output, layout_, placements_, submodule_count_);
+  error_ = lay_out(config, provided(config.role), layout_, placements_, submodule_count_);
   if (!ok()) return;
+  const bool controller = config.role == RtRole::Controller;
   EthernetHeader h;
-  h.dst = config.device_mac;
-  h.src = config.controller_mac;
+  h.dst = controller ? config.device_mac : config.controller_mac;
+  h.src = controller ? config.controller_mac : config.device_mac;
   h.vlan = true;
   h.priority = kPriorityRtCyclic;
   h.frame_id = config.frame_id;
@@ -139,8 +144,11 @@ std::string_view to_string(RtConsumerState s) noexcept {
 }
 
 RtConsumer::RtConsumer(const RtIocrConfig& config) noexcept
-    : frame_id_(config.frame_id), device_mac_(config.device_mac), data_hold_(rt_data_hold_time(config)) {
-  error_ = lay_out(config, CrDirection::Input, layout_, placements_, submodule_count_);
+    : frame_id_(config.frame_id),
+      source_mac_(config.role == RtRole::Controller ? config.device_mac : config.controller_mac),
+      device_side_(config.role == RtRole::Device),
+      data_hold_(rt_data_hold_time(config)) {
+  error_ = lay_out(config, consumed(config.role), layout_, placements_, submodule_count_);
 }
 
 void RtConsumer::arm(core::TimePoint now) noexcept {
@@ -162,9 +170,10 @@ void RtConsumer::expire(core::TimePoint now) noexcept {
   ++counters_.timeouts;
   const double hold = ms(data_hold_);
   if (state_ == RtConsumerState::Waiting) {
-    reason_.format("no input frame 0x%04X from the device within the data hold time (%g ms)", frame_id_, hold);
+    reason_.format("no %s frame 0x%04X from the %s within the data hold time (%g ms)", cr_name(), frame_id_,
+                   device_side_ ? "controller" : "device", hold);
   } else {
-    reason_.format("input frame 0x%04X silent for %g ms (data hold time %g ms); last valid cycle counter %u",
+    reason_.format("%s frame 0x%04X silent for %g ms (data hold time %g ms); last valid cycle counter %u", cr_name(),
                    frame_id_, ms(now - last_valid_), hold, static_cast<unsigned>(last_cycle_));
   }
   state_ = RtConsumerState::Timeout;
@@ -187,7 +196,7 @@ bool RtConsumer::on_frame(std::span<const std::uint8_t> frame, core::TimePoint n
     ++counters_.wrong_frame_id;
     return false;
   }
-  if (e.header.src != device_mac_) {
+  if (e.header.src != source_mac_) {
     ++counters_.wrong_source;
     return true;
   }

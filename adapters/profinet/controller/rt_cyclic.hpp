@@ -3,6 +3,10 @@
 // provider (PPM) and consumer (CPM) protocol machines]: frames and the time go in, frames come out
 // into the caller's buffer (DESIGN.md §2 rule 1). Nothing here allocates after construction.
 //
+//   Both run on either side (RtIocrConfig::role): on the controller's as below, on a simulated
+//   device's the provider sends the input CR to the controller and the consumer takes the output
+//   CR from it (the C_SDU laid out for that CR's direction, the MACs swapped).
+//
 //   RtProvider (the output IOCR): owns the output frame (header with the 802.1Q priority tag 6,
 //     VID 0, and the C_SDU laid out by compute_csdu_layout); the application writes each
 //     submodule's data, its IOPS and the IOCS of the input submodules through the accessors, and
@@ -43,12 +47,17 @@ inline constexpr std::size_t kMaxRtSubmodules = 64;
 // One SendClockFactor unit: 31.25 µs [IEC 61158-6-10, SendClockFactor].
 inline constexpr core::Duration kSendClockUnit{31250};
 
+// Whose side an engine runs on. The controller provides the output CR and consumes the input
+// CR; the device (the simulator's) provides the input CR and consumes the output CR.
+enum class RtRole : std::uint8_t { Controller, Device };
+
 // One IOCR as the Connect set it up (IOCRBlockReq). `submodules` lists the AR's submodules in
 // the Connect's order; both CRs of an AR use the same list.
 struct RtIocrConfig {
   std::uint16_t frame_id = frame_id::kRtClass1First;
   MacAddress controller_mac{};  // the output CR's source, the input CR's destination
   MacAddress device_mac{};
+  RtRole role = RtRole::Controller;
   std::uint16_t send_clock_factor = 32;  // 1..128 (32: 1 ms)
   std::uint16_t reduction_ratio = 1;     // 1..512, a power of two (RT class 1)
   std::uint16_t phase = 1;               // 1..reduction_ratio
@@ -92,9 +101,10 @@ class RtProvider {
   [[nodiscard]] std::size_t frame_size() const noexcept { return frame_size_; }
 
   // The application's side, any time between polls. Index i names config.submodules[i].
-  // The output data of submodule i (empty when it has none).
+  // The data submodule i has in this CR (its outputs on the controller's side, its inputs on the
+  // device's; empty when it has none).
   [[nodiscard]] std::span<std::uint8_t> data(std::size_t i) noexcept;
-  // IOPS of submodule i's output data / IOCS for submodule i's input data (iox_status::); false
+  // IOPS of submodule i's data in this CR / IOCS for its data in the other CR (iox_status::); false
   // when submodule i has no such object in this CR. IOPS start bad (by controller), IOCS good.
   bool set_iops(std::size_t i, std::uint8_t iops) noexcept;
   bool set_iocs(std::size_t i, std::uint8_t iocs) noexcept;
@@ -142,7 +152,7 @@ std::string_view to_string(RtConsumerState s) noexcept;
 struct RtConsumerCounters {
   std::uint64_t frames = 0;          // valid frames taken
   std::uint64_t wrong_frame_id = 0;  // an RT class 1 frame with another FrameID (not taken)
-  std::uint64_t wrong_source = 0;    // this FrameID from another MAC than the device's
+  std::uint64_t wrong_source = 0;    // this FrameID from another MAC than the provider's
   std::uint64_t malformed = 0;       // not a PROFINET Ethernet frame (decode_ethernet failed)
   std::uint64_t truncated = 0, transfer_error = 0, repeated_cycle = 0, old_cycle = 0;
   std::uint64_t ignore = 0, data_invalid = 0;  // pass the cycle check, not taken
@@ -178,8 +188,8 @@ class RtConsumer {
   [[nodiscard]] std::string_view reason() const noexcept { return reason_.view(); }
   // The last valid frame's values (zeros and bad IOPS before the first one).
   [[nodiscard]] std::span<const std::uint8_t> data(std::size_t i) const noexcept;
-  [[nodiscard]] std::uint8_t iops(std::size_t i) const noexcept;  // of submodule i's input data
-  [[nodiscard]] std::uint8_t iocs(std::size_t i) const noexcept;  // the device's for submodule i's output data
+  [[nodiscard]] std::uint8_t iops(std::size_t i) const noexcept;  // of submodule i's data in this CR
+  [[nodiscard]] std::uint8_t iocs(std::size_t i) const noexcept;  // the peer's for submodule i's data in the other CR
   [[nodiscard]] bool all_iops_good() const noexcept;
   [[nodiscard]] const ApduStatus& status() const noexcept { return status_; }
   [[nodiscard]] bool provider_run() const noexcept { return status_.provider_run(); }
@@ -191,10 +201,12 @@ class RtConsumer {
 
  private:
   void expire(core::TimePoint now) noexcept;
+  [[nodiscard]] const char* cr_name() const noexcept { return device_side_ ? "output" : "input"; }
 
   RtConfigError error_ = RtConfigError::None;
   std::uint16_t frame_id_ = 0;
-  MacAddress device_mac_{};
+  MacAddress source_mac_{};  // the provider's: the device's, or the controller's on the device side
+  bool device_side_ = false;
   CsduLayout layout_{};
   std::size_t submodule_count_ = 0;
   std::array<IoPlacement, kMaxRtSubmodules> placements_{};
