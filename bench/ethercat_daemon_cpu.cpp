@@ -262,7 +262,7 @@ int run(int argc, char** argv) {
       test::write_config_text("bench-ethercat-daemon-cpu", config_text(dds, axes, rig ? rig->interfaces : std::vector<std::string>{}));
   if (rig) rig->start_sim(config);
   test::NotifySocket notify;
-  test::DaemonProcess daemon(config, notify.path(), "info");
+  test::DaemonProcess daemon(config, notify.path(), "warn");
   if (!notify.wait_for("READY=1", 30s)) return fail("drivegated did not start:\n" + daemon.log());
 
   client::Client c0(client::options_for(dds.domain, dds.ns, "bench-0"));
