@@ -39,16 +39,14 @@ PnPersona::IoLengths AkdPersona::lengths(std::uint32_t api, std::uint16_t slot, 
   return {true, static_cast<std::uint16_t>(size->actual_bytes), static_cast<std::uint16_t>(size->setpoint_bytes)};
 }
 
-bool AkdPersona::fit(std::uint32_t api, std::uint16_t slot, std::uint32_t module_ident, std::uint16_t subslot,
+void AkdPersona::fit(std::uint32_t api, std::uint16_t slot, std::uint32_t module_ident, std::uint16_t subslot,
                      std::uint32_t submodule_ident) noexcept {
-  if (api != akd::kProfidriveApi || slot != akd::kTelegramSlot || subslot != akd::kTelegramSubslot) return false;
-  if (module_ident < akd::telegram_module(0) || module_ident > akd::telegram_module(0xFFFF)) return false;
+  if (api != akd::kProfidriveApi || slot != akd::kTelegramSlot || subslot != akd::kTelegramSubslot) return;
+  if (module_ident < akd::telegram_module(0) || module_ident > akd::telegram_module(0xFFFF)) return;
   const auto telegram = static_cast<std::uint16_t>(module_ident - akd::telegram_module(0));
-  if (!akd::offers_telegram(telegram) || submodule_ident != akd::telegram_submodule(telegram)) return false;
-  if (telegram == telegram_) return false;
+  if (!akd::offers_telegram(telegram) || submodule_ident != akd::telegram_submodule(telegram)) return;
   // [sim] Another telegram module: the drive starts over with it (its PNU 922 is the module's).
-  plug(telegram);
-  return true;
+  if (telegram != telegram_) plug(telegram);
 }
 
 PnioStatus AkdPersona::write_record(const RecordReqHeader& h, std::span<const std::uint8_t> data) noexcept {

@@ -21,9 +21,9 @@
 //              in S1 untouched. Without an AR the drive keeps stepping (it brakes) at the device's
 //              idle period.
 //
-// The AKD's minimum update time is 16 ms [§2]: kMinUpdateTime. [sim] A Connect with a faster CR
-// is still accepted (the digest does not say what the AKD answers to one); the controller's
-// configuration checks it.
+// The AKD's fastest update time is 16 ms [§2]: a Connect with a faster CR is refused (IOCRBlockReq,
+// [sim] the field ReductionRatio: the digest does not say what the AKD answers; its GSDML would not
+// offer the controller such a ratio).
 #include <array>
 #include <cstdint>
 #include <optional>
@@ -62,8 +62,9 @@ class AkdPersona final : public PnPersona {
 
   [[nodiscard]] std::span<const CmModelSlot> slots() const noexcept override { return slots_; }
   [[nodiscard]] IoLengths lengths(std::uint32_t api, std::uint16_t slot, std::uint16_t subslot) const noexcept override;
-  bool fit(std::uint32_t api, std::uint16_t slot, std::uint32_t module_ident, std::uint16_t subslot,
+  void fit(std::uint32_t api, std::uint16_t slot, std::uint32_t module_ident, std::uint16_t subslot,
            std::uint32_t submodule_ident) noexcept override;
+  [[nodiscard]] core::Duration min_update_time() const noexcept override { return akd::kMinUpdateTime; }
   PnioStatus write_record(const RecordReqHeader& h, std::span<const std::uint8_t> data) noexcept override;
   PnioStatus read_record(const RecordReqHeader& h, std::span<std::uint8_t> into, std::size_t& length) noexcept override;
   void cycle(core::Duration dt, std::span<const PnSubmoduleIo> io) noexcept override;

@@ -88,7 +88,7 @@ void GenericIoPersona::power_cycle() noexcept {
 
 bool GenericIoPersona::set_input(std::uint32_t api, std::uint16_t slot, std::uint16_t subslot,
                                  std::span<const std::uint8_t> data) noexcept {
-  auto* d = const_cast<Data*>(find(api, slot, subslot));
+  Data* d = find(api, slot, subslot);
   if (d == nullptr || data.size() != d->input.size()) return false;
   std::copy(data.begin(), data.end(), d->input.begin());
   return true;

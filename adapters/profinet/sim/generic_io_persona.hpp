@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "adapters/profinet/sim/pn_persona.hpp"
@@ -30,6 +31,7 @@ struct GenericIoPersonaConfig {
   std::uint16_t vendor_id = 0;  // I&M0
   std::string order_id = "SIM-GENERIC-IO";
   std::string serial_number = "SIM0000001";
+  core::Duration min_update_time = std::chrono::milliseconds(1);  // PnPersona::min_update_time
 };
 
 class GenericIoPersona final : public PnPersona {
@@ -39,7 +41,8 @@ class GenericIoPersona final : public PnPersona {
 
   [[nodiscard]] std::span<const CmModelSlot> slots() const noexcept override { return model_; }
   [[nodiscard]] IoLengths lengths(std::uint32_t api, std::uint16_t slot, std::uint16_t subslot) const noexcept override;
-  bool fit(std::uint32_t, std::uint16_t, std::uint32_t, std::uint16_t, std::uint32_t) noexcept override { return false; }
+  void fit(std::uint32_t, std::uint16_t, std::uint32_t, std::uint16_t, std::uint32_t) noexcept override {}
+  [[nodiscard]] core::Duration min_update_time() const noexcept override { return config_.min_update_time; }
   PnioStatus write_record(const RecordReqHeader& h, std::span<const std::uint8_t> data) noexcept override;
   PnioStatus read_record(const RecordReqHeader& h, std::span<std::uint8_t> into, std::size_t& length) noexcept override;
   void cycle(core::Duration dt, std::span<const PnSubmoduleIo> io) noexcept override;
@@ -61,6 +64,9 @@ class GenericIoPersona final : public PnPersona {
     PnOutputs outputs = PnOutputs::Lost;
   };
   [[nodiscard]] const Data* find(std::uint32_t api, std::uint16_t slot, std::uint16_t subslot) const noexcept;
+  [[nodiscard]] Data* find(std::uint32_t api, std::uint16_t slot, std::uint16_t subslot) noexcept {
+    return const_cast<Data*>(std::as_const(*this).find(api, slot, subslot));
+  }
 
   GenericIoPersonaConfig config_;
   std::vector<CmModelSubmodule> submodules_;

@@ -16,13 +16,14 @@ constexpr PnioStatus connect_error(std::uint8_t code1, std::uint8_t code2) noexc
   return {pnio_error_code::kConnect, pnio_error_decode::kPnio, code1, code2};
 }
 constexpr std::uint8_t kFieldDataLength = 8;
+constexpr std::uint8_t kFieldReductionRatio = 11;
 constexpr std::uint8_t kFieldFrameOffset = 24;
 constexpr std::uint8_t kFieldSubmoduleDataLength = 14;
 
 std::uint8_t iocr_field(RtConfigError e) noexcept {
   switch (e) {
     case RtConfigError::BadSendClock: return 10;
-    case RtConfigError::BadReductionRatio: return 11;
+    case RtConfigError::BadReductionRatio: return kFieldReductionRatio;
     case RtConfigError::BadPhase: return 12;
     case RtConfigError::BadDataHold: return 16;
     case RtConfigError::BadFrameId: return 9;
@@ -167,7 +168,7 @@ PnioStatus PnDevice::on_connect(const CmArSetup& setup) noexcept {
     ExpectedSubmoduleReader reader(setup.request.expected[b]);
     ExpectedEntry e;
     while (reader.next(e)) {
-      if (e.has_submodule) (void)persona_.fit(e.api, e.slot, e.module_ident, e.submodule.subslot, e.submodule.ident);
+      if (e.has_submodule) persona_.fit(e.api, e.slot, e.module_ident, e.submodule.subslot, e.submodule.ident);
     }
   }
   const PnioStatus s = set_up_cyclic(setup);
@@ -227,6 +228,7 @@ PnioStatus PnDevice::set_up_cyclic(const CmArSetup& setup) noexcept {
   for (const RtIocrConfig* c : {&in, &out}) {
     const RtConfigError e = validate(*c);
     if (e != RtConfigError::None) return connect_error(pnio_error_code1::kIocrBlockReq, iocr_field(e));
+    if (rt_period(*c) < persona_.min_update_time()) return connect_error(pnio_error_code1::kIocrBlockReq, kFieldReductionRatio);
   }
   provider_.emplace(in, RtSide::Device);
   consumer_.emplace(out, RtSide::Device);

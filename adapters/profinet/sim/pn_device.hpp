@@ -14,7 +14,8 @@
 // to call again. The time is a parameter.
 //
 // The Connect's submodules must have the data lengths the persona gives them (else the Connect is
-// refused: ExpectedSubmoduleBlockReq, SubmoduleDataLength), and its IOCRs must lay out as
+// refused: ExpectedSubmoduleBlockReq, SubmoduleDataLength), its CRs must not be faster than the
+// persona's min_update_time() (IOCRBlockReq, ReductionRatio), and its IOCRs must lay out as
 // compute_csdu_layout does (else IOCRBlockReq, DataLength / FrameOffset) [sim: a real device takes
 // any offsets the controller chooses; ours are the only layout our controller builds]. The cyclic
 // engines start with the accepted Connect; the input data's IOPS turn good once the AR is in data

@@ -49,9 +49,12 @@ class PnPersona {
   };
   [[nodiscard]] virtual IoLengths lengths(std::uint32_t api, std::uint16_t slot, std::uint16_t subslot) const noexcept = 0;
   // A Connect asks for `module_ident` with `submodule_ident` in `slot`: a modular device plugs
-  // it when it can (the AKD: a telegram module in slot 1). False: nothing changed.
-  virtual bool fit(std::uint32_t api, std::uint16_t slot, std::uint32_t module_ident, std::uint16_t subslot,
+  // it when it can (the AKD: a telegram module in slot 1), others ignore it.
+  virtual void fit(std::uint32_t api, std::uint16_t slot, std::uint32_t module_ident, std::uint16_t subslot,
                    std::uint32_t submodule_ident) noexcept = 0;
+  // The shortest CR period (send clock x reduction ratio) the device runs; a Connect asking for a
+  // faster one is refused.
+  [[nodiscard]] virtual core::Duration min_update_time() const noexcept = 0;
 
   virtual PnioStatus write_record(const RecordReqHeader& h, std::span<const std::uint8_t> data) noexcept = 0;
   virtual PnioStatus read_record(const RecordReqHeader& h, std::span<std::uint8_t> into,
