@@ -10,6 +10,7 @@
 #include "adapters/link/udp_endpoint.hpp"
 #include "adapters/profinet/link/profinet_link.hpp"
 #include "adapters/profinet/sim/pn_sim_link.hpp"
+#include "adapters/profinet/wire/byte_order.hpp"
 #include "tests/profinet_sim/sim_bench.hpp"
 #include "tests/support/netns.hpp"
 
@@ -96,19 +97,15 @@ class PnSimVeth : public ::testing::Test {
     link::Datagram d;
     for (const auto& [port, socket] : {std::pair{rpc_client_.get(), CmSocket::Client}, std::pair{rpc_server_.get(), CmSocket::Server}}) {
       while (port->receive_from(d)) {
-        const UdpEndpoint from{(std::uint32_t{d.from.address[0]} << 24) | (std::uint32_t{d.from.address[1]} << 16) |
-                                   (std::uint32_t{d.from.address[2]} << 8) | d.from.address[3],
-                               d.from.port};
-        cm_->on_datagram(d.view(), from, socket, now, out_);
+        cm_->on_datagram(d.view(), {get_be32(d.from.address, 0), d.from.port}, socket, now, out_);
       }
     }
     cm_->poll(now, out_);
     while (!out_.empty()) {
       const CmDatagram& g = out_.front();
       link::DatagramPort& port = g.from == CmSocket::Server ? *rpc_server_ : *rpc_client_;
-      const link::Ipv4Endpoint to{{static_cast<std::uint8_t>(g.to.ip >> 24), static_cast<std::uint8_t>(g.to.ip >> 16),
-                                   static_cast<std::uint8_t>(g.to.ip >> 8), static_cast<std::uint8_t>(g.to.ip)},
-                                  g.to.port};
+      link::Ipv4Endpoint to{{}, g.to.port};
+      put_be32(to.address, 0, g.to.ip);
       (void)port.send_to(to, g.view());
       out_.pop();
     }

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "adapters/profinet/wire/blocks_submodule.hpp"
+#include "adapters/profinet/wire/byte_order.hpp"
 
 namespace drivegate::profinet {
 
@@ -45,11 +46,6 @@ IoKind kind_of(SubmoduleType t) noexcept {
   return IoKind::NoIo;
 }
 
-std::uint32_t ip_of(const IpSuite& s) noexcept {
-  return (std::uint32_t{s.address[0]} << 24) | (std::uint32_t{s.address[1]} << 16) |
-         (std::uint32_t{s.address[2]} << 8) | s.address[3];
-}
-
 }  // namespace
 
 PnDevice::PnDevice(const PnDeviceConfig& config, PnPersona& persona)
@@ -68,7 +64,7 @@ CmServerConfig PnDevice::cm_config() const noexcept {
   return c;
 }
 
-std::uint32_t PnDevice::ip() const noexcept { return ip_of(dcp_.ip()); }
+std::uint32_t PnDevice::ip() const noexcept { return get_be32(dcp_.ip().address, 0); }
 
 // ---- frames and datagrams -------------------------------------------------------------------------
 

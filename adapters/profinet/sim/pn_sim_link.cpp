@@ -1,20 +1,18 @@
 #include "adapters/profinet/sim/pn_sim_link.hpp"
 
+#include "adapters/profinet/wire/byte_order.hpp"
+
 namespace drivegate::profinet {
 
 namespace {
 
 link::Ipv4Endpoint endpoint(std::uint32_t ip, std::uint16_t port) noexcept {
-  return {{static_cast<std::uint8_t>(ip >> 24), static_cast<std::uint8_t>(ip >> 16), static_cast<std::uint8_t>(ip >> 8),
-           static_cast<std::uint8_t>(ip)},
-          port};
+  link::Ipv4Endpoint e{{}, port};
+  put_be32(e.address, 0, ip);
+  return e;
 }
 
-UdpEndpoint endpoint(const link::Ipv4Endpoint& e) noexcept {
-  return {(std::uint32_t{e.address[0]} << 24) | (std::uint32_t{e.address[1]} << 16) |
-              (std::uint32_t{e.address[2]} << 8) | e.address[3],
-          e.port};
-}
+UdpEndpoint endpoint(const link::Ipv4Endpoint& e) noexcept { return {get_be32(e.address, 0), e.port}; }
 
 constexpr std::size_t kFramesPerReceive = 32;
 
