@@ -251,6 +251,13 @@ class SimBench final : private PnSimWire {
     return done();
   }
 
+  // Traffic from outside (another station, a fuzzer): to the devices now, their answers to the
+  // controller side as usual.
+  void inject_frame(std::span<const std::uint8_t> frame) { net.on_frame(frame, now); }
+  void inject_datagram(std::span<const std::uint8_t> bytes, const UdpEndpoint& from, const UdpEndpoint& to) {
+    (void)net.on_datagram(bytes, from, to, now, *this);
+  }
+
   PnSimNetwork net;
   DcpClient dcp;
   std::unique_ptr<StationFinder> finder;
@@ -259,10 +266,17 @@ class SimBench final : private PnSimWire {
   core::TimePoint now{};
   // Frames from the controller to drop (true: lost), for loss tests.
   std::function<bool(std::span<const std::uint8_t>)> drop_to_devices;
+  // Sees every frame and datagram the devices send (checks).
+  std::function<void(std::span<const std::uint8_t>)> watch_frames;
+  std::function<void(const UdpEndpoint& from, std::span<const std::uint8_t>)> watch_datagrams;
 
  private:
-  void send_frame(std::span<const std::uint8_t> frame) noexcept override { frames_.emplace_back(frame.begin(), frame.end()); }
+  void send_frame(std::span<const std::uint8_t> frame) noexcept override {
+    if (watch_frames) watch_frames(frame);
+    frames_.emplace_back(frame.begin(), frame.end());
+  }
   void send_datagram(const UdpEndpoint& from, const UdpEndpoint& to, std::span<const std::uint8_t> bytes) noexcept override {
+    if (watch_datagrams) watch_datagrams(from, bytes);
     datagrams_.push_back({from, to, Bytes(bytes.begin(), bytes.end())});
   }
   void to_devices(std::span<const std::uint8_t> frame) {
