@@ -149,7 +149,7 @@ TEST(PnSimAkd, WrongModuleInSlot1IsReportedByModuleDiff) {
 
 TEST(PnSimAkd, Record47ReadsAPnuThroughTheParameterChannel) {
   Line l;
-  ArPlan plan(akd_plan(1, 4, 4), ip_of(11), device_mac(1), 0);
+  ArPlan plan(akd_plan(1, 4, 4), ip_of(11), device_mac(1), 0, 16, 5);  // watchdog 5 x 16 ms
   SimBench::Ar& ar = l.bench.add_ar(plan);
   l.bench.start(ar);
   ASSERT_TRUE(l.bench.run_until([&] { return in_data_exchange(ar); }, 5s)) << ar.cm->reason();
@@ -183,6 +183,18 @@ TEST(PnSimAkd, Record47ReadsAPnuThroughTheParameterChannel) {
   ASSERT_EQ(im.error, WireError::None);
   EXPECT_EQ(im.im0.order_id, "AKD-P00306-NBPN-0000");
   EXPECT_EQ(im.im0.profile_id, 0x3A00);
+  // PN.TIMEOUTFTHRESH (PNU 3022) is the watchdog this AR assigned [digest §19.3].
+  const std::array<pd::ParamAddress, 1> threshold{{{pd::Attribute::Value, 1, 3022, 0}}};
+  const pd::EncodeResult e2 = pd::encode_read_request(request, 8, threshold);
+  ASSERT_NE(ar.cm->submit_write(akd::kProfidriveApi, 1, 1, record_index::kAkdParameterAccess,
+                                std::span<const std::uint8_t>(request).first(e2.size)),
+            0U);
+  ASSERT_NE(ar.cm->submit_read(akd::kProfidriveApi, 1, 1, record_index::kAkdParameterAccess, 240), 0U);
+  ASSERT_TRUE(l.bench.run_until([&] { return l.bench.replies.count == 6; }, 5s));
+  const pd::ResponseResult t = pd::decode_param_response(l.bench.replies.data);
+  ASSERT_EQ(t.error, pd::ParamError::None);
+  ASSERT_EQ(t.response.values().size(), 1U);
+  EXPECT_EQ(t.response.values()[0].value(0), 80U);
 }
 
 TEST(PnSimAkd, SilentControllerMakesTheDeviceWatchdogAbortTheAr) {

@@ -10,6 +10,7 @@
 //              submodule = telegram number, for telegrams 1, 7, 9, 350..353 and 400 (telegram 0's
 //              I/O length is not stated, §13, so no module offers it). A module ident that is no
 //              telegram leaves the plugged one, and the ModuleDiffBlock says "wrong module".
+//   PN.TIMEOUTFTHRESH  PNU 3022 reads the output CR's data hold time of the running AR (§19.3).
 //   record 47  on slot 1 subslot 1: the PROFIdrive parameter channel [§5.1] (write the request,
 //              read the response; a read with nothing waiting or a second write before the read
 //              is PNIORW "state conflict", a request over 240 bytes "write length error").
@@ -65,6 +66,10 @@ class AkdPersona final : public PnPersona {
   void fit(std::uint32_t api, std::uint16_t slot, std::uint32_t module_ident, std::uint16_t subslot,
            std::uint32_t submodule_ident) noexcept override;
   [[nodiscard]] core::Duration min_update_time() const noexcept override { return akd::kMinUpdateTime; }
+  // PN.TIMEOUTFTHRESH (PNU 3022) reads the watchdog the controller assigned [§18.3, §19.3].
+  void on_ar_start(core::Duration watchdog) noexcept override {
+    drive_->set_watchdog_ms(static_cast<std::uint32_t>(std::chrono::duration_cast<std::chrono::milliseconds>(watchdog).count()));
+  }
   PnioStatus write_record(const RecordReqHeader& h, std::span<const std::uint8_t> data) noexcept override;
   PnioStatus read_record(const RecordReqHeader& h, std::span<std::uint8_t> into, std::size_t& length) noexcept override;
   void cycle(core::Duration dt, std::span<const PnSubmoduleIo> io) noexcept override;

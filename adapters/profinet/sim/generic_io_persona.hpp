@@ -42,6 +42,7 @@ class GenericIoPersona final : public PnPersona {
   [[nodiscard]] std::span<const CmModelSlot> slots() const noexcept override { return model_; }
   [[nodiscard]] IoLengths lengths(std::uint32_t api, std::uint16_t slot, std::uint16_t subslot) const noexcept override;
   void fit(std::uint32_t, std::uint16_t, std::uint32_t, std::uint16_t, std::uint32_t) noexcept override {}
+  void on_ar_start(core::Duration) noexcept override {}
   [[nodiscard]] core::Duration min_update_time() const noexcept override { return config_.min_update_time; }
   PnioStatus write_record(const RecordReqHeader& h, std::span<const std::uint8_t> data) noexcept override;
   PnioStatus read_record(const RecordReqHeader& h, std::span<std::uint8_t> into, std::size_t& length) noexcept override;

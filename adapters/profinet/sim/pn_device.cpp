@@ -242,6 +242,7 @@ PnioStatus PnDevice::set_up_cyclic(const CmArSetup& setup) noexcept {
   }
   provider_->start(now_);
   consumer_->arm(now_);
+  persona_.on_ar_start(consumer_->data_hold_time());
   return {};
 }
 

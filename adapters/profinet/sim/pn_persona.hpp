@@ -56,6 +56,9 @@ class PnPersona {
   // faster one is refused.
   [[nodiscard]] virtual core::Duration min_update_time() const noexcept = 0;
 
+  // A Connect set up the cyclic data; `watchdog` is the output CR's data hold time.
+  virtual void on_ar_start(core::Duration watchdog) noexcept = 0;
+
   virtual PnioStatus write_record(const RecordReqHeader& h, std::span<const std::uint8_t> data) noexcept = 0;
   virtual PnioStatus read_record(const RecordReqHeader& h, std::span<std::uint8_t> into,
                                  std::size_t& length) noexcept = 0;
