@@ -39,6 +39,9 @@ profinet_alarm_engines: the profinet_alarm frames as records (format in
 profinet_rt_consumer: records of input frames (format in fuzz_profinet_rt_consumer.cpp): cycles on
                   time, repeated and old counters, silence past the data hold time and a re-arm,
                   STOP / invalid / backup / Ignore, another source, FrameID and C_SDU length.
+profinet_sim_device: records for the simulated IO device (format in fuzz_profinet_sim_device.cpp):
+                  the profinet_dcp frames, the profinet_rpc requests to its server port, an
+                  enable by STW1, each fault, and one file with all of them.
 """
 import struct
 import pathlib
@@ -505,9 +508,29 @@ def profinet_rpc_seeds():
         write("profinet_blocks", n, d)
 
 
+def profinet_sim_device_seeds():
+    def record(kind, step, body):
+        return bytes([kind, step]) + struct.pack(">H", len(body)) + body
+
+    records = {}
+    for name in ("identify_all", "identify_name", "set_ip", "set_name", "signal", "get_request", "lying_length"):
+        records["dcp_" + name] = record(0, 10, (CORPUS / "profinet_dcp" / name).read_bytes())
+    for name in ("connect_request_le", "connect_request_be", "write_request_pnu930", "read_request_im0",
+                 "control_prm_end", "ping", "truncated"):
+        records["rpc_" + name] = record(1, 10, (CORPUS / "profinet_rpc" / name).read_bytes())
+    records["ready_answer"] = record(2, 1, (CORPUS / "profinet_rpc" / "release_response").read_bytes())
+    records["enable"] = record(4, 16, bytes.fromhex("047E")) + record(4, 32, bytes.fromhex("047F"))
+    for n, what in enumerate(("power_loss", "power_return", "abort", "lose_rx", "lose_tx", "drive_fault")):
+        records["fault_" + what] = record(3, 20, bytes([n + 6 * 2, 0x01, 0xF5]))
+    for name, data in records.items():
+        write("profinet_sim_device", name, data)
+    write("profinet_sim_device", "all", b"".join(records.values()))
+
+
 if __name__ == "__main__":
     profinet_seeds()
     profinet_rpc_seeds()
+    profinet_sim_device_seeds()
     ethercat_sim_seeds()
     ethercat_frame_seeds()
     ethercat_mailbox_seeds()

@@ -3,10 +3,6 @@
 // provider (PPM) and consumer (CPM) protocol machines]: frames and the time go in, frames come out
 // into the caller's buffer (DESIGN.md §2 rule 1). Nothing here allocates after construction.
 //
-//   Both run on either side (RtIocrConfig::role): on the controller's as below, on a simulated
-//   device's the provider sends the input CR to the controller and the consumer takes the output
-//   CR from it (the C_SDU laid out for that CR's direction, the MACs swapped).
-//
 //   RtProvider (the output IOCR): owns the output frame (header with the 802.1Q priority tag 6,
 //     VID 0, and the C_SDU laid out by compute_csdu_layout); the application writes each
 //     submodule's data, its IOPS and the IOCS of the input submodules through the accessors, and
@@ -29,6 +25,10 @@
 //     [IEC 61158-6-10 §4.7.2.1.2; the DHT is retriggered only by frames that may be used. A frame
 //     with DataValid clear or Ignore set passes the cycle counter check but neither retriggers the
 //     DHT nor replaces the data.]
+//
+// The same engines run the device's end of the AR (the simulator) with RtSide::Device: its
+// provider sends the input CR (device -> controller: the input data with their IOPS, the IOCS of
+// the output data) and its consumer takes the output CR from the controller's MAC.
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -47,17 +47,12 @@ inline constexpr std::size_t kMaxRtSubmodules = 64;
 // One SendClockFactor unit: 31.25 µs [IEC 61158-6-10, SendClockFactor].
 inline constexpr core::Duration kSendClockUnit{31250};
 
-// Whose side an engine runs on. The controller provides the output CR and consumes the input
-// CR; the device (the simulator's) provides the input CR and consumes the output CR.
-enum class RtRole : std::uint8_t { Controller, Device };
-
 // One IOCR as the Connect set it up (IOCRBlockReq). `submodules` lists the AR's submodules in
 // the Connect's order; both CRs of an AR use the same list.
 struct RtIocrConfig {
   std::uint16_t frame_id = frame_id::kRtClass1First;
   MacAddress controller_mac{};  // the output CR's source, the input CR's destination
   MacAddress device_mac{};
-  RtRole role = RtRole::Controller;
   std::uint16_t send_clock_factor = 32;  // 1..128 (32: 1 ms)
   std::uint16_t reduction_ratio = 1;     // 1..512, a power of two (RT class 1)
   std::uint16_t phase = 1;               // 1..reduction_ratio
@@ -84,6 +79,10 @@ constexpr core::Duration rt_period(const RtIocrConfig& c) noexcept {
 }
 constexpr core::Duration rt_data_hold_time(const RtIocrConfig& c) noexcept { return rt_period(c) * c.data_hold_factor; }
 
+// Which end of the AR an engine runs: the controller provides the output CR and consumes the
+// input CR; the device the other way round.
+enum class RtSide : std::uint8_t { Controller, Device };
+
 struct RtProviderCounters {
   std::uint64_t frames_sent = 0;
   std::uint64_t missed_slots = 0;   // slots that passed without a poll() (not sent late)
@@ -92,8 +91,9 @@ struct RtProviderCounters {
 
 class RtProvider {
  public:
-  // Builds the output CR's frame; an invalid config leaves the provider inert (error()).
-  explicit RtProvider(const RtIocrConfig& config) noexcept;
+  // Builds the frame of the CR `side` provides (the controller: the output CR); an invalid config
+  // leaves the provider inert (error()).
+  explicit RtProvider(const RtIocrConfig& config, RtSide side = RtSide::Controller) noexcept;
 
   [[nodiscard]] RtConfigError error() const noexcept { return error_; }
   [[nodiscard]] bool ok() const noexcept { return error_ == RtConfigError::None; }
@@ -101,11 +101,11 @@ class RtProvider {
   [[nodiscard]] std::size_t frame_size() const noexcept { return frame_size_; }
 
   // The application's side, any time between polls. Index i names config.submodules[i].
-  // The data submodule i has in this CR (its outputs on the controller's side, its inputs on the
-  // device's; empty when it has none).
+  // The data submodule i provides in this CR (the controller: its output data; empty when none).
   [[nodiscard]] std::span<std::uint8_t> data(std::size_t i) noexcept;
-  // IOPS of submodule i's data in this CR / IOCS for its data in the other CR (iox_status::); false
-  // when submodule i has no such object in this CR. IOPS start bad (by controller), IOCS good.
+  // IOPS of the data submodule i provides in this CR / IOCS for the data it consumes from the
+  // other one (iox_status::); false when submodule i has no such object in this CR. IOPS start
+  // bad (by controller, or by device on the device's side), IOCS good.
   bool set_iops(std::size_t i, std::uint8_t iops) noexcept;
   bool set_iocs(std::size_t i, std::uint8_t iocs) noexcept;
   // DataStatus ProviderState RUN (true, the start) or STOP.
@@ -152,7 +152,7 @@ std::string_view to_string(RtConsumerState s) noexcept;
 struct RtConsumerCounters {
   std::uint64_t frames = 0;          // valid frames taken
   std::uint64_t wrong_frame_id = 0;  // an RT class 1 frame with another FrameID (not taken)
-  std::uint64_t wrong_source = 0;    // this FrameID from another MAC than the provider's
+  std::uint64_t wrong_source = 0;    // this FrameID from another MAC than the device's
   std::uint64_t malformed = 0;       // not a PROFINET Ethernet frame (decode_ethernet failed)
   std::uint64_t truncated = 0, transfer_error = 0, repeated_cycle = 0, old_cycle = 0;
   std::uint64_t ignore = 0, data_invalid = 0;  // pass the cycle check, not taken
@@ -165,7 +165,8 @@ struct RtConsumerCounters {
 
 class RtConsumer {
  public:
-  explicit RtConsumer(const RtIocrConfig& config) noexcept;
+  // Consumes the CR the other side provides (the controller: the input CR from the device's MAC).
+  explicit RtConsumer(const RtIocrConfig& config, RtSide side = RtSide::Controller) noexcept;
 
   [[nodiscard]] RtConfigError error() const noexcept { return error_; }
   [[nodiscard]] bool ok() const noexcept { return error_ == RtConfigError::None; }
@@ -188,8 +189,11 @@ class RtConsumer {
   [[nodiscard]] std::string_view reason() const noexcept { return reason_.view(); }
   // The last valid frame's values (zeros and bad IOPS before the first one).
   [[nodiscard]] std::span<const std::uint8_t> data(std::size_t i) const noexcept;
-  [[nodiscard]] std::uint8_t iops(std::size_t i) const noexcept;  // of submodule i's data in this CR
-  [[nodiscard]] std::uint8_t iocs(std::size_t i) const noexcept;  // the peer's for submodule i's data in the other CR
+  // The provider's status of the data it sends for submodule i (the controller: of its input data).
+  [[nodiscard]] std::uint8_t iops(std::size_t i) const noexcept;
+  // The provider's status of the data we send for submodule i (the controller: the device's for
+  // its output data).
+  [[nodiscard]] std::uint8_t iocs(std::size_t i) const noexcept;
   [[nodiscard]] bool all_iops_good() const noexcept;
   [[nodiscard]] const ApduStatus& status() const noexcept { return status_; }
   [[nodiscard]] bool provider_run() const noexcept { return status_.provider_run(); }
@@ -201,12 +205,11 @@ class RtConsumer {
 
  private:
   void expire(core::TimePoint now) noexcept;
-  [[nodiscard]] const char* cr_name() const noexcept { return device_side_ ? "output" : "input"; }
 
   RtConfigError error_ = RtConfigError::None;
+  RtSide side_ = RtSide::Controller;
   std::uint16_t frame_id_ = 0;
-  MacAddress source_mac_{};  // the provider's: the device's, or the controller's on the device side
-  bool device_side_ = false;
+  MacAddress peer_mac_{};  // the provider's
   CsduLayout layout_{};
   std::size_t submodule_count_ = 0;
   std::array<IoPlacement, kMaxRtSubmodules> placements_{};
