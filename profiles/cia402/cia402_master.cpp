@@ -141,38 +141,13 @@ Admission Cia402Master::admit_motion(const core::DriveCommand& cmd, Mode mode) c
   return Admission::accept();
 }
 
-void Cia402Master::fail_slot(Slot& slot, std::string_view reason, core::ControllerSink& sink) noexcept {
-  if (!slot.active) return;
-  slot.active = false;
-  sink.failed(slot.id, reason);
-}
-
-void Cia402Master::complete_slot(Slot& slot, core::ControllerSink& sink) noexcept {
-  if (!slot.active) return;
-  slot.active = false;
-  sink.completed(slot.id);
-}
-
-void Cia402Master::abort_slot(Slot& slot, const core::DriveCommand& by, core::ControllerSink& sink) noexcept {
-  if (!slot.active) return;
-  // Command ids are the gateway's own bookkeeping, meaningless to the client that reads this.
-  core::Text reason;
-  if (core::is_internal(by.id))
-    reason.format("aborted by the gateway's %s", core::to_string(by.kind).data());
-  else if (slot.kind == by.kind)
-    reason.format("superseded by a newer %s command", core::to_string(by.kind).data());
-  else
-    reason.format("aborted by a %s command", core::to_string(by.kind).data());
-  fail_slot(slot, reason.view(), sink);
-}
-
 Admission Cia402Master::submit(const core::DriveCommand& cmd, core::TimePoint now, core::ControllerSink& sink) noexcept {
   if (!status_valid_) return Admission::reject("no status from the drive yet: wait for the link to come up");
   const Slot incoming{true, cmd.id, cmd.kind};
   switch (cmd.kind) {
     case CommandKind::Enable:
       if (in_fault(state_)) return Admission::reject("axis is in fault: send fault_reset first");
-      abort_slot(device_slot_, cmd, sink);
+      device_slot_.abort(cmd, sink);
       device_.start(DeviceGoal::Enable, state_, now);
       device_slot_ = incoming;
       if (state_ != AxisState::OperationEnabled) write_safe_holds();  // a walk starts: no old motion
@@ -180,9 +155,9 @@ Admission Cia402Master::submit(const core::DriveCommand& cmd, core::TimePoint no
 
     case CommandKind::Disable:
     case CommandKind::QuickStop:
-      abort_slot(device_slot_, cmd, sink);
-      abort_slot(motion_.slot, cmd, sink);
-      abort_slot(halt_slot_, cmd, sink);
+      device_slot_.abort(cmd, sink);
+      motion_.slot.abort(cmd, sink);
+      halt_slot_.abort(cmd, sink);
       abandon_motion_requests();
       mode_switching_ = false;
       bit4_ = false;
@@ -204,7 +179,7 @@ Admission Cia402Master::submit(const core::DriveCommand& cmd, core::TimePoint no
         sink.completed(cmd.id);
         return Admission::accept();
       }
-      abort_slot(device_slot_, cmd, sink);
+      device_slot_.abort(cmd, sink);
       device_.start(DeviceGoal::FaultReset, state_, now);
       device_slot_ = incoming;
       return Admission::accept();
@@ -212,14 +187,14 @@ Admission Cia402Master::submit(const core::DriveCommand& cmd, core::TimePoint no
     case CommandKind::Halt:
       if (in_fault(state_)) return Admission::reject("axis is in fault: send fault_reset first");
       if (state_ != AxisState::OperationEnabled) return Admission::reject("axis is not enabled: send enable first");
-      abort_slot(halt_slot_, cmd, sink);
+      halt_slot_.abort(cmd, sink);
       halt_ = true;
       halt_settle_until_ = cycle_ + settings_.settle_cycles;
       halt_slot_ = incoming;
       return Admission::accept();
 
     case CommandKind::Resume:
-      abort_slot(halt_slot_, cmd, sink);
+      halt_slot_.abort(cmd, sink);
       halt_ = false;
       sink.completed(cmd.id);
       return Admission::accept();
@@ -244,9 +219,9 @@ Admission Cia402Master::submit(const core::DriveCommand& cmd, core::TimePoint no
   const Mode mode = motion_mode(cmd);
   const Admission admission = admit_motion(cmd, mode);
   if (!admission.accepted) return admission;
-  abort_slot(motion_.slot, cmd, sink);  // start_motion() cancels its requests in flight
+  motion_.slot.abort(cmd, sink);  // start_motion() cancels its requests in flight
   if (cmd.kind != CommandKind::SetMode && cmd.kind != CommandKind::Stop) {
-    abort_slot(halt_slot_, cmd, sink);  // a new motion command implies resume
+    halt_slot_.abort(cmd, sink);  // a new motion command implies resume
     halt_ = false;
   }
   start_motion(cmd, mode, now);
@@ -321,9 +296,9 @@ void Cia402Master::link_lost(core::TimePoint /*now*/, core::ControllerSink& sink
   const std::string_view kLost = control_lost_ ? std::string_view("drive stopped following the gateway's controlword: "
                                                                   "it is being stopped and reconfigured")
                                                : std::string_view("link to drive lost");
-  fail_slot(device_slot_, kLost, sink);
-  fail_slot(motion_.slot, kLost, sink);
-  fail_slot(halt_slot_, kLost, sink);
+  device_slot_.fail(kLost, sink);
+  motion_.slot.fail(kLost, sink);
+  halt_slot_.fail(kLost, sink);
   for (auto& p : params_) {
     if (!p.active) continue;
     p.active = false;

@@ -19,6 +19,7 @@
 #include <span>
 
 #include "core/axis_controller.hpp"
+#include "core/command_slot.hpp"
 #include "profiles/cia402/error_codes.hpp"
 #include "profiles/cia402/master_settings.hpp"
 #include "profiles/cia402/object_access.hpp"
@@ -48,11 +49,7 @@ class Cia402Master final : public core::AxisController {
   [[nodiscard]] std::uint64_t dropped_setpoints() const noexcept { return dropped_setpoints_; }
 
  private:
-  struct Slot {
-    bool active = false;
-    core::CommandId id = 0;
-    core::CommandKind kind = core::CommandKind::Enable;
-  };
+  using Slot = core::CommandSlot;
   enum class Phase : std::uint8_t {
     SwitchMode,    // 6060h written, waiting for 6061h
     Stage,         // object writes that must land before the handshake
@@ -85,9 +82,6 @@ class Cia402Master final : public core::AxisController {
   [[nodiscard]] core::Mode motion_mode(const core::DriveCommand& cmd) const noexcept;
   [[nodiscard]] bool at_standstill() const noexcept;
   [[nodiscard]] bool profile_owns(ObjectId id) const noexcept;
-  void abort_slot(Slot& slot, const core::DriveCommand& by, core::ControllerSink& sink) noexcept;
-  void fail_slot(Slot& slot, std::string_view reason, core::ControllerSink& sink) noexcept;
-  void complete_slot(Slot& slot, core::ControllerSink& sink) noexcept;
   void start_motion(const core::DriveCommand& cmd, core::Mode mode, core::TimePoint now) noexcept;
 
   // cia402_master_update.cpp: inputs, device control, events, outputs, feedback.

@@ -103,7 +103,7 @@ void Cia402Master::run_motion(core::TimePoint now, core::ControllerSink& sink) n
   if (motion_.phase == Phase::SwitchMode) {
     if (!run_mode_switch(now, sink)) return;
     if (motion_.slot.kind == CommandKind::SetMode) {
-      complete_slot(motion_.slot, sink);
+      motion_.slot.complete(sink);
       return;
     }
     enter_stage(now);  // set-points again after a mode change [AKD digest §3.6]
@@ -291,14 +291,14 @@ bool Cia402Master::motion_done() const noexcept {
 void Cia402Master::finish_motion(core::ControllerSink& sink) noexcept {
   if (motion_.slot.kind == CommandKind::Home) homed_ = true;
   bit4_ = false;  // hm: clear bit 4 after success [AKD digest §9.3]
-  complete_slot(motion_.slot, sink);
+  motion_.slot.complete(sink);
 }
 
 void Cia402Master::fail_motion(std::string_view reason, core::ControllerSink& sink) noexcept {
   bit4_ = false;
   mode_switching_ = false;
   abandon_motion_requests();
-  fail_slot(motion_.slot, reason, sink);
+  motion_.slot.fail(reason, sink);
 }
 
 void Cia402Master::abandon_motion_requests() noexcept {
@@ -342,7 +342,7 @@ void Cia402Master::write_safe_holds() noexcept {
 void Cia402Master::run_halt(core::ControllerSink& sink) noexcept {
   if (!halt_slot_.active || cycle_ < halt_settle_until_) return;
   // With halt set, bit 10 means the axis stands still [CiA 402 §6.4.2.2].
-  if (state_ == AxisState::OperationEnabled && (statusword_ & sw::kTargetReached) != 0) complete_slot(halt_slot_, sink);
+  if (state_ == AxisState::OperationEnabled && (statusword_ & sw::kTargetReached) != 0) halt_slot_.complete(sink);
 }
 
 void Cia402Master::restart_cyclic_hold() noexcept {

@@ -119,14 +119,14 @@ void Cia402Master::track_state(core::TimePoint /*now*/, core::ControllerSink& si
       } else {
         reason.assign("drive went to fault");
       }
-      fail_slot(motion_.slot, reason.view(), sink);
-      fail_slot(halt_slot_, reason.view(), sink);
+      motion_.slot.fail(reason.view(), sink);
+      halt_slot_.fail(reason.view(), sink);
       abandon_motion_requests();
       // A disable is done once the drive is in fault (power stage off): run_device() completes it.
       const bool keeps_walk = device_slot_.active && (device_slot_.kind == core::CommandKind::FaultReset ||
                                                       device_slot_.kind == core::CommandKind::Disable);
       if (!keeps_walk) {
-        fail_slot(device_slot_, reason.view(), sink);
+        device_slot_.fail(reason.view(), sink);
         device_.hold(cw::kDisableVoltage);  // never re-enable by itself after the reset
       }
       mode_switching_ = false;
@@ -145,10 +145,10 @@ void Cia402Master::track_state(core::TimePoint /*now*/, core::ControllerSink& si
       core::Text reason;
       reason.format("drive left operation enabled on its own (now %s): hardware enable lost?", core::to_string(s).data());
       if (motion_.slot.kind != core::CommandKind::SetMode) {
-        fail_slot(motion_.slot, reason.view(), sink);
+        motion_.slot.fail(reason.view(), sink);
         abandon_motion_requests();
       }
-      fail_slot(halt_slot_, reason.view(), sink);
+      halt_slot_.fail(reason.view(), sink);
       device_.hold(cw::kDisableVoltage);
       bit4_ = false;
       halt_ = false;
@@ -212,9 +212,9 @@ void Cia402Master::track_fault_code(core::ControllerSink& sink) noexcept {
 void Cia402Master::run_device(core::TimePoint now, core::ControllerSink& sink) noexcept {
   const DeviceProgress p = device_.step(state_, now);
   if (p == DeviceProgress::Done) {
-    complete_slot(device_slot_, sink);
+    device_slot_.complete(sink);
   } else if (p == DeviceProgress::Failed) {
-    fail_slot(device_slot_, device_.failure().view(), sink);
+    device_slot_.fail(device_.failure().view(), sink);
   }
 }
 

@@ -167,30 +167,6 @@ const char* ProfidriveMaster::check_ramps(const core::DriveCommand& cmd) noexcep
   return nullptr;
 }
 
-void ProfidriveMaster::fail_slot(Slot& slot, std::string_view reason, core::ControllerSink& sink) noexcept {
-  if (!slot.active) return;
-  slot.active = false;
-  sink.failed(slot.id, reason);
-}
-
-void ProfidriveMaster::complete_slot(Slot& slot, core::ControllerSink& sink) noexcept {
-  if (!slot.active) return;
-  slot.active = false;
-  sink.completed(slot.id);
-}
-
-void ProfidriveMaster::abort_slot(Slot& slot, const core::DriveCommand& by, core::ControllerSink& sink) noexcept {
-  if (!slot.active) return;
-  core::Text reason;
-  if (core::is_internal(by.id))
-    reason.format("aborted by the gateway's %s", core::to_string(by.kind).data());
-  else if (slot.kind == by.kind)
-    reason.format("superseded by a newer %s command", core::to_string(by.kind).data());
-  else
-    reason.format("aborted by a %s command", core::to_string(by.kind).data());
-  fail_slot(slot, reason.view(), sink);
-}
-
 void ProfidriveMaster::start_device(DeviceGoal goal, const core::DriveCommand& cmd, core::TimePoint now) noexcept {
   goal_ = goal;
   step_state_ = state_;
@@ -212,7 +188,7 @@ Admission ProfidriveMaster::submit(const core::DriveCommand& cmd, core::TimePoin
   switch (cmd.kind) {
     case CommandKind::Enable:
       if (in_fault(state_.state)) return Admission::reject("axis is in fault: send fault_reset first");
-      abort_slot(device_slot_, cmd, sink);
+      device_slot_.abort(cmd, sink);
       if (state_.state != AxisState::OperationEnabled) {
         // A walk starts from a standing drive: no set-point of an earlier session survives it.
         end_motion();
@@ -223,9 +199,9 @@ Admission ProfidriveMaster::submit(const core::DriveCommand& cmd, core::TimePoin
 
     case CommandKind::Disable:
     case CommandKind::QuickStop:
-      abort_slot(device_slot_, cmd, sink);
-      abort_slot(motion_.slot, cmd, sink);
-      abort_slot(halt_slot_, cmd, sink);
+      device_slot_.abort(cmd, sink);
+      motion_.slot.abort(cmd, sink);
+      halt_slot_.abort(cmd, sink);
       safe_outputs();
       if (in_fault(state_.state)) {
         // The power stage is already off; the acknowledge stays for fault_reset.
@@ -240,21 +216,21 @@ Admission ProfidriveMaster::submit(const core::DriveCommand& cmd, core::TimePoin
         sink.completed(cmd.id);  // nothing to acknowledge; a walk in progress goes on
         return Admission::accept();
       }
-      abort_slot(device_slot_, cmd, sink);
+      device_slot_.abort(cmd, sink);
       start_device(DeviceGoal::FaultReset, cmd, now);
       return Admission::accept();
 
     case CommandKind::Halt:
       if (in_fault(state_.state)) return Admission::reject("axis is in fault: send fault_reset first");
       if (state_.state != AxisState::OperationEnabled) return Admission::reject("axis is not enabled: send enable first");
-      abort_slot(halt_slot_, cmd, sink);
+      halt_slot_.abort(cmd, sink);
       halt_ = true;
       halt_slot_ = Slot{true, cmd.id, cmd.kind};
       halt_settle_until_ = telegrams_ + settings_.settle_telegrams;
       return Admission::accept();
 
     case CommandKind::Resume:
-      abort_slot(halt_slot_, cmd, sink);
+      halt_slot_.abort(cmd, sink);
       halt_ = false;
       sink.completed(cmd.id);
       return Admission::accept();
@@ -279,9 +255,9 @@ Admission ProfidriveMaster::submit(const core::DriveCommand& cmd, core::TimePoin
   const Mode mode = mode_of(cmd);
   const Admission admission = admit_motion(cmd, mode);
   if (!admission.accepted) return admission;
-  abort_slot(motion_.slot, cmd, sink);
+  motion_.slot.abort(cmd, sink);
   if (cmd.kind != CommandKind::SetMode && cmd.kind != CommandKind::Stop) {
-    abort_slot(halt_slot_, cmd, sink);  // a new motion command implies resume
+    halt_slot_.abort(cmd, sink);  // a new motion command implies resume
     halt_ = false;
   }
   if (cmd.kind == CommandKind::SetMode) {
@@ -354,9 +330,9 @@ Admission ProfidriveMaster::parameter(const core::ParamRequest& req, core::TimeP
 }
 
 void ProfidriveMaster::drop_drive(std::string_view reason, core::ControllerSink& sink) noexcept {
-  fail_slot(device_slot_, reason, sink);
-  fail_slot(motion_.slot, reason, sink);
-  fail_slot(halt_slot_, reason, sink);
+  device_slot_.fail(reason, sink);
+  motion_.slot.fail(reason, sink);
+  halt_slot_.fail(reason, sink);
   cancel_channel();
   for (auto& p : params_) {
     if (p.active) client_reply(p, nullptr, reason, 0, sink);

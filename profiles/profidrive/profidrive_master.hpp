@@ -26,6 +26,7 @@
 #include <string_view>
 
 #include "core/axis_controller.hpp"
+#include "core/command_slot.hpp"
 #include "profiles/profidrive/fault_buffer.hpp"
 #include "profiles/profidrive/master_settings.hpp"
 #include "profiles/profidrive/param_access.hpp"
@@ -80,11 +81,7 @@ class ProfidriveMaster final : public core::AxisController {
   [[nodiscard]] std::uint64_t bad_telegrams() const noexcept { return bad_telegrams_; }
 
  private:
-  struct Slot {
-    bool active = false;
-    core::CommandId id = 0;
-    core::CommandKind kind = core::CommandKind::Enable;
-  };
+  using Slot = core::CommandSlot;
   enum class DeviceGoal : std::uint8_t { Hold, Enable, Disable, QuickStop, FaultReset };
   // What the motion slot runs on the drive.
   enum class Task : std::uint8_t {
@@ -124,9 +121,6 @@ class ProfidriveMaster final : public core::AxisController {
   [[nodiscard]] core::Admission admit_motion(const core::DriveCommand& cmd, core::Mode mode) const noexcept;
   static const char* check_ramps(const core::DriveCommand& cmd) noexcept;
   [[nodiscard]] bool gateway_owns(std::uint16_t pnu) const noexcept;
-  void fail_slot(Slot& slot, std::string_view reason, core::ControllerSink& sink) noexcept;
-  void complete_slot(Slot& slot, core::ControllerSink& sink) noexcept;
-  void abort_slot(Slot& slot, const core::DriveCommand& by, core::ControllerSink& sink) noexcept;
   void start_device(DeviceGoal goal, const core::DriveCommand& cmd, core::TimePoint now) noexcept;
   void drop_drive(std::string_view reason, core::ControllerSink& sink) noexcept;
   void safe_outputs() noexcept;

@@ -164,7 +164,7 @@ void ProfidriveMaster::run_motion(core::TimePoint now, core::ControllerSink& sin
   }
   if (!motion_done()) return;
   if (motion_.task == Task::Homing) motion_.task = Task::None;  // bit 11 back to 0 once homed
-  complete_slot(motion_.slot, sink);
+  motion_.slot.complete(sink);
 }
 
 bool ProfidriveMaster::motion_done() const noexcept {
@@ -193,7 +193,7 @@ void ProfidriveMaster::end_motion() noexcept {
 
 void ProfidriveMaster::fail_motion(std::string_view reason, core::ControllerSink& sink) noexcept {
   end_motion();
-  fail_slot(motion_.slot, reason, sink);
+  motion_.slot.fail(reason, sink);
 }
 
 }  // namespace drivegate::profidrive

@@ -46,7 +46,7 @@ void ProfidriveMaster::update(core::TimePoint now, core::ControllerSink& sink) n
     supervise_control(now, sink);
     run_device(now, sink);
     run_motion(now, sink);
-    if (halt_slot_.active && telegrams_ >= halt_settle_until_ && at_standstill()) complete_slot(halt_slot_, sink);
+    if (halt_slot_.active && telegrams_ >= halt_settle_until_ && at_standstill()) halt_slot_.complete(sink);
     if (mode_ != fb_.mode) {
       core::Text t;
       t.format("mode %s -> %s", core::to_string(fb_.mode).data(), core::to_string(mode_).data());
@@ -112,12 +112,12 @@ void ProfidriveMaster::track_state(core::ControllerSink& sink) noexcept {
   }
   if (in_fault(s.state) && !in_fault(prev.state)) {
     const std::string_view reason = "drive fault (ZSW1 bit 3): reading its fault buffer";
-    fail_slot(motion_.slot, reason, sink);
-    fail_slot(halt_slot_, reason, sink);
+    motion_.slot.fail(reason, sink);
+    halt_slot_.fail(reason, sink);
     if (device_slot_.active && (goal_ == DeviceGoal::Disable || goal_ == DeviceGoal::QuickStop)) {
-      complete_slot(device_slot_, sink);  // the power stage is off: nothing more to switch off
+      device_slot_.complete(sink);  // the power stage is off: nothing more to switch off
     } else if (goal_ != DeviceGoal::FaultReset) {
-      fail_slot(device_slot_, reason, sink);
+      device_slot_.fail(reason, sink);
     }
     if (goal_ != DeviceGoal::FaultReset) safe_outputs();
     // A new fault situation: read PNU 944 -> 947 -> 944 [§18.2, §24 step 12].
@@ -134,8 +134,8 @@ void ProfidriveMaster::track_state(core::ControllerSink& sink) noexcept {
     // Not commanded: hardware enable or STO, a local stop, another master.
     core::Text reason;
     reason.format("drive left S4 on its own (now %s): hardware enable or STO?", state_name(s));
-    fail_slot(motion_.slot, reason.view(), sink);
-    fail_slot(halt_slot_, reason.view(), sink);
+    motion_.slot.fail(reason.view(), sink);
+    halt_slot_.fail(reason.view(), sink);
     safe_outputs();
   }
 }
@@ -190,7 +190,7 @@ void ProfidriveMaster::run_device(core::TimePoint now, core::ControllerSink& sin
   if (done) {
     goal_ = DeviceGoal::Hold;
     device_stw1_ = hold_stw1_;
-    complete_slot(device_slot_, sink);
+    device_slot_.complete(sink);
     return;
   }
   const core::Duration limit = state_.stopping ? settings_.stop_timeout : settings_.step_timeout;
@@ -198,7 +198,7 @@ void ProfidriveMaster::run_device(core::TimePoint now, core::ControllerSink& sin
   failure_.format("%s: drive stayed in %s for %lld ms under STW1 0x%04X, waiting for %s (ZSW1 0x%04X)",
                   core::to_string(device_slot_.kind).data(), state_name(state_), ms(now - step_since_),
                   static_cast<unsigned>(device_stw1_), step, static_cast<unsigned>(actual_.zsw1));
-  fail_slot(device_slot_, failure_.view(), sink);
+  device_slot_.fail(failure_.view(), sink);
   if (goal_ == DeviceGoal::Enable) {
     safe_outputs();  // a half-finished walk is taken back, not left where it stopped
   } else {
