@@ -1,11 +1,12 @@
 // GSDML files: the reader on tests/config/gsdml/drivegate-test-io.xml (a small file written for
-// these tests) and broken variants with their exact messages.
+// these tests), broken variants with their exact messages, and `gsdml:` of an IO device entry.
 #include <gtest/gtest.h>
 
 #include <fstream>
 #include <sstream>
 
 #include "config/profinet/gsdml.hpp"
+#include "config/profinet/plan.hpp"
 #include "tests/config/test_support.hpp"
 
 namespace drivegate::config {
@@ -105,6 +106,60 @@ TEST(ProfinetGsdml, AMissingFileIsReported) {
   EXPECT_FALSE(load_gsdml(kDir + "/nope.xml", problems).has_value());
   ASSERT_EQ(problems.errors().size(), 1U);
   EXPECT_NE(problems.errors()[0].to_string().find("nope.xml"), std::string::npos) << problems.errors()[0].to_string();
+}
+
+class ProfinetGsdmlConfig : public test::TempDir {
+ protected:
+  std::string config(const std::string& io) const {
+    return R"(gateway: { name: cell }
+buses:
+  - name: pn0
+    type: profinet
+    cycle_time: 1ms
+    options: { interface: eth1 }
+    devices:
+      - { station: io-block, ip: 192.168.0.20 }
+    io:
+)" + io;
+  }
+};
+
+TEST_F(ProfinetGsdmlConfig, IoDevicesTakeIdentsAndLengthsFromTheGsdml) {
+  const auto file = write("cell.yaml", config("      - { name: panel, station: io-block, gsdml: " + kFile +
+                                              ", slots: [{ slot: 1, module: AIO_2 }, { slot: 3, module: DO_8 }] }\n"));
+  const Plan p = load_plan(file.string(), test::test_options());
+  const auto& io = p.buses[0].section<ProfinetBusOptions>().io.at(0);
+  EXPECT_EQ(io.dap_ident, 0x100U);
+  EXPECT_EQ(io.gsdml, kFile);
+  ASSERT_EQ(io.submodules.size(), 3U);
+  EXPECT_EQ(io.submodules[0].slot, 1);
+  EXPECT_EQ(io.submodules[0].subslot, 1);
+  EXPECT_EQ(io.submodules[0].module_ident, 0x230U);
+  EXPECT_EQ(io.submodules[0].submodule_ident, 0x21U);
+  EXPECT_EQ(io.submodules[0].input_bytes, 7);
+  EXPECT_EQ(io.submodules[1].subslot, 2);
+  EXPECT_EQ(io.submodules[1].output_bytes, 8);
+  EXPECT_EQ(io.submodules[2].slot, 3);
+  EXPECT_EQ(io.submodules[2].gsdml_id, "DO_8");
+}
+
+TEST_F(ProfinetGsdmlConfig, GsdmlProblemsAreReported) {
+  write("broken.xml", "<ISO15745Profile>\n<ProfileBody>\n");
+  const auto file = write("cell.yaml", config(
+      "      - { name: a, station: io-block, gsdml: broken.xml, slots: [{ slot: 1, module_ident: 1, submodule_ident: 1 }] }\n"
+      "      - { name: b, station: io-block, gsdml: missing.xml, slots: [{ slot: 1, module_ident: 1, submodule_ident: 1 }] }\n"
+      "      - { name: c, station: io-block, gsdml: " + kFile + ", dap: DAP_2, slots: [{ slot: 1, module: DI_61 }] }\n"
+      "      - { name: d, station: io-block, gsdml: " + kFile + ", dap_ident: 1, slots: [{ slot: 1, module: DI_16, inputs: 2 }] }\n"));
+  const std::string e = test::errors_of(read(file.string()), test::test_options(), file.string());
+  EXPECT_REPORTED(e, (dir_ / "broken.xml").string() + ":2:1: not well-formed XML (parsing)");
+  EXPECT_REPORTED(e, "buses[0].io[0].gsdml: GSDML \"" + (dir_ / "broken.xml").string() + "\" has errors, listed with its file name");
+  EXPECT_REPORTED(e, "buses[0].io[1].gsdml: file \"" + (dir_ / "missing.xml").string() +
+                         "\" does not exist (relative paths start at the config file's directory)");
+  EXPECT_REPORTED(e, "buses[0].io[2].dap: the GSDML lists no device access point \"DAP_2\" (DAPs: DAP_1)");
+  EXPECT_REPORTED(e, "buses[0].io[2].slots[0].module: the GSDML lists no module \"DI_61\", did you mean \"DI_16\"? "
+                     "(modules: DI_16, DO_8, AIO_2)");
+  EXPECT_REPORTED(e, "buses[0].io[3].dap_ident: comes from the GSDML's DAP; give dap to choose one");
+  EXPECT_REPORTED(e, "buses[0].io[3].slots[0].inputs: comes from the GSDML module; give either module or the idents and lengths");
 }
 
 }  // namespace
