@@ -16,9 +16,16 @@
 //   bench_ethercat_daemon_cpu [--seconds N (default 10)] [--axes N (default 64)]
 //                             [--axes-per-bus M (default 64)] [--transport sim|raw (default sim)]
 //                             [--no-dc (the buses with distributed_clocks: false)]
+//                             [--priority P (default 0: normal scheduling)]
+//
+// --priority 1..99 runs the cycle threads (bus priority: P) and, with --transport raw, the
+// simulator under SCHED_FIFO P, as a production machine runs its cycle threads: on a machine busy
+// with other work a normally scheduled simulator answers frames late enough for the master to take
+// its slaves as lost, which measures the machine, not the gateway.
 //
 // CPU is utime + stime from /proc/PID/stat and /proc/PID/task/TID/stat over wall time, in % of one
 // core; threads grouped by name (comm), as bench_daemon_cpu does.
+#include <sched.h>
 #include <signal.h>
 #include <time.h>
 #include <unistd.h>
@@ -53,6 +60,7 @@ namespace {
 constexpr auto kCycle = 1ms;
 int g_axes_per_bus = 64;  // --axes-per-bus
 bool g_no_dc = false;     // --no-dc
+int g_priority = 0;       // --priority
 
 // A process' CPU ticks, in total and per thread (by thread id, with its name).
 struct Sample {
@@ -137,7 +145,7 @@ std::string config_text(const test::DdsIsolation& dds, int axes, const std::vect
   y << "gateway: { name: bench, dds: { domain: " << dds.domain << ", namespace: " << dds.ns << " } }\n"
     << "buses:\n";
   for (int b = 0; b < buses; ++b) {
-    y << "  - { name: ec" << b << ", type: ethercat, cycle_time: 1ms, options: { ";
+    y << "  - { name: ec" << b << ", type: ethercat, cycle_time: 1ms, priority: " << g_priority << ", options: { ";
     if (interfaces.empty()) y << "transport: sim" << dc << " } }\n";
     else y << "transport: raw, interface: " << interfaces[static_cast<std::size_t>(b)] << dc << " } }\n";
   }
@@ -190,6 +198,11 @@ struct RawRig {
       std::vector<char*> argv;
       for (const auto& x : args) argv.push_back(const_cast<char*>(x.c_str()));
       argv.push_back(nullptr);
+      if (g_priority > 0) {
+        sched_param sp{};
+        sp.sched_priority = g_priority;
+        if (::sched_setscheduler(0, SCHED_FIFO, &sp) != 0) return 126;
+      }
       ::execv(argv[0], argv.data());
       return 127;
     });
@@ -231,6 +244,7 @@ int run(int argc, char** argv) {
     if (a == "--axes") axes = std::clamp(std::atoi(argv[i + 1]), 1, 512);
     if (a == "--axes-per-bus") g_axes_per_bus = std::clamp(std::atoi(argv[i + 1]), 1, 64);
     if (a == "--transport") raw = std::string(argv[i + 1]) == "raw";
+    if (a == "--priority") g_priority = std::clamp(std::atoi(argv[i + 1]), 0, 99);
   }
   for (int i = 1; i < argc; ++i) {
     if (std::string(argv[i]) == "--no-dc") g_no_dc = true;
@@ -281,6 +295,10 @@ int run(int argc, char** argv) {
     std::printf("--no-dc: WITHOUT distributed clocks (bus option distributed_clocks: false): no DC set-up, no FRMW, "
                 "the drives run free (not SYNC0-synchronized)\n");
   }
+  if (g_priority > 0) {
+    std::printf("--priority %d: cycle threads%s under SCHED_FIFO %d\n", g_priority, raw ? " and drivegate-sim" : "",
+                g_priority);
+  }
   std::printf("drivegated pid %d (for top -H -p PID while it runs)\n", static_cast<int>(daemon.pid()));
   std::fflush(stdout);
   const auto measure = [&](const char* phase) {
@@ -314,6 +332,7 @@ int run(int argc, char** argv) {
   std::atomic<bool> stop{false};
   std::atomic<int> errors{0};
   std::atomic<int> moves{0};
+  std::string first_refusal;  // written by the mover only, read after join()
   std::thread mover([&] {
     for (int round = 0; !stop; ++round) {
       const auto next = Clock::now() + 1500ms;
@@ -323,8 +342,12 @@ int run(int argc, char** argv) {
         m.axis = axis(i);
         m.kind = "move";
         m.position = round % 2 == 0 ? 10.0 : 0.0;
-        if (c0.send(m, false, 10s).ok()) ++moves;
-        else ++errors;
+        const auto r = c0.send(m, false, 10s);
+        if (r.ok()) {
+          ++moves;
+        } else if (errors++ == 0) {
+          first_refusal = m.axis + ": " + r.reason;
+        }
       }
       std::this_thread::sleep_until(next);
     }
@@ -334,7 +357,7 @@ int run(int argc, char** argv) {
   stop = true;
   mover.join();
   std::printf("  moves sent %d, refused %d\n", moves.load(), errors.load());
-  if (errors > 0) return fail("some moves were refused");
+  if (errors > 0) return fail("some moves were refused, the first: " + first_refusal);
   daemon.terminate(SIGTERM, 20s);
   for (const char* suffix : {"", ".log"}) std::filesystem::remove(config + suffix);
   return 0;

@@ -34,6 +34,14 @@ profinet_rpc:     PNIO DCE/RPC datagrams (UDP 34964) in both drep byte orders: C
 profinet_blocks:  the block lists (NDR args) of those datagrams, one file each.
 profinet_dcp_engines: the profinet_dcp frames as records (format in fuzz_profinet_dcp_engines.cpp),
                   one per file, and one file with them all 100 ms apart.
+profinet_alarm_engines: the profinet_alarm frames as records (format in
+                  fuzz_profinet_alarm_engines.cpp), one per file, and one file with them all.
+profinet_rt_consumer: records of input frames (format in fuzz_profinet_rt_consumer.cpp): cycles on
+                  time, repeated and old counters, silence past the data hold time and a re-arm,
+                  STOP / invalid / backup / Ignore, another source, FrameID and C_SDU length.
+profinet_sim_device: records for the simulated IO device (format in fuzz_profinet_sim_device.cpp):
+                  the profinet_dcp frames, the profinet_rpc requests to its server port, an
+                  enable by STW1, each fault, and one file with all of them.
 """
 import struct
 import pathlib
@@ -359,6 +367,27 @@ def profinet_seeds():
     }
     for name, data in seeds.items():
         write("profinet_alarm", name, data)
+    records = {name: bytes([10]) + struct.pack(">H", len(data)) + data for name, data in seeds.items()}
+    for name, data in records.items():
+        write("profinet_alarm_engines", name, data)
+    write("profinet_alarm_engines", "all", b"".join(records.values()))
+
+    # The consumer's input CR 8002h from the device: every IOxS and data octet 80h, DataStatus
+    # 35h (primary, valid, RUN, station ok), one frame per 2 ms period (cycle counter + 64).
+    def rt_in(cycle, status=0x35, src=PN_DEVICE, frame_id=0x8002, c_sdu=40):
+        return pn_frame(PN_CONTROLLER, src, frame_id, bytes([0x80]) * c_sdu + struct.pack(">HBB", cycle, status, 0), prio=6)
+
+    def rec(step, frame):
+        return bytes([step]) + struct.pack(">H", len(frame)) + frame
+
+    cycles = b"".join(rec(4, rt_in(64 * i)) for i in range(1, 11))
+    write("profinet_rt_consumer", "cycles", cycles)
+    write("profinet_rt_consumer", "repeated_and_old", rec(4, rt_in(640)) + rec(0, rt_in(640)) + rec(4, rt_in(576)))
+    write("profinet_rt_consumer", "timeout_rearm", cycles + rec(20, rt_in(2000)) + rec(0xFF, rt_in(2064)) + rec(4, rt_in(2128)))
+    write("profinet_rt_consumer", "stop_invalid_backup",
+          rec(4, rt_in(64, 0x25)) + rec(4, rt_in(128, 0x31)) + rec(4, rt_in(192, 0x34)) + rec(4, rt_in(256, 0x35 | 0x80)))
+    write("profinet_rt_consumer", "foreign",
+          rec(4, rt_in(64, src=bytes(6))) + rec(4, rt_in(64, frame_id=0x8003)) + rec(4, rt_in(64, c_sdu=20)))
 
 
 # ---- PROFINET connection management (IEC 61158-6-10; DCE 1.1 RPC ch. 12) -------------------
@@ -479,9 +508,29 @@ def profinet_rpc_seeds():
         write("profinet_blocks", n, d)
 
 
+def profinet_sim_device_seeds():
+    def record(kind, step, body):
+        return bytes([kind, step]) + struct.pack(">H", len(body)) + body
+
+    records = {}
+    for name in ("identify_all", "identify_name", "set_ip", "set_name", "signal", "get_request", "lying_length"):
+        records["dcp_" + name] = record(0, 10, (CORPUS / "profinet_dcp" / name).read_bytes())
+    for name in ("connect_request_le", "connect_request_be", "write_request_pnu930", "read_request_im0",
+                 "control_prm_end", "ping", "truncated"):
+        records["rpc_" + name] = record(1, 10, (CORPUS / "profinet_rpc" / name).read_bytes())
+    records["ready_answer"] = record(2, 1, (CORPUS / "profinet_rpc" / "release_response").read_bytes())
+    records["enable"] = record(4, 16, bytes.fromhex("047E")) + record(4, 32, bytes.fromhex("047F"))
+    for n, what in enumerate(("power_loss", "power_return", "abort", "lose_rx", "lose_tx", "drive_fault")):
+        records["fault_" + what] = record(3, 20, bytes([n + 6 * 2, 0x01, 0xF5]))
+    for name, data in records.items():
+        write("profinet_sim_device", name, data)
+    write("profinet_sim_device", "all", b"".join(records.values()))
+
+
 if __name__ == "__main__":
     profinet_seeds()
     profinet_rpc_seeds()
+    profinet_sim_device_seeds()
     ethercat_sim_seeds()
     ethercat_frame_seeds()
     ethercat_mailbox_seeds()

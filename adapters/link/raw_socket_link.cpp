@@ -5,6 +5,7 @@
 #include <linux/if_arp.h>
 #include <linux/if_ether.h>
 #include <sys/ioctl.h>
+#include <sys/mman.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -43,6 +44,11 @@ std::string link_type_name(unsigned type) {
     default: return "ARPHRD " + std::to_string(type);
   }
 }
+
+// Where a ring slot's sockaddr_ll starts: after the TPACKET_V2 header, aligned to
+// TPACKET_ALIGNMENT (the kernel's TPACKET_ALIGN, written without its signed mask).
+constexpr std::size_t kRingAddressOffset =
+    (sizeof(tpacket2_hdr) + TPACKET_ALIGNMENT - 1) / TPACKET_ALIGNMENT * TPACKET_ALIGNMENT;
 
 bool is_link_error(int e) noexcept { return e == ENETDOWN || e == ENXIO || e == ENODEV || e == ENETUNREACH; }
 
@@ -154,10 +160,13 @@ void RawSocketLink::open() {
     }
   }
 
+  if (options_.receive_ring) (void)map_ring(fd.get());  // else, or refused: recvmmsg
+
   fd_ = fd.get();
   if (!bind_to(index)) {
     const int e = errno;
     fd_ = -1;
+    unmap_ring();
     if (e == ENETDOWN) fail(interface_down_text(name));
     if (e == ENODEV || e == ENXIO) fail(no_interface_text(name, rules_.peers));
     fail("cannot bind to '" + name + "' (bind: " + errno_text(e) + ")");
@@ -195,7 +204,48 @@ bool RawSocketLink::bind_to(int ifindex) noexcept {
   return true;
 }
 
+bool RawSocketLink::map_ring(int fd) noexcept {
+  // Slots of 2048 bytes hold the TPACKET_V2 header, the address and a whole frame of 1514 bytes
+  // with room to spare (a longer one arrives cut: tp_snaplen < tp_len, dropped as too long); blocks
+  // of 64 KiB, as many as receive_buffer_bytes asks for (at least one).
+  constexpr std::size_t kFrameSize = 2048;
+  constexpr std::size_t kBlockSize = 1U << 16;
+  const std::size_t blocks =
+      std::max<std::size_t>(1, static_cast<std::size_t>(std::max(options_.receive_buffer_bytes, 0)) / kBlockSize);
+  int version = TPACKET_V2;
+  if (::setsockopt(fd, SOL_PACKET, PACKET_VERSION, &version, sizeof version) != 0) return false;
+  tpacket_req req{};
+  req.tp_block_size = kBlockSize;
+  req.tp_block_nr = static_cast<unsigned>(blocks);
+  req.tp_frame_size = kFrameSize;
+  req.tp_frame_nr = static_cast<unsigned>(blocks * (kBlockSize / kFrameSize));
+  if (::setsockopt(fd, SOL_PACKET, PACKET_RX_RING, &req, sizeof req) != 0) return false;
+  const std::size_t bytes = blocks * kBlockSize;
+  void* m = ::mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
+  if (m == MAP_FAILED) {
+    // Without the mapping the ring must go, or frames would queue where recvmmsg cannot see them.
+    tpacket_req none{};
+    (void)::setsockopt(fd, SOL_PACKET, PACKET_RX_RING, &none, sizeof none);
+    return false;
+  }
+  ring_ = static_cast<std::uint8_t*>(m);
+  ring_bytes_ = bytes;
+  frame_size_ = kFrameSize;
+  frame_count_ = req.tp_frame_nr;
+  next_frame_ = 0;
+  return true;
+}
+
+void RawSocketLink::unmap_ring() noexcept {
+  if (ring_ != nullptr) ::munmap(ring_, ring_bytes_);
+  ring_ = nullptr;
+  ring_bytes_ = 0;
+  frame_count_ = 0;
+  next_frame_ = 0;
+}
+
 void RawSocketLink::close() noexcept {
+  unmap_ring();  // before the socket: the mapping holds the ring
   if (fd_ >= 0) ::close(fd_);
   fd_ = -1;
   bound_ = false;
@@ -323,6 +373,54 @@ SendResult RawSocketLink::send(std::span<const FrameView> frames) noexcept {
 
 std::size_t RawSocketLink::receive(std::span<FrameBuffer> out) noexcept {
   if (fd_ < 0) return 0;
+  return ring_ != nullptr ? receive_ring(out) : receive_calls(out);
+}
+
+bool RawSocketLink::accept(FrameBuffer& slot, std::size_t length, bool truncated) noexcept {
+  const FrameCheck c = truncated ? FrameCheck::TooLong : check_frame({slot.bytes.data(), length}, rules_);
+  if (c != FrameCheck::Ok) {
+    counters_.count_drop(c);
+    return false;
+  }
+  slot.size = length;
+  return true;
+}
+
+std::size_t RawSocketLink::receive_ring(std::span<FrameBuffer> out) noexcept {
+  std::size_t n = 0;
+  while (n < out.size()) {
+    auto* h = reinterpret_cast<tpacket2_hdr*>(ring_ + next_frame_ * frame_size_);
+    // The slot is ours once the kernel set TP_STATUS_USER; acquire pairs with the kernel's
+    // barrier before it publishes the status, so the frame's bytes are complete.
+    const std::uint32_t status = __atomic_load_n(&h->tp_status, __ATOMIC_ACQUIRE);
+    if ((status & TP_STATUS_USER) == 0) break;
+    const auto* from = reinterpret_cast<const sockaddr_ll*>(reinterpret_cast<const std::uint8_t*>(h) + kRingAddressOffset);
+    if (from->sll_pkttype == PACKET_OUTGOING) {  // fallback for kernels before 4.20
+      counters_.rx_own.add();
+    } else {
+      FrameBuffer& slot = out[n];
+      std::size_t length = h->tp_snaplen;
+      bool truncated = h->tp_len > h->tp_snaplen || length > kMaxUntaggedFrameBytes;
+      if (!truncated) std::memcpy(slot.bytes.data(), reinterpret_cast<const std::uint8_t*>(h) + h->tp_mac, length);
+      bool tag_ok = true;
+      if (!truncated && rules_.vlan_tags && (status & TP_STATUS_VLAN_VALID) != 0) {
+        const std::uint16_t tpid = (status & TP_STATUS_VLAN_TPID_VALID) != 0 ? h->tp_vlan_tpid : kVlanTpid;
+        tag_ok = insert_tag(tpid, h->tp_vlan_tci, slot.bytes.data(), length);
+      }
+      if (!tag_ok) {
+        counters_.count_drop(FrameCheck::WrongEtherType);
+      } else if (accept(slot, length, truncated)) {
+        ++n;
+      }
+    }
+    __atomic_store_n(&h->tp_status, TP_STATUS_KERNEL, __ATOMIC_RELEASE);  // the slot back to the kernel
+    next_frame_ = next_frame_ + 1 == frame_count_ ? 0 : next_frame_ + 1;
+  }
+  counters_.rx_frames.add(n);
+  return n;
+}
+
+std::size_t RawSocketLink::receive_calls(std::span<FrameBuffer> out) noexcept {
   std::size_t n = 0;
   while (n < out.size()) {
     const std::size_t want = std::min(out.size() - n, kLinkBatch);
@@ -355,14 +453,11 @@ std::size_t RawSocketLink::receive(std::span<FrameBuffer> out) noexcept {
       }
       FrameBuffer& slot = out[n + i];
       const bool truncated = (m.msg_flags & MSG_TRUNC) != 0 || length > rx_iov_[i].iov_len;
-      const FrameCheck c = truncated ? FrameCheck::TooLong
-                           : rules_.vlan_tags && !restore_tag(m, slot.bytes.data(), length)
-                               ? FrameCheck::WrongEtherType
-                               : check_frame({slot.bytes.data(), length}, rules_);
-      if (c != FrameCheck::Ok) {
-        counters_.count_drop(c);
+      if (!truncated && rules_.vlan_tags && !restore_tag(m, slot.bytes.data(), length)) {
+        counters_.count_drop(FrameCheck::WrongEtherType);
         continue;
       }
+      if (!accept(slot, length, truncated)) continue;
       if (n + i != kept) std::memcpy(out[kept].bytes.data(), slot.bytes.data(), length);  // close a gap left by a drop
       out[kept].size = length;
       ++kept;
@@ -381,16 +476,21 @@ bool RawSocketLink::restore_tag(const msghdr& m, std::uint8_t* frame, std::size_
     if (c->cmsg_level != SOL_PACKET || c->cmsg_type != PACKET_AUXDATA) continue;
     tpacket_auxdata aux{};
     std::memcpy(&aux, CMSG_DATA(c), sizeof aux);
-    if ((aux.tp_status & TP_STATUS_VLAN_VALID) == 0 || length < kEtherTypeOffset) return true;
+    if ((aux.tp_status & TP_STATUS_VLAN_VALID) == 0) return true;
     const std::uint16_t tpid = (aux.tp_status & TP_STATUS_VLAN_TPID_VALID) != 0 ? aux.tp_vlan_tpid : kVlanTpid;
-    if (tpid != kVlanTpid) return false;
-    std::memmove(frame + kEtherTypeOffset + kVlanTagBytes, frame + kEtherTypeOffset, length - kEtherTypeOffset);
-    const std::span<std::uint8_t> tag(frame + kEtherTypeOffset, kVlanTagBytes);
-    core::put_be16(tag, 0, kVlanTpid);
-    core::put_be16(tag, 2, aux.tp_vlan_tci);
-    length += kVlanTagBytes;
-    return true;
+    return insert_tag(tpid, aux.tp_vlan_tci, frame, length);
   }
+  return true;
+}
+
+bool RawSocketLink::insert_tag(std::uint16_t tpid, std::uint16_t tci, std::uint8_t* frame, std::size_t& length) noexcept {
+  if (tpid != kVlanTpid) return false;
+  if (length < kEtherTypeOffset) return true;  // too short to carry one: check_frame() refuses it
+  std::memmove(frame + kEtherTypeOffset + kVlanTagBytes, frame + kEtherTypeOffset, length - kEtherTypeOffset);
+  const std::span<std::uint8_t> tag(frame + kEtherTypeOffset, kVlanTagBytes);
+  core::put_be16(tag, 0, kVlanTpid);
+  core::put_be16(tag, 2, tci);
+  length += kVlanTagBytes;
   return true;
 }
 

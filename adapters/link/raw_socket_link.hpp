@@ -6,8 +6,12 @@
 //   shows the frames other local senders put out on the port only to sockets bound to every
 //   EtherType; PACKET_IGNORE_OUTGOING (Linux 4.20+) keeps those away too, and without it (older
 //   kernels) receive() drops what the kernel marks PACKET_OUTGOING and counts it (rx_own).
-// - I/O is batched: send() writes up to kLinkBatch frames per sendmmsg, receive() reads up to
-//   kLinkBatch per recvmmsg straight into the caller's FrameBuffers.
+// - I/O is batched: send() writes up to kLinkBatch frames per sendmmsg. receive() takes the frames
+//   from a receive ring the kernel fills in memory shared with the process (PACKET_RX_RING,
+//   TPACKET_V2): no system call per cycle, only a look at the next slot's status word, and one
+//   copy into the caller's FrameBuffer. Without the ring (RawSocketOptions::receive_ring false, or
+//   a kernel that refuses it) it reads up to kLinkBatch per recvmmsg. Both paths check, restore
+//   tags and count alike.
 // - The link going down is a state, not an error: poll_state() reads the interface flags through
 //   the socket (so in the socket's network namespace) at most once per check interval, and at once
 //   after ENETDOWN/ENXIO from a send or receive. An interface that went down and up keeps the socket
@@ -54,6 +58,9 @@ struct RawSocketOptions {
   // counted: for diagnosis, and for tests of the drop counters. Costs a copy of every frame on the
   // port.
   bool all_ethertypes = false;
+  // Receive through a PACKET_RX_RING of receive_buffer_bytes (rounded to whole blocks) instead of
+  // recvmmsg. A kernel that refuses the ring gets recvmmsg (receive_ring() says which).
+  bool receive_ring = true;
 };
 
 // Not final: a protocol may name its own with its rules built in (ethercat::RawSocketLink).
@@ -83,6 +90,8 @@ class RawSocketLink : public Link {
 
   // Whether the kernel took PACKET_IGNORE_OUTGOING (false: the pkttype fallback drops own frames).
   [[nodiscard]] bool ignores_outgoing() const noexcept { return ignore_outgoing_; }
+  // Whether receive() reads the PACKET_RX_RING (false: recvmmsg).
+  [[nodiscard]] bool receive_ring() const noexcept { return ring_ != nullptr; }
 
  private:
   // Reads the interface's index and flags through the socket, binds again when the interface came
@@ -95,6 +104,16 @@ class RawSocketLink : public Link {
   // Puts the tag the kernel reported in m's control data back into `frame` (`length` grows by the
   // tag); false when the tag's TPID is not 8100h. A frame that came untagged stays as it is.
   static bool restore_tag(const msghdr& m, std::uint8_t* frame, std::size_t& length) noexcept;
+  // Puts a tag back in front of the EtherType: `tci`, and `tpid` (false when it is not 8100h).
+  static bool insert_tag(std::uint16_t tpid, std::uint16_t tci, std::uint8_t* frame, std::size_t& length) noexcept;
+  // Sets up the receive ring on `fd` (before bind); false when the kernel refuses it.
+  bool map_ring(int fd) noexcept;
+  void unmap_ring() noexcept;
+  std::size_t receive_ring(std::span<FrameBuffer> out) noexcept;
+  std::size_t receive_calls(std::span<FrameBuffer> out) noexcept;
+  // The checks of one received frame already in `slot` (`length` bytes; `truncated` when the
+  // kernel cut it): counted and false when dropped.
+  bool accept(FrameBuffer& slot, std::size_t length, bool truncated) noexcept;
   [[noreturn]] void fail(const std::string& what) const;
   void set_state(LinkState s) noexcept;
   // A send or receive error: what it says about the link (ENETDOWN, ENXIO, ENODEV) makes the next
@@ -124,6 +143,13 @@ class RawSocketLink : public Link {
     std::array<unsigned char, 64> bytes{};
   };
   std::array<Control, kLinkBatch> rx_control_{};
+
+  // The receive ring: frame_count_ slots of frame_size_ bytes in one mapping, read in order.
+  std::uint8_t* ring_ = nullptr;
+  std::size_t ring_bytes_ = 0;
+  std::size_t frame_size_ = 0;
+  std::size_t frame_count_ = 0;
+  std::size_t next_frame_ = 0;
 };
 
 }  // namespace drivegate::link

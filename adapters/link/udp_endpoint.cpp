@@ -76,6 +76,8 @@ void UdpEndpoint::open() {
   std::memcpy(&own, &r.ifr_addr, sizeof own);
   Ipv4Endpoint wanted = endpoint_of(own);
   wanted.port = options_.port;
+  const bool chosen = options_.address != std::array<std::uint8_t, 4>{};
+  if (chosen) wanted.address = options_.address;
 
   if (::setsockopt(fd.get(), SOL_SOCKET, SO_BINDTODEVICE, kernel_name.data(), static_cast<socklen_t>(name.size())) != 0) {
     const int e = errno;
@@ -105,6 +107,10 @@ void UdpEndpoint::open() {
       fail("no permission to bind " + where + ": ports below 1024 need CAP_NET_BIND_SERVICE; run as root, choose "
            "a port from 1024 on, or give the binary cap_net_bind_service, e.g. setcap cap_net_bind_service+ep " +
            own_binary());
+    }
+    if (e == EADDRNOTAVAIL && chosen) {
+      fail("address " + ipv4_text(wanted.address) + " is not on interface '" + name + "'; add it, e.g. 'ip addr add " +
+           ipv4_text(wanted.address) + "/24 dev " + name + "'");
     }
     if (e == EADDRNOTAVAIL) fail("interface '" + name + "' lost its address " + ipv4_text(wanted.address) + " while opening");
     fail("cannot bind " + where + " (bind: " + errno_text(e) + ")");

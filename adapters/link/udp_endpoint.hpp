@@ -3,7 +3,7 @@
 // management runs over it (the device side listens on UDP port 34964, the controller sends from a
 // port the kernel picks). Non-blocking, one datagram per call, owned by one thread.
 //
-// open() reads the interface's (primary) IPv4 address, binds the socket to the interface
+// open() reads the interface's (primary) IPv4 address (or takes the one the options name), binds the socket to the interface
 // (SO_BINDTODEVICE: datagrams go out on that port whatever the routing table says) and to that
 // address and port. It fails with one line each for: a name that is no interface, an interface
 // that is down, one without an IPv4 address (with the `ip addr add` that fixes it), a port in use,
@@ -15,6 +15,7 @@
 // dropped for a full receive buffer (SO_RXQ_OVFL, reported with the next datagram: rx_overflow).
 #include <netinet/in.h>
 
+#include <array>
 #include <cstdint>
 #include <string>
 
@@ -26,6 +27,9 @@ struct UdpOptions {
   std::string interface;
   // 0: a port the kernel picks (a controller's); a device side listens on its protocol's port.
   std::uint16_t port = 0;
+  // 0.0.0.0: the interface's (primary) IPv4 address; otherwise this one, which must be one of the
+  // interface's (a simulator with several devices behind one port, each on its own address).
+  std::array<std::uint8_t, 4> address{};
   // The first word of every error line ("profinet"), and what is on the other end of the cable
   // ("devices"), for the hints.
   const char* name = "";

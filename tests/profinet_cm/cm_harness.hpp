@@ -45,6 +45,7 @@ struct Packet {
 // refuses writes.
 class DriveApp final : public CmServerApp {
  public:
+  PnioStatus on_connect(const CmArSetup&) noexcept override { return {}; }
   PnioStatus on_record_write(const RecordReqHeader& h, std::span<const std::uint8_t> data) noexcept override {
     ++writes;
     if (h.index == kDeniedIndex) return {pnio_error_code::kWrite, pnio_error_decode::kPniorw, pniorw_error::kAccessDenied, 0};

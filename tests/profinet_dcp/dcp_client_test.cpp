@@ -366,5 +366,38 @@ TEST(PnDcpClient, TakeWhileInFlightDiscardsTheResult) {
   EXPECT_EQ(found[0].mac, MacAddress{});  // the answer did not go into the released array
 }
 
+TEST(PnDcpClient, BufferTooSmallFailsTheRequestSoPollingEnds) {
+  DcpClient client(kControllerMac);
+  std::array<DcpStation, 2> found{};
+  const DcpRequestId identify = client.identify_all(found, 1);
+  const DcpRequestId signal = client.signal(device_mac(7));
+  std::array<std::uint8_t, 20> tiny{};  // an Ethernet header and FrameID, no room for DCP
+  const core::TimePoint now{std::chrono::seconds(1)};
+  // A caller that polls while something is due: bounded, so a regression fails instead of hanging.
+  int polls = 0;
+  while (client.next_deadline() <= now && polls < 100) {
+    EXPECT_EQ(client.poll(now, tiny), 0U);
+    ++polls;
+  }
+  EXPECT_EQ(polls, 1);  // one poll fails both requests
+  EXPECT_TRUE(client.idle());
+  EXPECT_EQ(client.next_deadline(), core::TimePoint::max());
+  for (const DcpRequestId id : {identify, signal}) {
+    const DcpResult r = client.result(id);
+    EXPECT_EQ(r.status, DcpRequestStatus::Failed);
+    EXPECT_EQ(r.failure, DcpFailure::BufferTooSmall);
+    EXPECT_EQ(r.frames_sent, 0);
+  }
+  EXPECT_EQ(to_string(DcpFailure::BufferTooSmall),
+            "the request's frame does not fit the buffer given to poll() (not sent)");
+  EXPECT_EQ(client.counters().tx_too_small, 2U);
+  EXPECT_EQ(client.counters().failed, 2U);
+  EXPECT_EQ(client.counters().frames_sent, 0U);
+  // A buffer that fits serves the next request as usual.
+  std::array<std::uint8_t, kMaxFrameSize> out{};
+  (void)client.signal(device_mac(7));
+  EXPECT_GT(client.poll(now, out), 0U);
+}
+
 }  // namespace
 }  // namespace drivegate::profinet::test

@@ -137,5 +137,19 @@ TEST(PnStationFinder, InvalidConfigsAreRefusedWithoutTraffic) {
   EXPECT_EQ(line.hub.log.size(), 1U);  // only d4's Identify
 }
 
+TEST(PnStationFinder, IdentifyThatCannotBeSentIsReportedWithItsCause) {
+  DcpClient client(kControllerMac);
+  StationFinder finder(client, {station("x1", 10), station("x2", 11)});
+  std::array<std::uint8_t, 20> tiny{};
+  EXPECT_EQ(finder.poll(core::TimePoint{}, tiny), 0U);
+  ASSERT_TRUE(finder.done());
+  for (const StationReport& r : finder.reports()) {
+    EXPECT_EQ(r.outcome, StationOutcome::Missing);
+    EXPECT_NE(r.text.find("DCP Identify failed: the request's frame does not fit the buffer given to poll()"),
+              std::string::npos)
+        << r.text;
+  }
+}
+
 }  // namespace
 }  // namespace drivegate::profinet::test

@@ -25,10 +25,11 @@ using namespace std::chrono_literals;
 class ProfinetRawLinkTest : public test::VethTest {
  protected:
   static std::unique_ptr<link::RawSocketLink> open_in(const NetNamespace& ns, const std::string& iface,
-                                                      bool all_ethertypes = false) {
+                                                      bool all_ethertypes = false, bool receive_ring = true) {
     link::RawSocketOptions o;
     o.interface = iface;
     o.all_ethertypes = all_ethertypes;
+    o.receive_ring = receive_ring;
     auto l = std::make_unique<link::RawSocketLink>(kFrameRules, o);
     const NetnsScope in(ns);
     l->open();
@@ -100,6 +101,32 @@ TEST_F(ProfinetRawLinkTest, TaggedAndUntaggedFramesArriveAsSentOthersDoNot) {
   EXPECT_EQ(device->receive(in), 0U);
   EXPECT_EQ(device->counters().rx_frames, 5U);
   EXPECT_EQ(device->counters().rx_wrong_ethertype, 0U);
+}
+
+TEST_F(ProfinetRawLinkTest, TagsComeBackOnBothReceivePaths) {
+  // The receive ring reads the tag from its slot header, recvmmsg from PACKET_AUXDATA: the same
+  // frames come up either way.
+  auto controller = open_in(*ns_a_, veth_->a());
+  const auto cyclic = make_frame(0x8001, true, 60, kPriorityRtCyclic);
+  const auto in_vlan = make_frame(0x8002, true, 60, kPriorityRtCyclic, 5);
+  const auto dcp = make_frame(frame_id::kDcpIdentifyRequest, false, 60);
+  const auto longest = make_frame(0x8003, true, link::kMaxFrameBytes);
+  const auto ipv4_tagged = make_frame(0x8004, true, 60, kPriorityRtCyclic, 0, 0x0800);
+  const std::array<FrameView, 5> frames{FrameView(cyclic), FrameView(ipv4_tagged), FrameView(in_vlan), FrameView(dcp),
+                                        FrameView(longest)};
+  for (const bool ring : {true, false}) {
+    SCOPED_TRACE(ring ? "receive ring" : "recvmmsg");
+    auto device = open_in(*ns_b_, veth_->b(), false, ring);
+    EXPECT_EQ(device->receive_ring(), ring);
+    EXPECT_EQ(controller->send(frames).sent, frames.size());
+    const auto got = receive(*device, 4);
+    ASSERT_EQ(got.size(), 4U);
+    EXPECT_EQ(got[0], cyclic);
+    EXPECT_EQ(got[1], in_vlan);
+    EXPECT_EQ(got[2], dcp);
+    EXPECT_EQ(got[3], longest);
+    EXPECT_EQ(device->counters().rx_wrong_ethertype, 0U);
+  }
 }
 
 TEST_F(ProfinetRawLinkTest, SendRefusesFramesTooLongForTheirTag) {

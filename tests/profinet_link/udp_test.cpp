@@ -95,6 +95,25 @@ TEST_F(ProfinetUdpTest, ControllerAndDeviceExchangeDatagramsWithTheirSources) {
   EXPECT_EQ(controller->send_to(kDeviceAddress, {}), DatagramStatus::Invalid);
 }
 
+TEST_F(ProfinetUdpTest, SecondAddressOfTheInterfaceIsBoundWhenAsked) {
+  ASSERT_TRUE(ns_b_->ip({"addr", "add", "10.77.0.3/24", "dev", veth_->b()}).ok());
+  link::UdpOptions o = rpc_udp_options(veth_->b(), kRpcUdpPort);
+  o.address = {10, 77, 0, 3};
+  auto second = open_in(*ns_b_, o);
+  auto first = open_in(*ns_b_, rpc_udp_options(veth_->b(), kRpcUdpPort));  // the same port on the primary
+  EXPECT_EQ(second->local(), (Ipv4Endpoint{{10, 77, 0, 3}, kRpcUdpPort}));
+  auto controller = open_in(*ns_a_, rpc_udp_options(veth_->a()));
+  const std::vector<std::uint8_t> hello{1, 2, 3};
+  EXPECT_EQ(controller->send_to(second->local(), hello), DatagramStatus::Sent);
+  link::Datagram in;
+  ASSERT_TRUE(receive(*second, in));
+  EXPECT_EQ(in.from, controller->local());
+  EXPECT_FALSE(first->receive_from(in));
+  o.address = {10, 77, 0, 9};
+  EXPECT_EQ(open_error(*ns_b_, o), "profinet: address 10.77.0.9 is not on interface '" + veth_->b() +
+                                       "'; add it, e.g. 'ip addr add 10.77.0.9/24 dev " + veth_->b() + "'");
+}
+
 TEST_F(ProfinetUdpTest, OpenSaysWhatIsWrongInOneLine) {
   EXPECT_EQ(open_error(*ns_a_, rpc_udp_options("dgtnosuch0")),
             "profinet: no network interface 'dgtnosuch0'; give the name of the Ethernet port the devices are on");

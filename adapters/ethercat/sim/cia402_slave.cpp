@@ -433,6 +433,7 @@ Cia402Slave::Resolved Cia402Slave::resolve(ObjectId id) const noexcept {
   r.type = type_of(id);
   r.access = access_of(id);
   r.model_type = axes_[r.at.axis].model->dictionary().type_of(r.at.local);
+  r.model_value = axes_[r.at.axis].model->dictionary().value_address(r.at.local);
   r.vendor = vendor_object(id);
   r.hidden = hidden(id);
   r.ignored = ignored(id);
@@ -486,8 +487,8 @@ Cia402Slave::Value Cia402Slave::get(const Resolved& r) const noexcept {
     } else {
       value = vendor_.get(id).value_or(0);
     }
-  } else {
-    value = axis.model->dictionary().get(at.local).value_or(0);
+  } else if (r.model_value != nullptr) {
+    value = *r.model_value;
   }
   if (at.local == kControlword) value = from_model_controlword(axis, static_cast<std::uint16_t>(value));
   // ESR: no "ip mode active" bit in ip (quirk 7).

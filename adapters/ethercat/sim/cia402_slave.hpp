@@ -189,6 +189,7 @@ class Cia402Slave final : public SlaveApplication, private ObjectDictionary {
     std::optional<cia402::DataType> type;        // type_of()
     std::optional<cia402::sim::Access> access;   // access_of()
     std::optional<cia402::DataType> model_type;  // the axis model dictionary's own type
+    const std::int64_t* model_value = nullptr;   // where that dictionary keeps the value
     const EcatVendorObject* vendor = nullptr;
     bool hidden = false;
     bool ignored = false;

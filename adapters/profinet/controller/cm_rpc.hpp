@@ -124,6 +124,8 @@ class RpcCall {
   void cancel() noexcept { busy_ = false; }
   [[nodiscard]] bool busy() const noexcept { return busy_; }
   [[nodiscard]] const RpcHeader& request() const noexcept { return header_; }
+  // When poll() sends again or gives up; TimePoint::max() while no call runs.
+  [[nodiscard]] core::TimePoint next_deadline() const noexcept { return busy_ ? next_ : core::TimePoint::max(); }
 
   Event poll(core::TimePoint now, CmOutbox& out) noexcept;
   // A decoded datagram from the call's peer socket. Answers to another activity count as

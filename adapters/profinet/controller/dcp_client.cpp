@@ -42,6 +42,7 @@ std::string_view to_string(DcpFailure f) noexcept {
     case DcpFailure::BlockError: return "the device refused the value (BlockError)";
     case DcpFailure::NotSupported: return "the device answered \"request not supported\"";
     case DcpFailure::BadResponse: return "the Set response has no result for the block sent";
+    case DcpFailure::BufferTooSmall: return "the request's frame does not fit the buffer given to poll() (not sent)";
   }
   return "?";
 }
@@ -234,8 +235,11 @@ std::size_t DcpClient::poll(core::TimePoint now, std::span<std::uint8_t> out) no
     }
     const std::size_t n = encode(*s, out);
     if (n == 0) {
+      // Kept due, the same frame would not fit the next poll() either: the request ends here,
+      // as RtProvider drops a slot it cannot write.
       ++counters_.tx_too_small;
-      return 0;
+      finish(*s, DcpFailure::BufferTooSmall);
+      continue;
     }
     ++s->result.frames_sent;
     ++counters_.frames_sent;

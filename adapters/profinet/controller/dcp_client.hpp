@@ -82,6 +82,7 @@ enum class DcpFailure : std::uint8_t {
   BlockError,      // the device answered with a BlockError (DcpResult::block_error)
   NotSupported,    // the device answered ServiceType "request not supported"
   BadResponse,     // the device answered with a Set response without our block's result
+  BufferTooSmall,  // poll() was given a buffer shorter than the request's frame: never sent
 };
 std::string_view to_string(DcpFailure f) noexcept;
 
@@ -110,7 +111,7 @@ struct DcpClientCounters {
   std::uint64_t not_for_us = 0;         // a response addressed to another MAC
   std::uint64_t requests_seen = 0;      // DCP requests and Hellos (not for a controller)
   std::uint64_t malformed = 0;          // did not decode (Ethernet or DCP)
-  std::uint64_t tx_too_small = 0;       // poll() was given a buffer shorter than the frame
+  std::uint64_t tx_too_small = 0;       // poll() was given a buffer shorter than the frame (request failed)
 };
 
 class DcpClient {
@@ -136,7 +137,9 @@ class DcpClient {
   DcpResult take(DcpRequestId id) noexcept;
 
   // Engine interface. poll() writes at most one frame into `out` and returns its length (0: none
-  // due); call it until it returns 0. It also closes Identify windows and times Sets out.
+  // due); call it until it returns 0. It also closes Identify windows and times Sets out. A frame
+  // that does not fit `out` fails its request (BufferTooSmall) instead of staying due, so a
+  // caller's loop on poll() or next_deadline() ends.
   std::size_t poll(core::TimePoint now, std::span<std::uint8_t> out) noexcept;
   // True when the frame was a DCP frame (used or counted); false for other traffic.
   bool on_frame(std::span<const std::uint8_t> frame, core::TimePoint now) noexcept;

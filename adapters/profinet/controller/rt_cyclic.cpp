@@ -63,21 +63,23 @@ RtConfigError validate(const RtIocrConfig& c) noexcept {
 
 // ---- RtProvider -----------------------------------------------------------------------------------
 
-RtProvider::RtProvider(const RtIocrConfig& config) noexcept
+RtProvider::RtProvider(const RtIocrConfig& config, RtSide side) noexcept
     : period_(rt_period(config)), offset_(kSendClockUnit * config.send_clock_factor * (config.phase - 1)) {
+  const bool controller = side == RtSide::Controller;
   // In the body: the layout members are initialised after error_.
-  error_ = lay_out(config, CrDirection::Output, layout_, placements_, submodule_count_);
+  error_ = lay_out(config, controller ? CrDirection::Output : CrDirection::Input, layout_, placements_,
+                   submodule_count_);
   if (!ok()) return;
   EthernetHeader h;
-  h.dst = config.device_mac;
-  h.src = config.controller_mac;
+  h.dst = controller ? config.device_mac : config.controller_mac;
+  h.src = controller ? config.controller_mac : config.device_mac;
   h.vlan = true;
   h.priority = kPriorityRtCyclic;
   h.frame_id = config.frame_id;
   pdu_offset_ = encode_ethernet_header(h, frame_);
   frame_size_ = pdu_offset_ + layout_.length + kApduStatusSize;  // over 60: the C_SDU is at least 40
   for (std::size_t i = 0; i < submodule_count_; ++i) {
-    (void)set_iops(i, iox_status::kBadByController);
+    (void)set_iops(i, controller ? iox_status::kBadByController : iox_status::kBadByDevice);
     (void)set_iocs(i, iox_status::kGood);
   }
 }
@@ -138,9 +140,13 @@ std::string_view to_string(RtConsumerState s) noexcept {
   return "unknown";
 }
 
-RtConsumer::RtConsumer(const RtIocrConfig& config) noexcept
-    : frame_id_(config.frame_id), device_mac_(config.device_mac), data_hold_(rt_data_hold_time(config)) {
-  error_ = lay_out(config, CrDirection::Input, layout_, placements_, submodule_count_);
+RtConsumer::RtConsumer(const RtIocrConfig& config, RtSide side) noexcept
+    : side_(side),
+      frame_id_(config.frame_id),
+      peer_mac_(side == RtSide::Controller ? config.device_mac : config.controller_mac),
+      data_hold_(rt_data_hold_time(config)) {
+  error_ = lay_out(config, side == RtSide::Controller ? CrDirection::Input : CrDirection::Output, layout_,
+                   placements_, submodule_count_);
 }
 
 void RtConsumer::arm(core::TimePoint now) noexcept {
@@ -161,10 +167,13 @@ core::TimePoint RtConsumer::next_deadline() const noexcept {
 void RtConsumer::expire(core::TimePoint now) noexcept {
   ++counters_.timeouts;
   const double hold = ms(data_hold_);
+  const bool controller = side_ == RtSide::Controller;
+  const char* cr = controller ? "input" : "output";
   if (state_ == RtConsumerState::Waiting) {
-    reason_.format("no input frame 0x%04X from the device within the data hold time (%g ms)", frame_id_, hold);
+    reason_.format("no %s frame 0x%04X from the %s within the data hold time (%g ms)", cr, frame_id_,
+                   controller ? "device" : "controller", hold);
   } else {
-    reason_.format("input frame 0x%04X silent for %g ms (data hold time %g ms); last valid cycle counter %u",
+    reason_.format("%s frame 0x%04X silent for %g ms (data hold time %g ms); last valid cycle counter %u", cr,
                    frame_id_, ms(now - last_valid_), hold, static_cast<unsigned>(last_cycle_));
   }
   state_ = RtConsumerState::Timeout;
@@ -187,7 +196,7 @@ bool RtConsumer::on_frame(std::span<const std::uint8_t> frame, core::TimePoint n
     ++counters_.wrong_frame_id;
     return false;
   }
-  if (e.header.src != device_mac_) {
+  if (e.header.src != peer_mac_) {
     ++counters_.wrong_source;
     return true;
   }

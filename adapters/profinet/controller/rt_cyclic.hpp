@@ -25,6 +25,10 @@
 //     [IEC 61158-6-10 §4.7.2.1.2; the DHT is retriggered only by frames that may be used. A frame
 //     with DataValid clear or Ignore set passes the cycle counter check but neither retriggers the
 //     DHT nor replaces the data.]
+//
+// The same engines run the device's end of the AR (the simulator) with RtSide::Device: its
+// provider sends the input CR (device -> controller: the input data with their IOPS, the IOCS of
+// the output data) and its consumer takes the output CR from the controller's MAC.
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -75,6 +79,10 @@ constexpr core::Duration rt_period(const RtIocrConfig& c) noexcept {
 }
 constexpr core::Duration rt_data_hold_time(const RtIocrConfig& c) noexcept { return rt_period(c) * c.data_hold_factor; }
 
+// Which end of the AR an engine runs: the controller provides the output CR and consumes the
+// input CR; the device the other way round.
+enum class RtSide : std::uint8_t { Controller, Device };
+
 struct RtProviderCounters {
   std::uint64_t frames_sent = 0;
   std::uint64_t missed_slots = 0;   // slots that passed without a poll() (not sent late)
@@ -83,8 +91,9 @@ struct RtProviderCounters {
 
 class RtProvider {
  public:
-  // Builds the output CR's frame; an invalid config leaves the provider inert (error()).
-  explicit RtProvider(const RtIocrConfig& config) noexcept;
+  // Builds the frame of the CR `side` provides (the controller: the output CR); an invalid config
+  // leaves the provider inert (error()).
+  explicit RtProvider(const RtIocrConfig& config, RtSide side = RtSide::Controller) noexcept;
 
   [[nodiscard]] RtConfigError error() const noexcept { return error_; }
   [[nodiscard]] bool ok() const noexcept { return error_ == RtConfigError::None; }
@@ -92,10 +101,11 @@ class RtProvider {
   [[nodiscard]] std::size_t frame_size() const noexcept { return frame_size_; }
 
   // The application's side, any time between polls. Index i names config.submodules[i].
-  // The output data of submodule i (empty when it has none).
+  // The data submodule i provides in this CR (the controller: its output data; empty when none).
   [[nodiscard]] std::span<std::uint8_t> data(std::size_t i) noexcept;
-  // IOPS of submodule i's output data / IOCS for submodule i's input data (iox_status::); false
-  // when submodule i has no such object in this CR. IOPS start bad (by controller), IOCS good.
+  // IOPS of the data submodule i provides in this CR / IOCS for the data it consumes from the
+  // other one (iox_status::); false when submodule i has no such object in this CR. IOPS start
+  // bad (by controller, or by device on the device's side), IOCS good.
   bool set_iops(std::size_t i, std::uint8_t iops) noexcept;
   bool set_iocs(std::size_t i, std::uint8_t iocs) noexcept;
   // DataStatus ProviderState RUN (true, the start) or STOP.
@@ -155,7 +165,8 @@ struct RtConsumerCounters {
 
 class RtConsumer {
  public:
-  explicit RtConsumer(const RtIocrConfig& config) noexcept;
+  // Consumes the CR the other side provides (the controller: the input CR from the device's MAC).
+  explicit RtConsumer(const RtIocrConfig& config, RtSide side = RtSide::Controller) noexcept;
 
   [[nodiscard]] RtConfigError error() const noexcept { return error_; }
   [[nodiscard]] bool ok() const noexcept { return error_ == RtConfigError::None; }
@@ -178,8 +189,11 @@ class RtConsumer {
   [[nodiscard]] std::string_view reason() const noexcept { return reason_.view(); }
   // The last valid frame's values (zeros and bad IOPS before the first one).
   [[nodiscard]] std::span<const std::uint8_t> data(std::size_t i) const noexcept;
-  [[nodiscard]] std::uint8_t iops(std::size_t i) const noexcept;  // of submodule i's input data
-  [[nodiscard]] std::uint8_t iocs(std::size_t i) const noexcept;  // the device's for submodule i's output data
+  // The provider's status of the data it sends for submodule i (the controller: of its input data).
+  [[nodiscard]] std::uint8_t iops(std::size_t i) const noexcept;
+  // The provider's status of the data we send for submodule i (the controller: the device's for
+  // its output data).
+  [[nodiscard]] std::uint8_t iocs(std::size_t i) const noexcept;
   [[nodiscard]] bool all_iops_good() const noexcept;
   [[nodiscard]] const ApduStatus& status() const noexcept { return status_; }
   [[nodiscard]] bool provider_run() const noexcept { return status_.provider_run(); }
@@ -193,8 +207,9 @@ class RtConsumer {
   void expire(core::TimePoint now) noexcept;
 
   RtConfigError error_ = RtConfigError::None;
+  RtSide side_ = RtSide::Controller;
   std::uint16_t frame_id_ = 0;
-  MacAddress device_mac_{};
+  MacAddress peer_mac_{};  // the provider's
   CsduLayout layout_{};
   std::size_t submodule_count_ = 0;
   std::array<IoPlacement, kMaxRtSubmodules> placements_{};

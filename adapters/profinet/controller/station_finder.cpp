@@ -98,6 +98,10 @@ bool StationFinder::start(std::size_t i) {
 void StationFinder::identified(std::size_t i, const DcpResult& r) {
   const StationConfig& c = stations_[i];
   StationReport& rep = reports_[i];
+  if (r.status == DcpRequestStatus::Failed) {  // never sent: nobody could answer
+    conclude(i, StationOutcome::Missing, "DCP Identify failed: " + std::string(to_string(r.failure)));
+    return;
+  }
   const std::size_t answered = r.stations + r.stations_lost;
   if (answered == 0) {
     conclude(i, StationOutcome::Missing, "no device answers to this name (DCP Identify)");

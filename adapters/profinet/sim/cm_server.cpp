@@ -48,6 +48,10 @@ void CmServer::abort(std::string_view why) noexcept {
   set_state(CmServerState::NoAr, why);
 }
 
+void CmServer::abort_ar(std::string_view why) noexcept {
+  if (state_ != CmServerState::NoAr) abort(why);
+}
+
 void CmServer::poll(core::TimePoint now, CmOutbox& out) noexcept {
   if (ready_call_.poll(now, out) == RpcCall::Event::Failed) abort(ready_call_.failure());
 }
@@ -229,12 +233,6 @@ void CmServer::on_connect(std::span<const std::uint8_t> datagram, const UdpEndpo
     }
     abort("a new Connect for the running AR");
   }
-  ++counters_.connects;
-  ar_.ar_uuid = c.ar.block.ar_uuid;
-  ar_.session_key = c.ar.block.session_key;
-  ar_.initiator_object = c.ar.block.initiator_object_uuid;
-  ar_.controller = {from.ip, config_.controller_port};
-  compare(c);
   // RT class 1: the controller may leave the FrameIDs to the device (FFFFh); then the device
   // numbers them from C000h by IOCR reference.
   auto frame_id = [](const IocrParams& p) {
@@ -242,6 +240,17 @@ void CmServer::on_connect(std::span<const std::uint8_t> datagram, const UdpEndpo
   };
   const std::array<IocrBlockRes, 2> iocrs{{{iocr_type::kInput, in->params.reference, frame_id(in->params)},
                                            {iocr_type::kOutput, outcr->params.reference, frame_id(outcr->params)}}};
+  const PnioStatus app_status = app_.on_connect({c, *in, *outcr, iocrs[0].frame_id, iocrs[1].frame_id});
+  if (!app_status.ok()) {
+    refuse(app_status);
+    return;
+  }
+  ++counters_.connects;
+  ar_.ar_uuid = c.ar.block.ar_uuid;
+  ar_.session_key = c.ar.block.session_key;
+  ar_.initiator_object = c.ar.block.initiator_object_uuid;
+  ar_.controller = {from.ip, config_.controller_port};
+  compare(c);
   ConnectResponse res;
   res.ar = {ar_type::kIocarSingle, ar_.ar_uuid, ar_.session_key, config_.mac, kEtherTypePnio};
   res.iocrs = iocrs;

@@ -6,7 +6,8 @@
 //             class 1, the AlarmCR) and its expected submodules compared with the device model:
 //             a slot the model lacks is "no module", another module ident "wrong module", a
 //             missing or other submodule "no submodule" / "wrong submodule" in the ModuleDiffBlock;
-//             the AR is set up anyway (the controller decides). A Connect for the AR UUID that
+//             the AR is set up anyway (the controller decides). The application sees the
+//             Connect first (CmServerApp::on_connect) and may refuse it. A Connect for the AR UUID that
 //             already exists aborts that AR first (the controller restarted); another AR UUID
 //             while one runs is refused with CMRPC "Out of AR Resources".
 //   records   IODWrite/IODRead for the running AR go to the CmServerApp with the API, slot,
@@ -63,9 +64,22 @@ enum class CmServerState : std::uint8_t {
 };
 std::string_view to_string(CmServerState s) noexcept;
 
+// The IOCRs of a Connect the server is about to accept, with the FrameIDs it answers.
+struct CmArSetup {
+  const ConnectRequestView& request;
+  const IocrBlockReqView& input;
+  const IocrBlockReqView& output;
+  std::uint16_t input_frame_id = 0;
+  std::uint16_t output_frame_id = 0;
+};
+
 // The simulated device's application: record contents and AR events.
 class CmServerApp {
  public:
+  // A Connect that passed the server's checks, before its expected submodules are compared with
+  // the model: the application may fit the model to it (the slots' spans it owns) and sets up its
+  // cyclic data. A status other than OK refuses the Connect with it (no AR).
+  virtual PnioStatus on_connect(const CmArSetup& setup) noexcept = 0;
   // A write for the running AR; the PNIOStatus of the answer (OK: zero).
   virtual PnioStatus on_record_write(const RecordReqHeader& h, std::span<const std::uint8_t> data) noexcept = 0;
   // A read: up to `into.size()` bytes (the controller's RecordDataLength, at most what fits one
@@ -96,6 +110,11 @@ class CmServer {
   CmServer(const CmServerConfig& config, CmServerApp& app) noexcept;
 
   void poll(core::TimePoint now, CmOutbox& out) noexcept;
+  // When poll() has something to do (the ApplicationReady call's next send or its end).
+  [[nodiscard]] core::TimePoint next_deadline() const noexcept { return ready_call_.next_deadline(); }
+  // The device ends the running AR itself (its watchdog, an injected fault): no word to the
+  // controller; abort_reason() says `why`. Nothing happens without an AR.
+  void abort_ar(std::string_view why) noexcept;
   // A datagram arrived at `socket` (Server: the controller's calls; Client: the answers to the
   // device's ApplicationReady call) from `from`.
   void on_datagram(std::span<const std::uint8_t> datagram, const UdpEndpoint& from, CmSocket socket,

@@ -147,6 +147,8 @@ std::size_t encode_rta_error(std::span<std::uint8_t> out, RtaHeader h, const Rta
 
 // ---- Alarm blocks -----------------------------------------------------------------------------
 
+const char* to_string(AlarmPriority p) noexcept { return p == AlarmPriority::High ? "high" : "low"; }
+
 std::string_view alarm_type_name(std::uint16_t type) noexcept {
   switch (type) {
     case alarm_type::kDiagnosis: return "Diagnosis";

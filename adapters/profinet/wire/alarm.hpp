@@ -30,9 +30,9 @@ namespace drivegate::profinet {
 inline constexpr std::size_t kRtaHeaderSize = 12;
 inline constexpr std::uint8_t kRtaVersion = 1;
 inline constexpr std::uint8_t kRtaWindowSize = 1;  // the only window size RTA uses
-// Sequence numbers count 0..7FFFh and wrap; before the first DATA a sender's SendSeqNum is FFFFh
-// and its AckSeqNum FFFEh, so the first DATA goes out with SendSeqNum 0 and AckSeqNum FFFFh
-// [IEC 61158-6-10, APMS/APMR initial values].
+// Sequence numbers count 0..7FFFh and wrap; a sender starts with SendSeqNum FFFFh and AckSeqNum
+// FFFEh, so its first DATA goes out numbered FFFFh, the next 0 [IEC 61158-6-10, APMS/APMR initial
+// values; the numbering of the first DATA as p-net's pf_alarm.c does it, controller/rta_endpoint.hpp].
 inline constexpr std::uint16_t kRtaSeqMax = 0x7FFF;
 inline constexpr std::uint16_t kRtaInitialSendSeq = 0xFFFF;
 inline constexpr std::uint16_t kRtaInitialAckSeq = 0xFFFE;
@@ -117,6 +117,7 @@ inline constexpr std::uint16_t kAckLow = 0x8002;
 }  // namespace alarm_block
 
 enum class AlarmPriority : std::uint8_t { High, Low };
+const char* to_string(AlarmPriority p) noexcept;  // "high", "low"
 
 // AlarmType [IEC 61158-6-10, coding of the field AlarmType].
 namespace alarm_type {

@@ -335,6 +335,10 @@ std::string_view error_code2_text(std::uint8_t decode, std::uint8_t code1, std::
         case 5: return "AR consumer DHT/WDT expired";
         case 6: return "AR CMI timeout";
         case 7: return "AR alarm-open failed";
+        case 8: return "AR alarm-send.cnf(-)";
+        case 9: return "AR alarm-ack-send.cnf(-)";
+        case 10: return "AR alarm data too long";
+        case 11: return "AR alarm.ind(err)";
         case 12: return "AR RPC client call failed";
         case 13: return "AR abort request";
         case 14: return "AR re-run aborts existing";

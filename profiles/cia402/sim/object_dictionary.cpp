@@ -99,6 +99,11 @@ std::optional<std::int64_t> ObjectDictionary::get(ObjectId id) const noexcept {
   return e->value;
 }
 
+const std::int64_t* ObjectDictionary::value_address(ObjectId id) const noexcept {
+  const ObjectEntry* e = find(id);
+  return e == nullptr ? nullptr : &e->value;
+}
+
 std::optional<DataType> ObjectDictionary::type_of(ObjectId id) const noexcept {
   const ObjectEntry* e = find(id);
   if (e == nullptr) return std::nullopt;

@@ -54,6 +54,9 @@ class ObjectDictionary {
 
   // Raw value regardless of access rights (the drive's own view). nullopt when the object is absent.
   [[nodiscard]] std::optional<std::int64_t> get(ObjectId id) const noexcept;
+  // Where the object's value lives, for a caller that reads it every cycle without a lookup;
+  // nullptr when absent. Valid for the dictionary's life once the construction phase (add()) ends.
+  [[nodiscard]] const std::int64_t* value_address(ObjectId id) const noexcept;
   [[nodiscard]] std::optional<DataType> type_of(ObjectId id) const noexcept;
   [[nodiscard]] std::optional<Access> access_of(ObjectId id) const noexcept;
 

@@ -160,6 +160,8 @@ class DriveModel {
   // FBUS.PARAM02 bit 0 is set, otherwise the drive quick-stops to S1 [sim: the digest names no
   // other reaction] and waits there for valid outputs and a new enable.
   void set_outputs(Outputs o) noexcept;
+  // The watchdog the controller's AR set (PN.TIMEOUTFTHRESH, PNU 3022 [§19.3]).
+  void set_watchdog_ms(std::uint32_t ms) noexcept { config_.watchdog_ms = ms; }
 
   // Record 47 [§5.1]: the write of a parameter request, then the read of its response.
   RecordStatus write_parameter_record(std::span<const std::uint8_t> request) noexcept;
