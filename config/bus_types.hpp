@@ -85,6 +85,9 @@ struct BusTypeInfo {
   std::string address_name = "address";  // in messages and the printout ("node-ID")
   bool reused_address_names_axes = false;  // an address given twice names both axes
   std::string device_section;  // the device profile section of this type ("canopen"); empty: none
+  // Its drives are CiA 402 drives, so a profile with its section needs a CiA 402 cyclic image
+  // (controlword, statusword, the cyclic modes' targets); false for PROFIdrive.
+  bool cia402_device = true;
   std::vector<std::string> bus_keys;  // keys of the bus entry besides the common ones ("io"), for read_bus
   // The key under which two axes of one bus may not share an address; empty: the address. (An
   // EtherCAT slave with several axes carries them at one position, told apart by their section.)

@@ -222,7 +222,15 @@ void read_profile(const MapReader& root, const fs::path& file, const BusTypeRegi
                                 " PDO maps (the cyclic image):" + d);
     }
   }
-  check_cyclic_image(p, root, derived_from);
+  // A profile only for bus types whose drives are not CiA 402 (PROFIdrive) has no CiA 402 image.
+  bool cia402 = cyclic_given;
+  bool any_section = false;
+  for (const auto& type : types.types()) {
+    if (type->device_section.empty() || !root.has(type->device_section)) continue;
+    any_section = true;
+    cia402 = cia402 || type->cia402_device;
+  }
+  if (cia402 || !any_section) check_cyclic_image(p, root, derived_from);
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <charconv>
 #include <cstdio>
 #include <numeric>
 
@@ -90,6 +91,27 @@ std::string clipped(std::string_view value) {
 std::string in_quotes(std::string_view value) {
   if (value.size() <= kEchoLimit) return "\"" + std::string{value} + "\"";
   return "\"" + std::string{value.substr(0, kEchoLimit)} + "\"...(" + std::to_string(value.size()) + " characters)";
+}
+
+bool is_interface_name(std::string_view s) noexcept {
+  return !s.empty() && s.size() <= 15 && std::none_of(s.begin(), s.end(), [](char c) {
+    return c == '/' || c == ':' || c == ' ' || c == '\t';
+  });
+}
+
+std::optional<std::array<int, 4>> parse_ipv4(std::string_view s) noexcept {
+  std::array<int, 4> octets{};
+  for (std::size_t i = 0; i < 4; ++i) {
+    const auto dot = s.find('.');
+    const std::string_view part = i < 3 ? s.substr(0, dot) : s;
+    if (part.empty() || part.size() > 3 || (i < 3 && dot == std::string_view::npos)) return std::nullopt;
+    int v = -1;
+    const auto [end, ec] = std::from_chars(part.data(), part.data() + part.size(), v);
+    if (ec != std::errc{} || end != part.data() + part.size() || v < 0 || v > 255) return std::nullopt;
+    octets[i] = v;
+    if (i < 3) s.remove_prefix(dot + 1);
+  }
+  return octets;
 }
 
 }  // namespace drivegate::config

@@ -1,6 +1,8 @@
 #pragma once
 // Small text helpers for configuration messages: "did you mean", lists, name patterns, numbers.
+#include <array>
 #include <cstddef>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -29,6 +31,12 @@ bool is_valid_name(std::string_view s, bool allow_punct = true) noexcept;
 std::string in_quotes(std::string_view value);
 // The same without quotes, for field paths built from keys.
 std::string clipped(std::string_view value);
+
+// Linux interface names: 1..15 bytes (IFNAMSIZ 16 with the terminator), no '/', ':' or blanks.
+bool is_interface_name(std::string_view s) noexcept;
+
+// "192.168.0.1": four decimal octets 0..255; nullopt for anything else.
+std::optional<std::array<int, 4>> parse_ipv4(std::string_view s) noexcept;
 
 // Shortest readable form of a number: "5", "0.5", "26214.4", "1e-06".
 std::string format_number(double v);

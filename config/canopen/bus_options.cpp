@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <array>
-#include <charconv>
 
 #include "config/scalars.hpp"
+#include "config/text_util.hpp"
 
 namespace drivegate::config {
 
@@ -18,28 +18,6 @@ constexpr std::array<std::int64_t, 8> kBitrates{10000, 20000, 50000, 125000, 250
 const std::vector<std::string>& transports() {
   static const std::vector<std::string> kTransports{"socketcan", "udp-multicast", "sim"};
   return kTransports;
-}
-
-std::optional<std::array<int, 4>> parse_ipv4(std::string_view s) noexcept {
-  std::array<int, 4> octets{};
-  for (std::size_t i = 0; i < 4; ++i) {
-    const auto dot = s.find('.');
-    const std::string_view part = i < 3 ? s.substr(0, dot) : s;
-    if (part.empty() || part.size() > 3 || (i < 3 && dot == std::string_view::npos)) return std::nullopt;
-    int v = -1;
-    const auto [end, ec] = std::from_chars(part.data(), part.data() + part.size(), v);
-    if (ec != std::errc{} || end != part.data() + part.size() || v < 0 || v > 255) return std::nullopt;
-    octets[i] = v;
-    if (i < 3) s.remove_prefix(dot + 1);
-  }
-  return octets;
-}
-
-// Linux interface names: 1..15 bytes (IFNAMSIZ 16 with the terminator), no '/', ':' or blanks.
-bool is_interface_name(std::string_view s) noexcept {
-  return !s.empty() && s.size() <= 15 && std::none_of(s.begin(), s.end(), [](char c) {
-    return c == '/' || c == ':' || c == ' ' || c == '\t';
-  });
 }
 
 template <typename T>

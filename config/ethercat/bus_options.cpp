@@ -23,13 +23,6 @@ const T& option(const BusPlan& bus, const char* name) {
   return std::get<T>(bus.options.at(name));
 }
 
-// Linux interface names: 1..15 bytes (IFNAMSIZ 16 with the terminator), no '/', ':' or blanks.
-bool is_interface_name(std::string_view s) noexcept {
-  return !s.empty() && s.size() <= 15 && std::none_of(s.begin(), s.end(), [](char c) {
-    return c == '/' || c == ':' || c == ' ' || c == '\t';
-  });
-}
-
 void read_io(const MapReader& b, EthercatBusOptions& c) {
   const auto list = b.list("io", Need::Optional);
   if (!list) return;

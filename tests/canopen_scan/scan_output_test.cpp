@@ -225,14 +225,24 @@ TEST(WriteSkeleton, KeepsAnExistingFileUnlessForced) {
 }
 
 TEST(ScanBus, RefusesBusTypesWithoutAScanner) {
-  const auto registry = config::BusTypeRegistry::builtin();
+  auto registry = config::BusTypeRegistry::builtin();
+  config::BusTypeInfo modbus;  // known without an adapter
+  modbus.name = "modbus";
+  registry.add(modbus);
   core::ScanRequest r;
   r.bus_type = "profinet";
   try {
     (void)scan_bus(r, registry);
     FAIL() << "scanned profinet";
   } catch (const core::ScanError& e) {
-    EXPECT_STREQ(e.what(), "cannot scan profinet: no adapter in this build (scans: canopen, ethercat)");
+    EXPECT_STREQ(e.what(), "cannot scan profinet: profinet has no bus scan (scans: canopen, ethercat)");
+  }
+  r.bus_type = "modbus";
+  try {
+    (void)scan_bus(r, registry);
+    FAIL() << "scanned modbus";
+  } catch (const core::ScanError& e) {
+    EXPECT_STREQ(e.what(), "cannot scan modbus: no adapter in this build (scans: canopen, ethercat)");
   }
   r.bus_type = "canbus";
   EXPECT_THROW((void)scan_bus(r, registry), core::ScanError);

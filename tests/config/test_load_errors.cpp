@@ -117,7 +117,7 @@ axes:
   - { name: x, bus: sim0, address: 1, device: sim-servoo }
 )");
   EXPECT_REPORTED(e, "t.yaml:5:47: axes[0].device: unknown device profile \"sim-servoo\", did you mean \"sim-servo\"?");
-  EXPECT_REPORTED(e, "available: esr-triodrive, generic-cia402, generic-cia402-2axis, kollmorgen-akd, nord-sk500p, pp-only, sim-servo, stoeber-sd6;");
+  EXPECT_REPORTED(e, "available: esr-triodrive, generic-cia402, generic-cia402-2axis, kollmorgen-akd, kollmorgen-akd-profinet, nord-sk500p, pp-only, sim-servo, stoeber-sd6;");
 }
 
 TEST(LoadErrors, NoDeviceProfileInTheSearchPath) {
@@ -239,14 +239,19 @@ TEST(LoadErrors, DefaultsAboveLimits) {
 }
 
 TEST(LoadErrors, BusTypes) {
+  // A type the registry knows without an adapter (as a bus type whose adapter is not linked in).
+  LoadOptions options = test_options();
+  BusTypeInfo modbus;
+  modbus.name = "modbus";
+  options.bus_types.add(modbus);
   const std::string e = errors_of(R"(gateway: { name: g }
 buses:
   - { name: a, type: simm, cycle_time: 1ms }
-  - { name: b, type: profinet, cycle_time: 1ms }
+  - { name: b, type: modbus, cycle_time: 1ms }
   - { name: c, type: sim, cycle_time: 1ms, options: { latency: 2 } }
-)");
-  EXPECT_REPORTED(e, "t.yaml:3:22: buses[0].type: unknown bus type \"simm\", did you mean \"sim\"? (available: sim, canopen, ethercat)");
-  EXPECT_REPORTED(e, "t.yaml:4:22: buses[1].type: bus type \"profinet\" has no adapter in this build (available: sim, canopen, ethercat)");
+)", options);
+  EXPECT_REPORTED(e, "t.yaml:3:22: buses[0].type: unknown bus type \"simm\", did you mean \"sim\"? (available: sim, canopen, ethercat, profinet)");
+  EXPECT_REPORTED(e, "t.yaml:4:22: buses[1].type: bus type \"modbus\" has no adapter in this build (available: sim, canopen, ethercat, profinet)");
   EXPECT_REPORTED(e, "t.yaml:5:55: buses[2].options.latency: unknown field (allowed: acyclic_latency_cycles)");
 }
 
