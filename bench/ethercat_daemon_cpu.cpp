@@ -146,8 +146,11 @@ std::string config_text(const test::DdsIsolation& dds, int axes, const std::vect
     << "buses:\n";
   for (int b = 0; b < buses; ++b) {
     y << "  - { name: ec" << b << ", type: ethercat, cycle_time: 1ms, priority: " << g_priority << ", options: { ";
+    // Over veth the simulator is a process on a shared machine: a stall of 1.5 ms there (a
+    // descheduled vCPU) puts it three cycles behind, and with the default lost_cycles: 3 the whole
+    // line is taken as lost. The benchmark measures the master's CPU, not that: it tolerates 20.
     if (interfaces.empty()) y << "transport: sim" << dc << " } }\n";
-    else y << "transport: raw, interface: " << interfaces[static_cast<std::size_t>(b)] << dc << " } }\n";
+    else y << "transport: raw, lost_cycles: 20, interface: " << interfaces[static_cast<std::size_t>(b)] << dc << " } }\n";
   }
   y << "axes:\n";
   for (int b = 0, i = 0; b < buses; ++b) {
