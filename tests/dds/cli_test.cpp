@@ -306,17 +306,22 @@ TEST(DrivegatectlBuses, ClockFiguresShownOnlyForTheBusThatHasThem) {
   rt.add_bus(ec);
   daemon::DdsBridge bridge(rt, bridge_options());
   bridge.start();
-  CtlRun r;
-  // bus_status is published at 1 Hz: wait until both buses are listed.
-  for (int i = 0; i < 20; ++i) {
-    r = ctl("buses");
-    if (r.output.find("gw1/ec0") != std::string::npos && r.output.find("gw1/can0") != std::string::npos) break;
-  }
+  // bus_status is published at 1 Hz and each run of drivegatectl listens afresh: run it until it
+  // has heard both buses.
+  const auto until_both = [](const std::string& args, const char* first, const char* second) {
+    CtlRun run;
+    for (int i = 0; i < 20; ++i) {
+      run = ctl(args);
+      if (run.output.find(first) != std::string::npos && run.output.find(second) != std::string::npos) break;
+    }
+    return run;
+  };
+  CtlRun r = until_both("buses", "gw1/ec0", "gw1/can0");
   EXPECT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("  distributed clocks: max difference 42ns  master - reference -900ns\n"), std::string::npos)
       << r.output;
   EXPECT_EQ(r.output.find("distributed clocks"), r.output.rfind("distributed clocks")) << r.output;  // ec0's only
-  r = ctl("--json buses");
+  r = until_both("--json buses", R"("bus":"ec0")", R"("bus":"can0")");
   EXPECT_EQ(r.status, 0) << r.output;
   const auto ec_line = r.output.find(R"("bus":"ec0")");
   const auto can_line = r.output.find(R"("bus":"can0")");
