@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "config/text_util.hpp"
+#include "config/xml_text.hpp"
 #include "config/yaml_reader.hpp"
 
 namespace drivegate::config {
@@ -105,12 +106,6 @@ std::string name_of(const XMLElement* e) {
   return trimmed(first);
 }
 
-std::string child_path(const std::string& path, std::string_view name, int position = 0) {
-  std::string s = path.empty() ? std::string{name} : path + "/" + std::string{name};
-  if (position > 0) s += "[" + std::to_string(position) + "]";
-  return s;
-}
-
 class Parser {
  public:
   Parser(const std::string& label, Problems& problems) : label_(label), problems_(problems) {}
@@ -118,14 +113,7 @@ class Parser {
   std::optional<EsiFile> run(std::string_view text) {
     tinyxml2::XMLDocument doc;
     if (doc.Parse(text.data(), text.size()) != tinyxml2::XML_SUCCESS) {
-      std::string what = tinyxml2::XMLDocument::ErrorIDToName(doc.ErrorID());
-      if (what.rfind("XML_ERROR_", 0) == 0)
-        what = what.substr(10);
-      else if (what.rfind("XML_", 0) == 0)
-        what = what.substr(4);
-      std::transform(what.begin(), what.end(), what.begin(),
-                     [](unsigned char c) { return c == '_' ? ' ' : static_cast<char>(std::tolower(c)); });
-      report(true, doc.ErrorLineNum(), "", "not well-formed XML (" + what + ")");
+      report(true, doc.ErrorLineNum(), "", xml_parse_problem(doc));
       return finish(std::nullopt);
     }
     const XMLElement* root = doc.RootElement();
@@ -148,7 +136,7 @@ class Parser {
     int position = 0;
     for (const XMLElement* d = devices ? devices->FirstChildElement("Device") : nullptr; d != nullptr;
          d = d->NextSiblingElement("Device"))
-      out.devices.push_back(device(d, child_path("", "Device", ++position)));
+      out.devices.push_back(device(d, xml_child_path("", "Device", ++position)));
     if (out.devices.empty()) error(devices ? devices : root, devices ? "Descriptions/Devices" : "EtherCATInfo", "lists no Device");
     return finish(std::move(out));
   }
@@ -211,13 +199,13 @@ class Parser {
       error(parent, path, std::string{"has no "} + name);
       return std::nullopt;
     }
-    return number(e, child_path(path, name), text_of(e), max);
+    return number(e, xml_child_path(path, name), text_of(e), max);
   }
   std::optional<std::uint64_t> optional_number(const XMLElement* parent, const std::string& path, const char* name,
                                                std::uint64_t max) {
     const XMLElement* e = parent->FirstChildElement(name);
     if (e == nullptr) return std::nullopt;
-    return number(e, child_path(path, name), text_of(e), max);
+    return number(e, xml_child_path(path, name), text_of(e), max);
   }
   std::optional<std::uint64_t> attribute_number(const XMLElement* e, const std::string& path, const char* name,
                                                 std::uint64_t max) {
@@ -244,7 +232,7 @@ class Parser {
       error(d, path, "has no Type (its product code and revision)");
     } else {
       dev.type = trimmed(type);
-      const std::string tpath = child_path(path, "Type");
+      const std::string tpath = xml_child_path(path, "Type");
       if (type->Attribute("ProductCode") == nullptr)
         error(type, tpath, "has no ProductCode");
       else if (const auto v = attribute_number(type, tpath, "ProductCode", 0xFFFFFFFF))
@@ -257,29 +245,29 @@ class Parser {
     std::string dictionary_path;
     int position = 0;
     for (const XMLElement* p = d->FirstChildElement("Profile"); p != nullptr; p = p->NextSiblingElement("Profile")) {
-      const std::string ppath = child_path(path, "Profile", ++position);
+      const std::string ppath = xml_child_path(path, "Profile", ++position);
       if (position == 1)
         if (const auto no = optional_number(p, ppath, "ProfileNo", 0xFFFFFFFF)) dev.profile_no = static_cast<std::uint32_t>(*no);
       if (dictionary == nullptr && (dictionary = p->FirstChildElement("Dictionary")) != nullptr)
-        dictionary_path = child_path(ppath, "Dictionary");
+        dictionary_path = xml_child_path(ppath, "Dictionary");
       if (const XMLElement* f = p->FirstChildElement("DictionaryFile"); f != nullptr && dictionary == nullptr)
-        warning(f, child_path(ppath, "DictionaryFile"),
+        warning(f, xml_child_path(ppath, "DictionaryFile"),
                 "the dictionary in another file (" + in_quotes(trimmed(f)) + ") is not read; objects are not checked");
     }
-    if (const XMLElement* m = d->FirstChildElement("Mailbox")) dev.mailbox = mailbox(m, child_path(path, "Mailbox"));
+    if (const XMLElement* m = d->FirstChildElement("Mailbox")) dev.mailbox = mailbox(m, xml_child_path(path, "Mailbox"));
     position = 0;
     for (const XMLElement* s = d->FirstChildElement("Sm"); s != nullptr; s = s->NextSiblingElement("Sm"))
-      dev.sms.push_back(sm(s, child_path(path, "Sm", ++position)));
+      dev.sms.push_back(sm(s, xml_child_path(path, "Sm", ++position)));
     for (const bool rx : {true, false}) {
       const char* tag = rx ? "RxPdo" : "TxPdo";
       position = 0;
       for (const XMLElement* p = d->FirstChildElement(tag); p != nullptr; p = p->NextSiblingElement(tag))
-        (rx ? dev.rxpdos : dev.txpdos).push_back(pdo(p, child_path(path, tag, ++position)));
+        (rx ? dev.rxpdos : dev.txpdos).push_back(pdo(p, xml_child_path(path, tag, ++position)));
     }
     if (const XMLElement* dc = d->FirstChildElement("Dc")) {
       position = 0;
       for (const XMLElement* o = dc->FirstChildElement("OpMode"); o != nullptr; o = o->NextSiblingElement("OpMode"))
-        dev.op_modes.push_back(op_mode(o, child_path(child_path(path, "Dc"), "OpMode", ++position)));
+        dev.op_modes.push_back(op_mode(o, xml_child_path(xml_child_path(path, "Dc"), "OpMode", ++position)));
     }
     if (dictionary != nullptr) read_dictionary(dictionary, dictionary_path, dev);
     return dev;
@@ -292,7 +280,7 @@ class Parser {
     mb.soe = m->FirstChildElement("SoE") != nullptr;
     mb.aoe = m->FirstChildElement("AoE") != nullptr;
     if (const XMLElement* coe = m->FirstChildElement("CoE")) {
-      const std::string p = child_path(path, "CoE");
+      const std::string p = xml_child_path(path, "CoE");
       mb.coe = true;
       mb.sdo_info = attribute_bool(coe, p, "SdoInfo", false);
       mb.pdo_assign = attribute_bool(coe, p, "PdoAssign", false);
@@ -339,7 +327,7 @@ class Parser {
     out.name = name_of(p);
     int position = 0;
     for (const XMLElement* e = p->FirstChildElement("Entry"); e != nullptr; e = e->NextSiblingElement("Entry")) {
-      const std::string epath = child_path(path, "Entry", ++position);
+      const std::string epath = xml_child_path(path, "Entry", ++position);
       EsiPdoEntry entry;
       entry.line = e->GetLineNum();
       if (const auto v = required_number(e, epath, "Index", 0xFFFF)) entry.object.index = static_cast<std::uint16_t>(*v);
@@ -347,7 +335,7 @@ class Parser {
       // A mapping entry holds the length in one byte [ETG.1000.6 §5.6.7.4.8, CiA 301 §7.5.2.36].
       if (const auto v = required_number(e, epath, "BitLen", 0xFF)) {
         if (*v == 0)
-          error(e->FirstChildElement("BitLen"), child_path(epath, "BitLen"), "must be 1..255, got 0");
+          error(e->FirstChildElement("BitLen"), xml_child_path(epath, "BitLen"), "must be 1..255, got 0");
         else
           entry.bits = static_cast<int>(*v);
       }
@@ -367,14 +355,14 @@ class Parser {
     // AssignActivate is written to the 16-bit register 0980h [ETG.1000.4 Table 60].
     if (const auto v = required_number(o, path, "AssignActivate", 0xFFFF)) out.assign_activate = static_cast<std::uint32_t>(*v);
     if (const XMLElement* c = o->FirstChildElement("CycleTimeSync0")) {
-      const std::string cpath = child_path(path, "CycleTimeSync0");
+      const std::string cpath = xml_child_path(path, "CycleTimeSync0");
       if (const auto v = number(c, cpath, text_of(c), 0xFFFFFFFF)) out.cycle_time_sync0 = static_cast<std::uint32_t>(*v);
       if (const char* f = c->Attribute("Factor"))
         if (const auto v = signed_number(c, cpath + "/@Factor", f, INT32_MIN, INT32_MAX))
           out.cycle_time_sync0_factor = static_cast<std::int32_t>(*v);
     }
     if (const XMLElement* s = o->FirstChildElement("ShiftTimeSync0"))
-      out.shift_time_sync0 = signed_number(s, child_path(path, "ShiftTimeSync0"), text_of(s), INT32_MIN, INT32_MAX);
+      out.shift_time_sync0 = signed_number(s, xml_child_path(path, "ShiftTimeSync0"), text_of(s), INT32_MIN, INT32_MAX);
     return out;
   }
 
@@ -398,7 +386,7 @@ class Parser {
       else if (same_text(v, "wo"))
         out.access = EsiAccess::WriteOnly;
       else
-        error(a, child_path(path, "Access"), "must be ro, rw or wo, got " + in_quotes(v));
+        error(a, xml_child_path(path, "Access"), "must be ro, rw or wo, got " + in_quotes(v));
     }
     if (const XMLElement* m = f->FirstChildElement("PdoMapping")) {
       const std::string v = trimmed(m);
@@ -410,7 +398,7 @@ class Parser {
           out.tx = true;
       }
       if (!v.empty() && !same_text(v, "R") && !same_text(v, "T") && !same_text(v, "RT") && !same_text(v, "TR"))
-        warning(m, child_path(path, "PdoMapping"), "must be R, T, RT or TR, got " + in_quotes(v));
+        warning(m, xml_child_path(path, "PdoMapping"), "must be R, T, RT or TR, got " + in_quotes(v));
     }
     return out;
   }
@@ -449,7 +437,7 @@ class Parser {
   // The entry's BitSize, else its type's; 0 with a warning when neither gives one.
   int bit_size(const XMLElement* e, const std::string& path, const Resolved& type) {
     if (const XMLElement* b = e->FirstChildElement("BitSize")) {
-      const auto v = number(b, child_path(path, "BitSize"), text_of(b), 0xFFFF);
+      const auto v = number(b, xml_child_path(path, "BitSize"), text_of(b), 0xFFFF);
       return v ? static_cast<int>(*v) : -1;
     }
     return type.bits;
@@ -495,7 +483,7 @@ class Parser {
       object_entries_ = 0;
       object_full_ = false;
       object_at_ = o;
-      object_path_ = child_path(child_path(path, "Objects"), "Object", ++position);
+      object_path_ = xml_child_path(xml_child_path(path, "Objects"), "Object", ++position);
       object(o, object_path_);
       if (device_full_) break;
     }
@@ -524,7 +512,7 @@ class Parser {
     if (type_element == nullptr) error(o, path, "has no Type");
     if (!index || type_element == nullptr) return;
     const std::string type = trimmed(type_element);
-    const Flags object_flags = flags(o->FirstChildElement("Flags"), child_path(path, "Flags"), Flags{});
+    const Flags object_flags = flags(o->FirstChildElement("Flags"), xml_child_path(path, "Flags"), Flags{});
     const XMLElement* info = o->FirstChildElement("Info");
     EsiObject base;
     base.line = o->GetLineNum();
@@ -602,7 +590,7 @@ class Parser {
     int position = 0;
     for (const XMLElement* s = dt->FirstChildElement("SubItem"); s != nullptr && !full(); s = s->NextSiblingElement("SubItem")) {
       const std::string spath = tpath + "/SubItem[" + std::to_string(++position) + "]";
-      const Flags f = flags(s->FirstChildElement("Flags"), child_path(spath, "Flags"), object_flags);
+      const Flags f = flags(s->FirstChildElement("Flags"), xml_child_path(spath, "Flags"), object_flags);
       const std::string stype = trimmed(s->FirstChildElement("Type"));
       const auto subidx = optional_number(s, spath, "SubIdx", 0xFF);
       const XMLElement* sdt = data_type(stype);

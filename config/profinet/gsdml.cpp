@@ -8,6 +8,7 @@
 
 #include "config/scalars.hpp"
 #include "config/text_util.hpp"
+#include "config/xml_text.hpp"
 #include "config/yaml_reader.hpp"
 
 namespace drivegate::config {
@@ -36,12 +37,6 @@ constexpr std::array<DataType, 26> kDataTypes{{
     {"Float32+Unsigned8", 5},
 }};
 
-std::string child_path(const std::string& path, std::string_view name, int position = 0) {
-  std::string s = path.empty() ? std::string{name} : path + "/" + std::string{name};
-  if (position > 0) s += "[" + std::to_string(position) + "]";
-  return s;
-}
-
 class Parser {
  public:
   Parser(const std::string& label, Problems& problems) : label_(label), problems_(problems) {}
@@ -49,11 +44,7 @@ class Parser {
   std::optional<GsdmlFile> run(std::string_view text) {
     tinyxml2::XMLDocument doc;
     if (doc.Parse(text.data(), text.size()) != tinyxml2::XML_SUCCESS) {
-      std::string what = tinyxml2::XMLDocument::ErrorIDToName(doc.ErrorID());
-      if (what.rfind("XML_ERROR_", 0) == 0) what = what.substr(10);
-      std::transform(what.begin(), what.end(), what.begin(),
-                     [](unsigned char c) { return c == '_' ? ' ' : static_cast<char>(std::tolower(c)); });
-      error(doc.ErrorLineNum(), "", "not well-formed XML (" + what + ")");
+      error(doc.ErrorLineNum(), "", xml_parse_problem(doc));
       return std::nullopt;
     }
     const XMLElement* root = doc.RootElement();
@@ -116,7 +107,7 @@ class Parser {
     int total = 0;
     int position = 0;
     for (const XMLElement* d = io->FirstChildElement("DataItem"); d != nullptr; d = d->NextSiblingElement("DataItem")) {
-      const std::string at = child_path(path, "DataItem", ++position);
+      const std::string at = xml_child_path(path, "DataItem", ++position);
       const char* type = d->Attribute("DataType");
       if (type == nullptr) {
         error(d, at, "has no DataType");
@@ -151,7 +142,7 @@ class Parser {
     int position = 0;
     for (const XMLElement* s = list ? list->FirstChildElement("VirtualSubmoduleItem") : nullptr; s != nullptr;
          s = s->NextSiblingElement("VirtualSubmoduleItem")) {
-      const std::string at = child_path(child_path(path, "VirtualSubmoduleList"), "VirtualSubmoduleItem", ++position);
+      const std::string at = xml_child_path(xml_child_path(path, "VirtualSubmoduleList"), "VirtualSubmoduleItem", ++position);
       GsdmlSubmodule sub;
       sub.line = s->GetLineNum();
       sub.id = s->Attribute("ID") ? s->Attribute("ID") : "";
@@ -160,8 +151,8 @@ class Parser {
       if (const char* fixed = s->Attribute("FixedInSubslots"))
         if (const auto n = parse_integer(fixed); n && *n >= 1 && *n <= 0x7FFF) sub.fixed_subslot = static_cast<int>(*n);
       if (const XMLElement* io = s->FirstChildElement("IOData")) {
-        sub.input_bytes = io_bytes(io->FirstChildElement("Input"), child_path(at, "IOData/Input"));
-        sub.output_bytes = io_bytes(io->FirstChildElement("Output"), child_path(at, "IOData/Output"));
+        sub.input_bytes = io_bytes(io->FirstChildElement("Input"), xml_child_path(at, "IOData/Input"));
+        sub.output_bytes = io_bytes(io->FirstChildElement("Output"), xml_child_path(at, "IOData/Output"));
       }
       out.submodules.push_back(std::move(sub));
     }
@@ -170,7 +161,7 @@ class Parser {
   void modules(const XMLElement* list, const char* item, const std::string& list_path, std::vector<GsdmlModule>& out) {
     int position = 0;
     for (const XMLElement* m = list ? list->FirstChildElement(item) : nullptr; m != nullptr; m = m->NextSiblingElement(item)) {
-      const std::string at = child_path(list_path, item, ++position);
+      const std::string at = xml_child_path(list_path, item, ++position);
       GsdmlModule module;
       module.line = m->GetLineNum();
       if (const char* id = m->Attribute("ID"))
