@@ -207,7 +207,7 @@ void read_io(const ProfinetWireRules& rules, const MapReader& b, ProfinetBusOpti
   for (std::size_t i = 0; i < list->size(); ++i) {
     const MapReader m{(*list)[i], indexed(b.field("io"), i), b.source()};
     if (!m.present()) continue;
-    m.check_keys({"name", "station", "gsdml", "dap", "dap_ident", "slots", "records"});
+    m.check_keys({"name", "station", "gsdml", "dap", "dap_ident", "dap_submodule_ident", "slots", "records"});
     ProfinetIoDevice io;
     io.name = m.name("name", Need::Required).value_or("");
     if (!io.name.empty() && !names.insert(io.name).second) m.error("name", "IO device " + in_quotes(io.name) + " is listed twice");
@@ -234,7 +234,8 @@ void read_io(const ProfinetWireRules& rules, const MapReader& b, ProfinetBusOpti
       }
     }
     if (gsdml) {
-      if (m.has("dap_ident")) m.error("dap_ident", "comes from the GSDML's DAP; give dap to choose one");
+      for (const char* key : {"dap_ident", "dap_submodule_ident"})
+        if (m.has(key)) m.error(key, "comes from the GSDML's DAP; give dap to choose one");
       const auto dap_id = m.string("dap", gsdml->daps.size() == 1 ? Need::Optional : Need::Required);
       const GsdmlModule* dap = dap_id ? find_gsdml_module(gsdml->daps, *dap_id) : &gsdml->daps.front();
       if (dap == nullptr) {
@@ -243,10 +244,13 @@ void read_io(const ProfinetWireRules& rules, const MapReader& b, ProfinetBusOpti
         m.error("dap", "the GSDML lists no device access point " + in_quotes(*dap_id) + " (DAPs: " + join(ids) + ")");
       } else {
         io.dap_ident = dap->ident;
+        if (!dap->submodules.empty()) io.dap_submodule_ident = dap->submodules.front().ident;
       }
     } else if (!m.has("gsdml")) {
       if (m.has("dap")) m.error("dap", "names a GSDML device access point, but the IO device has no gsdml file");
       io.dap_ident = static_cast<std::uint32_t>(m.integer("dap_ident", Need::Required, 0, 0xFFFFFFFF).value_or(0));
+      io.dap_submodule_ident = static_cast<std::uint32_t>(
+          m.integer("dap_submodule_ident", Need::Optional, 0, 0xFFFFFFFF).value_or(io.dap_submodule_ident));
     }
     if (const auto slots = m.list("slots", Need::Required)) {
       for (std::size_t k = 0; k < slots->size(); ++k) {

@@ -61,6 +61,8 @@ struct ProfinetIoDevice {
   std::string name;
   std::string station;
   std::uint32_t dap_ident = 0;  // slot 0, the device access point (from the GSDML or dap_ident)
+  // Its submodule in subslot 1 (the GSDML DAP's first VirtualSubmoduleItem, or dap_submodule_ident).
+  std::uint32_t dap_submodule_ident = 1;
   std::vector<ProfinetIoSubmodule> submodules;  // slots >= 1, in slot/subslot order
   std::vector<ProfinetRecordWrite> records;
   std::string gsdml;  // a GSDML file (absolute path), empty: none
@@ -93,6 +95,21 @@ struct ProfinetAxisSpec {
   int subslot = 1;  // [§4.1, INF: subslot 1]
 };
 
+// The numbers the controller's Connect names the drive's modules by (ExpectedSubmoduleBlockReq):
+// the device access point in slot 0, and the telegram module, whose idents are a base plus the
+// telegram number. A device's GSDML holds them.
+struct ProfidriveIdents {
+  std::uint32_t api = 0x3A00;  // the PROFIdrive profile's API [akd-profinet-profidrive.md §2]
+  std::uint32_t dap_module = 0;
+  std::uint32_t dap_submodule = 0;
+  std::uint32_t telegram_module_base = 0;
+  std::uint32_t telegram_submodule_base = 0;
+  [[nodiscard]] std::uint32_t telegram_module(std::uint16_t telegram) const noexcept { return telegram_module_base + telegram; }
+  [[nodiscard]] std::uint32_t telegram_submodule(std::uint16_t telegram) const noexcept {
+    return telegram_submodule_base + telegram;
+  }
+};
+
 // A device profile's `profidrive:` section.
 struct ProfidriveDeviceSpec {
   unsigned single_turn_bits = 16;            // PNU 1002 [§17.2]
@@ -101,6 +118,7 @@ struct ProfidriveDeviceSpec {
   std::vector<std::uint16_t> telegrams;      // the telegram modules the device offers [§4.3]
   core::Duration min_update_time = std::chrono::milliseconds(1);  // fastest cyclic update [§2]
   std::map<std::string, bool> quirks;        // only names from known_profidrive_quirks()
+  std::optional<ProfidriveIdents> idents;    // absent: a PROFINET bus cannot connect the drive
   [[nodiscard]] bool offers(std::uint16_t telegram) const noexcept {
     for (const auto t : telegrams)
       if (t == telegram) return true;

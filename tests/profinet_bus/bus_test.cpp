@@ -1,0 +1,207 @@
+// The PROFINET bus on simulated devices: stations found by name and given their IP, ARs to data
+// exchange, an AKD enabled and run in speed mode through its telegram, a PNU read over record 47,
+// the IO device's bytes both ways, losses (power, AR abort) that reconnect only the device that
+// was lost with a new AR and its axis disabled, a missing station and a wrong module named, the
+// ARs released on close, and no allocation per cycle in data exchange.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+
+#include "tests/profinet_bus/bus_harness.hpp"
+#include "tests/support/alloc_counter.hpp"
+#include "tests/support/param_request.hpp"
+
+namespace drivegate::profinet::test {
+namespace {
+
+std::string replaced(std::string s, const std::string& what, const std::string& with) {
+  const auto at = s.find(what);
+  if (at == std::string::npos) throw std::runtime_error("no " + what);
+  return s.replace(at, what.size(), with);
+}
+
+core::CommandId set_mode(PnHarness& h, const std::string& name, core::Mode m) {
+  core::Command c;
+  c.id = h.next_id++;
+  c.axis = h.axis(name);
+  c.kind = core::CommandKind::SetMode;
+  c.mode = m;
+  EXPECT_TRUE(h.runner->push_command(c));
+  return c.id;
+}
+
+TEST(ProfinetBus, FindsNamesConnectsAndExchangesData) {
+  PnHarness h;
+  EXPECT_EQ(h.link("x"), core::LinkState::Booting);  // searching
+  ASSERT_TRUE(h.run_until([&] { return h.all_up(); }, 5s)) << h.details();
+  // Every device got its configured address by DCP (they came up without one) and one AR.
+  for (std::size_t k = 0; k < 3; ++k) {
+    EXPECT_EQ(h.bus->ars(k), 1U);
+    EXPECT_EQ(h.bus->cm(k)->state(), CmClientState::DataExchange);
+  }
+  EXPECT_NE(h.bus->device_detail(0).find("station \"akd-x\" (02:1b:1b:00:0a:01 at 192.168.0.10): in data exchange (AR 1)"),
+            std::string_view::npos)
+      << h.details();
+  EXPECT_EQ(h.sim->akd_x->telegram(), 1);
+  EXPECT_EQ(h.sim->akd_y->telegram(), 9);
+  // The drives come up disabled: S1 (switching on inhibited).
+  EXPECT_EQ(h.snap("x").state, core::AxisState::SwitchOnDisabled);
+  EXPECT_EQ(h.snap("y").state, core::AxisState::SwitchOnDisabled);
+  EXPECT_EQ(h.snap("x").link, core::LinkState::Operational);
+  const core::BusCounters c = h.bus->counters();
+  EXPECT_GT(c.frames_sent, 0U);
+  EXPECT_GT(c.frames_received, 0U);
+  EXPECT_EQ(c.errors, 0U);
+}
+
+TEST(ProfinetBus, EnablesAnAkdAndRunsItInSpeedMode) {
+  PnHarness h;
+  ASSERT_TRUE(h.run_until([&] { return h.all_up(); }, 5s)) << h.details();
+  const auto en = h.push("x", core::CommandKind::Enable);
+  ASSERT_EQ(h.wait_final(en, 3s), core::ReplyStatus::Completed) << h.reason(en);
+  EXPECT_EQ(h.snap("x").state, core::AxisState::OperationEnabled);
+  EXPECT_EQ(h.sim->akd_x->drive().state(), profidrive::sim::State::S4Operation);
+  ASSERT_EQ(h.wait_final(set_mode(h, "x", core::Mode::ProfileVelocity), 1s), core::ReplyStatus::Completed);
+  const auto v = h.push("x", core::CommandKind::Velocity, 0, 5.0);  // 5 rev/s
+  ASSERT_TRUE(h.run_until([&] { return std::fabs(h.snap("x").velocity - 5.0) < 0.1; }, 3s))
+      << h.snap("x").velocity << " " << h.reason(v);
+  // The other drive was not touched.
+  EXPECT_EQ(h.snap("y").state, core::AxisState::SwitchOnDisabled);
+  const auto off = h.push("x", core::CommandKind::Disable);
+  ASSERT_EQ(h.wait_final(off, 5s), core::ReplyStatus::Completed) << h.reason(off);
+}
+
+TEST(ProfinetBus, ReadsAPnuOverRecord47) {
+  PnHarness h;
+  ASSERT_TRUE(h.run_until([&] { return h.all_up(); }, 5s)) << h.details();
+  // PNU 922: the telegram the drive runs [digest §11.1].
+  core::ParamRequest r = drivegate::test::param_read(h.next_id++, 922, 0, core::ParamType::U16);
+  r.axis = h.axis("y");
+  ASSERT_TRUE(h.runner->push_parameter(r));
+  core::ParamReply reply;
+  ASSERT_TRUE(h.run_until([&] { return h.runner->pop_parameter_reply(reply); }, 3s));
+  ASSERT_TRUE(reply.ok) << reply.error.view();
+  EXPECT_EQ(drivegate::test::reply_integer(reply), 9);
+}
+
+TEST(ProfinetBus, IoDeviceBytesGoBothWays) {
+  PnHarness h;
+  ASSERT_TRUE(h.run_until([&] { return h.all_up(); }, 5s)) << h.details();
+  ASSERT_EQ(h.bus->io_count(), 1U);
+  const core::IoInfo info = h.bus->io_info(0);
+  EXPECT_EQ(info.name, "panel");
+  EXPECT_EQ(info.input_size, 2U);
+  EXPECT_EQ(info.output_size, 4U);
+  const std::array<std::uint8_t, 2> in{0x12, 0x34};
+  ASSERT_TRUE(h.sim->io->set_input(0, 1, 1, in));
+  core::IoSnapshot s;
+  ASSERT_TRUE(h.run_until([&] {
+    h.bus->io_read(0, s);
+    return s.valid && s.input_size == 2 && s.inputs[0] == 0x12 && s.inputs[1] == 0x34;
+  }, 1s));
+  const std::array<std::uint8_t, 4> out{1, 2, 3, 4};
+  EXPECT_EQ(h.bus->io_write(0, 0, out), core::IoWriteStatus::Ok);
+  EXPECT_EQ(h.bus->io_write(0, 3, std::span<const std::uint8_t>(out).first(2)), core::IoWriteStatus::OutOfRange);
+  EXPECT_EQ(h.bus->io_write(1, 0, out), core::IoWriteStatus::UnknownSlave);
+  ASSERT_TRUE(h.run_until([&] {
+    const auto o = h.sim->io->output(0, 2, 1);
+    return o.size() == 4 && o[0] == 1 && o[3] == 4;
+  }, 1s));
+  h.bus->io_read(0, s);
+  EXPECT_EQ(s.output_size, 4U);
+  EXPECT_EQ(s.outputs[2], 3);
+}
+
+TEST(ProfinetBus, PowerLossOfOneDriveReconnectsItWithANewArAndLeavesTheOthers) {
+  PnHarness h;
+  ASSERT_TRUE(h.run_until([&] { return h.all_up(); }, 5s)) << h.details();
+  const auto en = h.push("x", core::CommandKind::Enable);
+  ASSERT_EQ(h.wait_final(en, 3s), core::ReplyStatus::Completed) << h.reason(en);
+  h.sim->x->power_loss();
+  // The input CR's watchdog: 3 x 16 ms.
+  ASSERT_TRUE(h.run_until([&] { return h.link("x") == core::LinkState::Lost; }, 200ms)) << h.details();
+  EXPECT_NE(h.bus->device_detail(0).find("lost: input frame"), std::string_view::npos) << h.details();
+  EXPECT_EQ(h.link("y"), core::LinkState::Operational);
+  h.run_for(500ms);
+  h.sim->x->power_return(h.now);
+  ASSERT_TRUE(h.run_until([&] { return h.up("x"); }, 10s)) << h.details();
+  EXPECT_EQ(h.bus->ars(0), 2U);
+  EXPECT_EQ(h.bus->ars(1), 1U);  // y kept its AR throughout
+  EXPECT_EQ(h.bus->ars(2), 1U);
+  // The axis comes back disabled; the drive lost its temporary IP and got it again.
+  EXPECT_EQ(h.snap("x").state, core::AxisState::SwitchOnDisabled);
+  EXPECT_EQ(h.sim->akd_x->drive().state(), profidrive::sim::State::S1SwitchingOnInhibited);
+}
+
+TEST(ProfinetBus, DeviceAbortingItsArIsLostAndReconnected) {
+  PnHarness h;
+  ASSERT_TRUE(h.run_until([&] { return h.all_up(); }, 5s)) << h.details();
+  h.sim->block->abort_ar("test abort");
+  ASSERT_TRUE(h.run_until([&] { return h.bus->phase(2) == ProfinetBus::Phase::Wait; }, 500ms)) << h.details();
+  ASSERT_TRUE(h.run_until([&] { return h.bus->phase(2) == ProfinetBus::Phase::Running; }, 10s)) << h.details();
+  EXPECT_EQ(h.bus->ars(2), 2U);
+  EXPECT_EQ(h.bus->ars(0), 1U);
+  core::IoSnapshot s;
+  EXPECT_TRUE(h.run_until([&] {
+    h.bus->io_read(0, s);
+    return s.valid;
+  }, 200ms));
+}
+
+TEST(ProfinetBus, MissingStationIsNamedAndTheOthersRun) {
+  const std::string yaml = replaced(
+      replaced(kNetwork, "      - { station: io-block,", "      - { station: akd-z, ip: 192.168.0.12 }\n      - { station: io-block,"),
+      "axes:\n", "axes:\n  - { name: z, bus: pn0, address: 3, device: kollmorgen-akd-profinet, profinet: { station: akd-z, telegram: 1 } }\n");
+  PnHarness h(yaml);
+  ASSERT_TRUE(h.run_until([&] { return h.up("x") && h.up("y"); }, 5s)) << h.details();
+  // dcp_timeout (3 s) of asking again, then the report.
+  ASSERT_TRUE(h.run_until([&] { return h.bus->phase(2) == ProfinetBus::Phase::Wait; }, 5s)) << h.details();
+  EXPECT_EQ(h.bus->device_detail(2), "station \"akd-z\": no device answers to this name (DCP Identify)");
+  EXPECT_EQ(h.link("z"), core::LinkState::Offline);
+  EXPECT_EQ(h.snap("z").link_detail.view(), h.bus->device_detail(2));
+}
+
+TEST(ProfinetBus, WrongModuleIsReportedPerSlot) {
+  PnHarness h(replaced(kNetwork, "module_ident: 0x30,", "module_ident: 0x33,"));
+  ASSERT_TRUE(h.run_until([&] { return h.bus->phase(2) == ProfinetBus::Phase::Wait; }, 5s)) << h.details();
+  EXPECT_NE(h.bus->device_detail(2).find("failed: Connecting: the device's modules differ from the expected ones: slot 2: wrong module (ident "
+                                                   "0x00000030, expected 0x00000033)"),
+            std::string_view::npos)
+      << h.details();
+  EXPECT_TRUE(h.run_until([&] { return h.up("x") && h.up("y"); }, 5s)) << h.details();
+}
+
+TEST(ProfinetBus, CloseReleasesEveryAr) {
+  PnHarness h;
+  ASSERT_TRUE(h.run_until([&] { return h.all_up(); }, 5s)) << h.details();
+  h.bus->close();
+  EXPECT_EQ(h.sim->x->ar_state(), CmServerState::NoAr);
+  EXPECT_EQ(h.sim->y->ar_state(), CmServerState::NoAr);
+  EXPECT_EQ(h.sim->block->ar_state(), CmServerState::NoAr);
+  EXPECT_EQ(h.bus->cm(0)->state(), CmClientState::Released);
+}
+
+TEST(ProfinetBus, NoAllocationPerCycleInDataExchange) {
+  PnHarness h;
+  ASSERT_TRUE(h.run_until([&] { return h.all_up(); }, 5s)) << h.details();
+  const auto en = h.push("x", core::CommandKind::Enable);
+  ASSERT_EQ(h.wait_final(en, 3s), core::ReplyStatus::Completed) << h.reason(en);
+  ASSERT_EQ(h.wait_final(set_mode(h, "x", core::Mode::ProfileVelocity), 1s), core::ReplyStatus::Completed);
+  (void)h.push("x", core::CommandKind::Velocity, 0, 2.0);
+  h.run_for(100ms);
+  const std::array<std::uint8_t, 4> out{5, 6, 7, 8};
+  core::IoSnapshot s;
+  const drivegate::test::AllocationScope scope;
+  for (int i = 0; i < 2000; ++i) {
+    h.now += 1ms;
+    h.runner->cycle(h.now);
+    h.bus->io_read(0, s);
+    (void)h.bus->io_write(0, 0, out);
+  }
+  EXPECT_EQ(scope.count(), 0U);
+  EXPECT_TRUE(h.all_up()) << h.details();
+}
+
+}  // namespace
+}  // namespace drivegate::profinet::test
