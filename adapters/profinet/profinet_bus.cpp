@@ -652,8 +652,10 @@ void ProfinetBus::receive(core::TimePoint now) noexcept {
   }
   while (transport_.client->receive_from(datagram_)) dispatch_datagram(datagram_, CmSocket::Client, now);
   while (transport_.server->receive_from(datagram_)) dispatch_datagram(datagram_, CmSocket::Server, now);
-  for (auto& d : devices_) step(*d, now);
-  flush_datagrams();
+  for (auto& d : devices_) {
+    step(*d, now);
+    flush_datagrams();
+  }
 }
 
 void ProfinetBus::transmit(core::TimePoint now) noexcept {
@@ -723,6 +725,7 @@ void ProfinetBus::dispatch_datagram(const link::Datagram& g, CmSocket socket, co
   for (auto& d : devices_) {
     if (!d->cm || d->ip != ip) continue;
     d->cm->on_datagram(g.view(), UdpEndpoint{ip, g.from.port}, socket, now, out_);
+    flush_datagrams();  // the outbox holds 8: a burst of answers (every device's Connect) must not fill it
     return;
   }
   dropped_.fetch_add(1, std::memory_order_relaxed);
