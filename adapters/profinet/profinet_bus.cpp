@@ -198,6 +198,21 @@ bool ProfinetBus::Device::exchanging() const noexcept {
 }
 
 void ProfinetBus::Device::on_record_reply(const CmRecordReply& reply) noexcept {
+  if (im0_read != 0 && reply.id == im0_read) {
+    im0_read = 0;
+    const Im0View v = reply.outcome == CmRecordOutcome::Done ? decode_im0(reply.data) : Im0View{WireError::Truncated, {}};
+    if (v.error == WireError::None) {
+      const Im0& m = v.im0;
+      identity.format("%.*s serial %.*s hw %u sw %c%u.%u.%u", static_cast<int>(m.order_id.size()), m.order_id.data(),
+                      static_cast<int>(m.serial_number.size()), m.serial_number.data(), m.hardware_revision,
+                      m.software_prefix, m.software_functional, m.software_bugfix, m.software_internal);
+    } else {
+      const std::string_view why = reply.outcome == CmRecordOutcome::Done ? to_string(v.error) : reply.text;
+      identity.format("I&M0 not read: %.*s", static_cast<int>(why.size()), why.data());
+    }
+    if (phase == Phase::Running) bus->set_detail(*this, "in data exchange (AR %u); %s", static_cast<unsigned>(ars), identity.c_str());
+    return;
+  }
   for (const std::size_t a : axes)
     if (bus->axes_[a]->channel->on_reply(reply)) return;
 }
@@ -505,6 +520,7 @@ void ProfinetBus::connect(Device& d, core::TimePoint now) noexcept {
   q.alarm = AlarmCrBlockReq{};
   q.expected = d.layout->expected();
   c.parameters = d.parameters;
+  d.im0_read = 0;
   d.cm.emplace(c, &d);
   d.cm->start(now, out_);
   set_detail(d, "connecting (AR %u)", ar);
@@ -610,6 +626,8 @@ void ProfinetBus::step(Device& d, core::TimePoint now) noexcept {
         set_detail(d, "in data exchange (AR %u)", static_cast<unsigned>(d.ars));
         d.backoff = kRetryFirst;
         enter(d, Phase::Running, now);
+        // The device's identity for the link detail: I&M0 of the DAP [IEC 61158-6-10 I&M0, AFF0h].
+        d.im0_read = d.cm->submit_read(kDefaultApi, 0, 1, record_index::kIm0, kIm0Size);
       }
       for (const std::size_t a : d.axes) axes_[a]->channel->step();
       break;

@@ -29,7 +29,8 @@
 //   station "akd-x" (00:1b:1b:00:0a:01 at 192.168.0.10): searching (DCP identify)
 //   <StationFinder's report>                                  found, missing, duplicate, IP set
 //   station "akd-x" (...): connecting (AR 3)
-//   station "akd-x" (...): in data exchange (AR 3)
+//   station "akd-x" (...): in data exchange (AR 3); AKD-P00306-NBPN-0000 serial ... hw 1 sw V1.2.3
+//                                           (I&M0 of the DAP, read once data exchange started)
 //   station "akd-x" (...): lost: input frame 0xC001 silent for 48 ms (...)
 //   station "akd-x" (...): <CmClient's reason> (connect refused, module diff, ...)
 //
@@ -114,6 +115,8 @@ class ProfinetBus final : public core::Bus {
   [[nodiscard]] Phase phase(std::size_t device) const noexcept { return devices_[device]->phase; }
   [[nodiscard]] std::string_view device_detail(std::size_t device) const noexcept { return devices_[device]->detail.view(); }
   [[nodiscard]] std::uint64_t ars(std::size_t device) const noexcept { return devices_[device]->ars; }
+  // The device's I&M0 as read at the start of its last data exchange ("" before).
+  [[nodiscard]] std::string_view identity(std::size_t device) const noexcept { return devices_[device]->identity.view(); }
   [[nodiscard]] const CmClient* cm(std::size_t device) const noexcept {
     return devices_[device]->cm ? &*devices_[device]->cm : nullptr;
   }
@@ -224,6 +227,8 @@ class ProfinetBus final : public core::Bus {
     bool cyclic = false;            // the CRs and the alarm CR run for the present AR
     std::uint64_t frames_seen = 0;  // the consumer's frame count at the previous cycle
     bool fresh = false;             // a new input frame was taken this cycle
+    CmRecordId im0_read = 0;        // the I&M0 read of the DAP after the start of data exchange
+    core::FixedString<160> identity{};  // from I&M0: order ID, serial, revisions ("" before)
     bool lose_pending = false;      // control lost: lose it at the next step
     core::FixedString<200> lose_reason{};
     core::FixedString<400> detail{};

@@ -43,6 +43,11 @@ TEST(ProfinetBus, FindsNamesConnectsAndExchangesData) {
   EXPECT_NE(h.bus->device_detail(0).find("station \"akd-x\" (02:1b:1b:00:0a:01 at 192.168.0.10): in data exchange (AR 1)"),
             std::string_view::npos)
       << h.details();
+  // I&M0 of the DAP, read once data exchange started, in the detail.
+  ASSERT_TRUE(h.run_until([&] { return !h.bus->identity(0).empty(); }, 1s));
+  EXPECT_EQ(h.bus->identity(0), "AKD-P00306-NBPN-0000 serial SIM0000001 hw 0 sw V0.0.0") << h.details();
+  EXPECT_NE(h.bus->device_detail(0).find("in data exchange (AR 1); AKD-P00306-NBPN-0000"), std::string_view::npos);
+  EXPECT_EQ(h.bus->identity(2).substr(0, 4), "IO-1");
   EXPECT_EQ(h.sim->akd_x->telegram(), 1);
   EXPECT_EQ(h.sim->akd_y->telegram(), 9);
   // The drives come up disabled: S1 (switching on inhibited).
