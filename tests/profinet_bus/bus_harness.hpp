@@ -88,7 +88,8 @@ struct SimDevices {
 };
 
 struct PnHarness {
-  explicit PnHarness(const std::string& yaml = kNetwork)
+  // `wrap` may replace parts of the transport before the bus takes it (recorders).
+  explicit PnHarness(const std::string& yaml = kNetwork, const std::function<void(ProfinetTransport&)>& wrap = {})
       : plan(config::load_plan_from_string(yaml, "pn-test.yaml", load_options())) {
     const auto& bp = plan.buses.at(0);
     for (const auto& a : bp.axes) specs.push_back(a.spec);
@@ -96,7 +97,9 @@ struct PnHarness {
     sim = devices.get();
     SimControllerAddress address;
     address.ip = 0xC0A80001;  // 192.168.0.1
-    bus = std::make_unique<ProfinetBus>(bp, sim_transport(sim->net, devices, address));
+    ProfinetTransport transport = sim_transport(sim->net, devices, address);
+    if (wrap) wrap(transport);
+    bus = std::make_unique<ProfinetBus>(bp, std::move(transport));
     runner = std::make_unique<core::BusRunner>(*bus, specs);
     bus->open(now);
     replies.reserve(4096);
