@@ -2,7 +2,8 @@
 // exchange, an AKD enabled and run in speed mode through its telegram, a PNU read over record 47,
 // the IO device's bytes both ways, losses (power, AR abort) that reconnect only the device that
 // was lost with a new AR and its axis disabled, a missing station and a wrong module named, the
-// ARs released on close, and no allocation per cycle in data exchange.
+// ARs released on close, no allocation per cycle in data exchange, and a drive fault read from
+// the fault buffer over record 47 and acknowledged.
 #include <gtest/gtest.h>
 
 #include <array>
@@ -206,6 +207,29 @@ TEST(ProfinetBus, NoAllocationPerCycleInDataExchange) {
   }
   EXPECT_EQ(scope.count(), 0U);
   EXPECT_TRUE(h.all_up()) << h.details();
+}
+
+}  // namespace
+}  // namespace drivegate::profinet::test
+
+namespace drivegate::profinet::test {
+namespace {
+
+TEST(ProfinetBus, DriveFaultIsReadFromTheFaultBufferAndAcknowledged) {
+  PnHarness h;
+  ASSERT_TRUE(h.run_until([&] { return h.all_up(); }, 5s)) << h.details();
+  const auto en = h.push("x", core::CommandKind::Enable);
+  ASSERT_EQ(h.wait_final(en, 3s), core::ReplyStatus::Completed) << h.reason(en);
+  h.sim->akd_x->inject_drive_fault(235);  // heat sink temperature too high
+  ASSERT_TRUE(h.run_until([&] { return h.snap("x").state == core::AxisState::Fault; }, 1s));
+  // The fault buffer (PNU 944 -> 947 -> 944 over record 47) names it with the profile's text.
+  ASSERT_TRUE(h.run_until([&] { return h.events_text().find("Heat sink temperature too high") != std::string::npos; }, 3s))
+      << h.events_text();
+  EXPECT_EQ(h.snap("y").state, core::AxisState::SwitchOnDisabled);
+  const auto reset = h.push("x", core::CommandKind::FaultReset);
+  ASSERT_EQ(h.wait_final(reset, 3s), core::ReplyStatus::Completed) << h.reason(reset);
+  EXPECT_EQ(h.snap("x").state, core::AxisState::SwitchOnDisabled);
+  EXPECT_EQ(h.bus->ars(0), 1U);
 }
 
 }  // namespace
