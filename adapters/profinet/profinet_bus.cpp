@@ -844,6 +844,7 @@ core::IoWriteStatus ProfinetBus::io_write(std::size_t k, std::size_t offset, std
 
 std::unique_ptr<ProfinetBus> make_profinet_bus(const config::BusPlan& plan) {
   const auto& o = plan.section<config::ProfinetBusOptions>();
+  if (o.simulated) return make_simulated_profinet_bus(plan);
   ProfinetTransport t;
   link::RawSocketOptions raw;
   raw.interface = o.interface;

@@ -282,7 +282,8 @@ class ProfinetBus final : public core::Bus {
   std::atomic<std::uint64_t> errors_{0};
 };
 
-// The bus of a plan: transport raw -> the raw link and UDP ports on the bus' interface.
+// The bus of a plan: transport raw -> the raw link and UDP ports on the bus' interface; transport
+// sim -> make_simulated_profinet_bus (sim_transport.hpp).
 std::unique_ptr<ProfinetBus> make_profinet_bus(const config::BusPlan& plan);
 
 }  // namespace drivegate::profinet

@@ -23,4 +23,8 @@ struct SimControllerAddress {
 // for as long as the transport's parts live.
 ProfinetTransport sim_transport(PnSimNetwork& network, std::shared_ptr<void> keep, const SimControllerAddress& address);
 
+// The bus of a `transport: sim` plan with its simulated devices. Throws core::BusError naming the
+// station when a device cannot be made.
+std::unique_ptr<ProfinetBus> make_simulated_profinet_bus(const config::BusPlan& plan);
+
 }  // namespace drivegate::profinet

@@ -283,8 +283,12 @@ void read_io(const ProfinetWireRules& rules, const MapReader& b, ProfinetBusOpti
 
 std::vector<OptionSpec> profinet_options() {
   return {
+      {"transport", OptionKind::Choice, 0, 0, std::string{"raw"},
+       "raw: the Ethernet interface given to the network (raw socket and UDP, needs CAP_NET_RAW); sim: simulated "
+       "devices inside drivegated, made from the stations' axes and IO devices",
+       {"raw", "sim"}},
       {"interface", OptionKind::String, 0, 0, std::string{},
-       "the Ethernet interface the PROFINET network is plugged into (such as eth1); required", {}},
+       "raw: the Ethernet interface the PROFINET network is plugged into (such as eth1)", {}},
       {"reduction_ratio", OptionKind::Integer, 1, 512, std::int64_t{16},
        "the IO data go every cycle_time x reduction_ratio (the update time); a power of two, 1..512 (RT class 1)", {}},
       {"data_hold_factor", OptionKind::Integer, 3, 7680, std::int64_t{3},
@@ -312,11 +316,15 @@ std::string ipv4_text(std::uint32_t a) {
 
 void read_profinet_bus(const ProfinetWireRules& rules, const MapReader& b, const MapReader& m, BusPlan& bus) {
   auto& c = bus.sections.edit<ProfinetBusOptions>();
+  c.simulated = option<std::string>(bus, "transport") == "sim";
   c.interface = option<std::string>(bus, "interface");
-  if (c.interface.empty())
+  if (c.simulated) {
+    if (m.has("interface")) m.source().warning(m.mark_of("interface"), m.field("interface"), "is not used with transport sim");
+  } else if (c.interface.empty()) {
     m.error("interface", "a profinet bus needs the Ethernet interface its network is plugged into (such as eth1)");
-  else if (!is_interface_name(c.interface))
+  } else if (!is_interface_name(c.interface)) {
     m.error("interface", "must be a network interface name of 1 to 15 characters such as eth1, got " + in_quotes(c.interface));
+  }
   c.reduction_ratio = static_cast<int>(option<std::int64_t>(bus, "reduction_ratio"));
   c.data_hold_factor = static_cast<int>(option<std::int64_t>(bus, "data_hold_factor"));
   c.dcp_timeout = option<core::Duration>(bus, "dcp_timeout");

@@ -12,7 +12,10 @@ namespace {
 using namespace std::chrono_literals;
 
 // Two controllers on one Ethernet interface would both send the stations' frames.
-std::string resource(const BusPlan& bus) { return "profinet " + bus.section<ProfinetBusOptions>().interface; }
+std::string resource(const BusPlan& bus) {
+  const auto& c = bus.section<ProfinetBusOptions>();
+  return c.simulated ? std::string{} : "profinet " + c.interface;
+}
 
 }  // namespace
 

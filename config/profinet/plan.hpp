@@ -69,6 +69,7 @@ struct ProfinetIoDevice {
 };
 
 struct ProfinetBusOptions {
+  bool simulated = false;  // transport sim: simulated devices inside drivegated
   std::string interface;
   int reduction_ratio = 16;    // update time = cycle_time (the send clock) x this
   int data_hold_factor = 3;    // update times without a frame until the data are invalid
