@@ -1,8 +1,11 @@
 #include "adapters/profinet/sim_transport.hpp"
 
+#include <algorithm>
+
 #include "adapters/link/memory_datagram_port.hpp"
 #include "adapters/link/memory_link.hpp"
 #include "adapters/profinet/link/profinet_link.hpp"
+#include "adapters/profinet/sim/network_builder.hpp"
 #include "adapters/profinet/wire/rpc.hpp"
 
 namespace drivegate::profinet {
@@ -127,6 +130,30 @@ ProfinetTransport sim_transport(PnSimNetwork& network, std::shared_ptr<void> kee
   t.interface = "sim";
   t.peer = std::make_unique<HubPeer>(hub);
   return t;
+}
+
+}  // namespace drivegate::profinet
+
+namespace drivegate::profinet {
+
+std::unique_ptr<ProfinetBus> make_simulated_profinet_bus(const config::BusPlan& plan) {
+  std::shared_ptr<BuiltPnNetwork> built;
+  try {
+    built = build_pn_network(plan, 0);  // one network per bus: its MACs need not differ from another bus'
+  } catch (const PnBuildError& e) {
+    throw core::BusError("bus '" + plan.name + "': " + e.what());
+  }
+  // The controller's address: the first host of the first station's subnet that no station has.
+  const auto& o = plan.section<config::ProfinetBusOptions>();
+  SimControllerAddress a;
+  if (!o.stations.empty()) {
+    const std::uint32_t net = o.stations.front().ip & o.stations.front().netmask;
+    for (std::uint32_t host = net + 1; a.ip == 0 && host < net + 255; ++host)
+      if (std::none_of(o.stations.begin(), o.stations.end(), [&](const config::ProfinetStation& s) { return s.ip == host; }))
+        a.ip = host;
+  }
+  PnSimNetwork& network = built->network();
+  return std::make_unique<ProfinetBus>(plan, sim_transport(network, std::move(built), a));
 }
 
 }  // namespace drivegate::profinet
