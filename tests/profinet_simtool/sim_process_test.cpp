@@ -1,7 +1,9 @@
 // The drivegate-sim binary serving a config's profinet bus on end B of a veth pair (its own network
 // namespace, which carries the stations' configured addresses), driven through its console on a
 // pipe; on end A the controller's DcpClient and StationFinder find the stations by name and give
-// them their addresses; a power loss from the console silences a station. Skipped without root.
+// them their addresses, a CmClient then connects to one over UDP at its new address (the tool
+// opened the device's ports there), and a power loss from the console silences a station.
+// Skipped without root.
 // Also: what the binary says about an interface it cannot open (no root needed).
 #include <gtest/gtest.h>
 
@@ -11,8 +13,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "adapters/link/raw_socket_link.hpp"
-#include "adapters/profinet/link/profinet_link.hpp"
+#include "tests/profinet_sim/veth_controller.hpp"
 #include "tests/profinet_simtool/support.hpp"
 #include "tests/support/netns.hpp"
 #include "tests/support/tool_process.hpp"
@@ -24,9 +25,6 @@ using drivegate::test::NetNamespace;
 using drivegate::test::NetnsScope;
 using drivegate::test::ToolProcess;
 using drivegate::test::VethPair;
-using namespace std::chrono_literals;
-
-constexpr MacAddress kControllerMac{0x02, 0x00, 0x00, 0x00, 0x00, 0x01};
 
 std::filesystem::path write_config(const std::string& name, const std::string& yaml) {
   const auto path = std::filesystem::temp_directory_path() /
@@ -61,32 +59,24 @@ class PnSimProcess : public ::testing::Test {
       const NetnsScope in(*ns_sim_);
       sim_ = std::make_unique<ToolProcess>(DRIVEGATE_SIM_EXE, std::vector<std::string>{config_.string(), "--interface", veth_->b()});
     }
-    link::RawSocketOptions o;
-    o.interface = veth_->a();
-    link_ = std::make_unique<link::RawSocketLink>(kFrameRules, o);
+    controller_ = std::make_unique<VethController>(veth_->a());
     const NetnsScope in(*ns_gw_);
-    link_->open();
+    controller_->open();
   }
   void TearDown() override {
     sim_.reset();
     if (!config_.empty()) std::filesystem::remove(config_);
   }
 
-  // Runs the controller's DCP engine on end A until `done` or 10 s.
-  template <typename Engine>
-  bool run_dcp(Engine& engine, const std::function<bool()>& done) {
-    std::array<std::uint8_t, kMaxFrameSize> buf{};
-    std::array<link::FrameBuffer, 16> in{};
+  // Runs the controller on end A until `done` or 10 s.
+  bool run_until(const std::function<bool()>& done) {
+    std::vector<pollfd> fds;
+    for (const int fd : controller_->wait_fds()) fds.push_back({fd, POLLIN, 0});
     const core::SteadyClock clock;
     for (const core::TimePoint end = clock.now() + 10s; clock.now() < end;) {
-      const core::TimePoint now = clock.now();
-      while (const std::size_t n = engine.poll(now, buf)) (void)link_->send(std::span<const std::uint8_t>(buf).first(n));
-      while (const std::size_t n = link_->receive(in)) {
-        for (std::size_t i = 0; i < n; ++i) (void)engine.on_frame(std::span<const std::uint8_t>(in[i].bytes).first(in[i].size), now);
-      }
+      controller_->poll(clock.now());
       if (done()) return true;
-      pollfd p{link_->wait_fd(), POLLIN, 0};
-      (void)::poll(&p, 1, 1);
+      (void)::poll(fds.data(), fds.size(), 1);
     }
     return done();
   }
@@ -96,7 +86,7 @@ class PnSimProcess : public ::testing::Test {
   std::unique_ptr<VethPair> veth_;
   std::filesystem::path config_;
   std::unique_ptr<ToolProcess> sim_;
-  std::unique_ptr<link::RawSocketLink> link_;
+  std::unique_ptr<VethController> controller_;
 };
 
 TEST_F(PnSimProcess, TheControllerFindsTheStationsByNameAndGivesThemTheirAddresses) {
@@ -111,9 +101,10 @@ TEST_F(PnSimProcess, TheControllerFindsTheStationsByNameAndGivesThemTheirAddress
             "alarm-cr=0 rx-lost=0 tx-lost=0 alarms=-");
 
   const config::Plan plan = plan_of(pn_config(veth_->a()));
-  DcpClient dcp(kControllerMac);
-  StationFinder finder(dcp, stations_of(plan.buses[0].section<config::ProfinetBusOptions>()));
-  ASSERT_TRUE(run_dcp(finder, [&] { return finder.done(); }));
+  DcpClient& dcp = controller_->dcp;
+  controller_->finder = std::make_unique<StationFinder>(dcp, stations_of(plan.buses[0].section<config::ProfinetBusOptions>()));
+  StationFinder& finder = *controller_->finder;
+  ASSERT_TRUE(run_until([&] { return finder.done(); }));
   ASSERT_EQ(finder.reports().size(), 3U);
   for (std::size_t i = 0; i < 3; ++i) {
     const StationReport& r = finder.reports()[i];
@@ -124,16 +115,26 @@ TEST_F(PnSimProcess, TheControllerFindsTheStationsByNameAndGivesThemTheirAddress
   EXPECT_NE(item(status, "akd-x").find(" ip=192.168.0.10 ar=NoAr "), std::string::npos) << status;
   EXPECT_NE(item(status, "akd-y").find(" ip=192.168.0.11 "), std::string::npos) << status;
   EXPECT_NE(item(status, "io-block").find(" ip=192.168.0.20 "), std::string::npos) << status;
+  controller_->finder.reset();
+
+  // A Connect to akd-x at its new address (the [sim] IDs are the test bench's), to data exchange.
+  ArPlan ar(akd_plan(1, 4, 4), 0xC0A8000A, MacAddress{0x02, 0x50, 0x4E, 0x00, 0x00, 0x01}, 0);
+  ASSERT_TRUE(controller_->connect(ar, core::SteadyClock{}.now()));
+  CmClient& cm = controller_->cm();
+  ASSERT_TRUE(run_until([&] { return cm.state() == CmClientState::DataExchange || cm.state() == CmClientState::Failed; }));
+  ASSERT_EQ(cm.state(), CmClientState::DataExchange) << cm.reason();
+  ASSERT_TRUE(run_until([&] { return ar.consumer->counters().frames >= 3; })) << ar.consumer->reason();
+  EXPECT_NE(item(sim_->command("status"), "akd-x").find(" ar=DataExchange "), std::string::npos);
 
   // A power loss: akd-y no longer answers; back, it answers without its (temporary) address.
   EXPECT_EQ(sim_->command("power-off akd-y"), "ok power-off pn0:akd-y");
   std::array<DcpStation, 8> found{};
   DcpRequestId id = dcp.identify_all(found, 1);
-  ASSERT_TRUE(run_dcp(dcp, [&] { return dcp.result(id).status == DcpRequestStatus::Done; }));
+  ASSERT_TRUE(run_until([&] { return dcp.result(id).status == DcpRequestStatus::Done; }));
   EXPECT_EQ(dcp.stations(id).size(), 2U);
   EXPECT_EQ(sim_->command("power-on akd-y"), "ok power-on pn0:akd-y");
   id = dcp.identify_name("akd-y", found, 1);
-  ASSERT_TRUE(run_dcp(dcp, [&] { return dcp.result(id).status == DcpRequestStatus::Done; }));
+  ASSERT_TRUE(run_until([&] { return dcp.result(id).status == DcpRequestStatus::Done; }));
   ASSERT_EQ(dcp.stations(id).size(), 1U);
   EXPECT_EQ(dcp.stations(id)[0].ip.address, (std::array<std::uint8_t, 4>{}));
   EXPECT_EQ(sim_->stop(), 0);
