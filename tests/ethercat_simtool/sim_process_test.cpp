@@ -5,10 +5,6 @@
 // needed).
 #include <gtest/gtest.h>
 
-#include <fcntl.h>
-#include <signal.h>
-#include <spawn.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -21,9 +17,7 @@
 #include "adapters/ethercat/link/ethercat_link.hpp"
 #include "tests/ethercat_simtool/support.hpp"
 #include "tests/support/netns.hpp"
-#include "tests/support/pipe_lines.hpp"
-
-extern char** environ;
+#include "tests/support/tool_process.hpp"
 
 namespace drivegate::ethercat::sim {
 namespace {
@@ -31,8 +25,6 @@ namespace {
 using drivegate::test::NetNamespace;
 using drivegate::test::NetnsScope;
 using drivegate::test::VethPair;
-using namespace std::chrono_literals;
-using Clock = std::chrono::steady_clock;
 
 std::filesystem::path write_config(const std::string& name, const std::string& yaml) {
   const auto path = std::filesystem::temp_directory_path() /
@@ -41,84 +33,10 @@ std::filesystem::path write_config(const std::string& name, const std::string& y
   return path;
 }
 
-// drivegate-sim with pipes on stdin, stdout and stderr, started in the caller's network namespace
-// (a NetnsScope around the constructor puts it into another).
-class SimProcess {
+// drivegate-sim with pipes on stdin, stdout and stderr (tests/support/tool_process.hpp).
+class SimProcess : public drivegate::test::ToolProcess {
  public:
-  explicit SimProcess(const std::vector<std::string>& args) {
-    int in[2];
-    int out[2];
-    int err[2];
-    if (::pipe2(in, O_CLOEXEC) != 0 || ::pipe2(out, O_CLOEXEC) != 0 || ::pipe2(err, O_CLOEXEC) != 0) {
-      ADD_FAILURE() << "pipe2 failed";
-      return;
-    }
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_adddup2(&actions, in[0], STDIN_FILENO);
-    posix_spawn_file_actions_adddup2(&actions, out[1], STDOUT_FILENO);
-    posix_spawn_file_actions_adddup2(&actions, err[1], STDERR_FILENO);
-    std::vector<std::string> all{DRIVEGATE_SIM_EXE};
-    all.insert(all.end(), args.begin(), args.end());
-    std::vector<char*> argv;
-    for (auto& a : all) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    if (posix_spawn(&pid_, argv[0], &actions, nullptr, argv.data(), environ) != 0) {
-      ADD_FAILURE() << "cannot start " << all[0];
-      pid_ = -1;
-    }
-    posix_spawn_file_actions_destroy(&actions);
-    ::close(in[0]);
-    ::close(out[1]);
-    ::close(err[1]);
-    stdin_ = in[1];
-    stdout_ = out[0];
-    stderr_ = err[0];
-  }
-  ~SimProcess() {
-    if (pid_ > 0) {
-      ::kill(pid_, SIGKILL);
-      ::waitpid(pid_, nullptr, 0);
-    }
-    for (int fd : {stdin_, stdout_, stderr_}) {
-      if (fd >= 0) ::close(fd);
-    }
-  }
-  SimProcess(const SimProcess&) = delete;
-  SimProcess& operator=(const SimProcess&) = delete;
-
-  std::optional<std::string> line(std::chrono::milliseconds timeout = 10s) { return out_.next(stdout_, timeout); }
-  std::string error_text() {
-    std::string all;
-    while (const auto l = err_.next(stderr_, 2000ms)) all += *l + "\n";
-    return all;
-  }
-  std::string command(const std::string& c) {
-    const std::string l = c + "\n";
-    if (::write(stdin_, l.data(), l.size()) != static_cast<ssize_t>(l.size())) return "(write failed)";
-    return line(5s).value_or("(no answer)");
-  }
-  // Exit status after SIGTERM (or after it ended by itself); -1 when it did not end in 5 s.
-  int stop(bool signal = true) {
-    if (signal) ::kill(pid_, SIGTERM);
-    for (const auto end = Clock::now() + 5s; Clock::now() < end;) {
-      int status = 0;
-      if (::waitpid(pid_, &status, WNOHANG) == pid_) {
-        pid_ = -1;
-        return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-      }
-      ::poll(nullptr, 0, 10);
-    }
-    return -1;
-  }
-
- private:
-  pid_t pid_ = -1;
-  int stdin_ = -1;
-  int stdout_ = -1;
-  int stderr_ = -1;
-  drivegate::test::PipeLines out_;
-  drivegate::test::PipeLines err_;
+  explicit SimProcess(const std::vector<std::string>& args) : ToolProcess(DRIVEGATE_SIM_EXE, args) {}
 };
 
 // The part of a status answer about BUS:K, up to its `;`.

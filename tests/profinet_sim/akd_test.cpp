@@ -1,6 +1,7 @@
 // The controller's CmClient and cyclic engines against simulated AKD and generic IO devices: the
 // telegram picked by the expected submodule, data both ways, the PROFIdrive state machine to S4,
-// a record-47 parameter read, the device's watchdog, power loss, a wrong module, no allocation.
+// a record-47 parameter read, the device's watchdog, power loss, a wrong module, no allocation
+// (alarms included).
 #include <gtest/gtest.h>
 
 #include "profiles/profidrive/param_access.hpp"
@@ -350,7 +351,16 @@ TEST(PnSimAkd, DeviceCyclicPathDoesNotAllocate) {
   l.bench.start(ar);
   ASSERT_TRUE(l.bench.run_until([&] { return in_data_exchange(ar); }, 5s)) << ar.cm->reason();
   put16(plan.provider->data(plan.index(1)), 0, 0x047E);
-  // The device alone: its output frames fed in and its polls, 1000 cycles.
+  // The controller's side of the AR's alarm CR, to acknowledge the device's alarms.
+  AlarmChannel alarms(AlarmChannelConfig{kControllerMac, device_mac(1), plan.connect.alarm, kDeviceAlarmReference});
+  alarms.open();
+  AlarmNotification process;
+  process.alarm_type = alarm_type::kProcess;
+  process.api = akd::kProfidriveApi;
+  process.slot = akd::kTelegramSlot;
+  process.subslot = akd::kTelegramSubslot;
+  // The device alone: its output frames fed in and its polls, 1000 cycles, an alarm every 50th
+  // acknowledged by the controller's alarm CR.
   std::array<std::uint8_t, kMaxFrameSize> out_frame{};
   std::array<std::uint8_t, kMaxFrameSize> in_frame{};
   CmOutbox box;
@@ -359,14 +369,30 @@ TEST(PnSimAkd, DeviceCyclicPathDoesNotAllocate) {
   const drivegate::test::AllocationScope scope;
   for (int i = 0; i < 1000; ++i) {
     t += 16ms;
+    if (i % 50 == 0) {
+      ASSERT_TRUE(l.drive->send_alarm(process));
+    }
     const std::size_t n = plan.provider->poll(t, out_frame);
     if (n > 0) (void)l.drive->on_frame(std::span<const std::uint8_t>(out_frame).first(n), t);
-    while (const std::size_t m = l.drive->poll(t, in_frame, box)) sent += m > 0 ? 1 : 0;
+    for (bool any = true; any;) {
+      any = false;
+      while (const std::size_t m = l.drive->poll(t, in_frame, box)) {
+        any = true;
+        if (!alarms.on_frame(std::span<const std::uint8_t>(in_frame).first(m), t)) ++sent;  // an input CR frame
+      }
+      while (const std::size_t m = alarms.poll(t, out_frame)) {
+        any = true;
+        (void)l.drive->on_frame(std::span<const std::uint8_t>(out_frame).first(m), t);
+      }
+    }
   }
   EXPECT_EQ(scope.count(), 0U);
   EXPECT_GE(sent, 999U);
   EXPECT_EQ(l.drive->ar_state(), CmServerState::DataExchange);
   EXPECT_EQ(l.akd->drive().state(), pd::sim::State::S2ReadyForSwitchingOn);
+  EXPECT_EQ(alarms.counters().alarms, 20U);
+  ASSERT_NE(l.drive->alarm_cr(), nullptr);
+  EXPECT_EQ(l.drive->alarm_cr()->counters().acknowledged, 20U);
 }
 
 }  // namespace

@@ -3,7 +3,8 @@
 // PnSimNetwork of simulated devices, in memory on virtual time: every tick the controller side and
 // the network are polled, and frames and datagrams are delivered until none is left. An AR plan
 // (ArPlan) builds the Connect (expected submodules, both IOCRs with the frame offsets
-// compute_csdu_layout gives) and the controller's cyclic engines for it.
+// compute_csdu_layout gives) and the controller's cyclic engines for it; an AR may have the
+// controller's AlarmChannel, which runs with the AR and takes the devices' alarm frames.
 #include <chrono>
 #include <cstdint>
 #include <deque>
@@ -12,6 +13,7 @@
 #include <span>
 #include <vector>
 
+#include "adapters/profinet/controller/alarm_channel.hpp"
 #include "adapters/profinet/controller/cm_client.hpp"
 #include "adapters/profinet/controller/rt_cyclic.hpp"
 #include "adapters/profinet/controller/station_finder.hpp"
@@ -190,20 +192,24 @@ class LastReply final : public CmRecordListener {
   std::string text;
 };
 
-// A controller with one AR per plan, its DCP client and an optional station finder.
+// A controller with one AR per plan, its DCP client and an optional station finder, on its own
+// network of devices or the caller's.
 class SimBench final : private PnSimWire {
  public:
   struct Ar {
     ArPlan* plan = nullptr;
     std::unique_ptr<CmClient> cm;
     bool cyclic = false;  // the cyclic engines run (from the Connect response on)
+    std::unique_ptr<AlarmChannel> alarms;  // optional: opened and closed with the cyclic engines
   };
 
-  SimBench() : dcp(kControllerMac) {}
+  SimBench() : net(own_net_), dcp(kControllerMac) {}
+  // The devices of `network` (which must outlive the bench).
+  explicit SimBench(PnSimNetwork& network) : net(network), dcp(kControllerMac) {}
 
   // An AR for `plan` (which must outlive the bench); start() sends its Connect.
   Ar& add_ar(ArPlan& plan) {
-    ars.push_back({&plan, std::make_unique<CmClient>(plan.config, &replies), false});
+    ars.push_back({&plan, std::make_unique<CmClient>(plan.config, &replies), false, nullptr});
     return ars.back();
   }
   void start(Ar& ar) {
@@ -224,6 +230,10 @@ class SimBench final : private PnSimWire {
         ar.cm->poll(now, out_);
         drive_cyclic(ar);
         while (const std::size_t n = ar.plan->provider->poll(now, buf)) {
+          any = true;
+          to_devices(std::span<const std::uint8_t>(buf).first(n));
+        }
+        while (const std::size_t n = ar.alarms ? ar.alarms->poll(now, buf) : 0) {
           any = true;
           to_devices(std::span<const std::uint8_t>(buf).first(n));
         }
@@ -258,7 +268,11 @@ class SimBench final : private PnSimWire {
     (void)net.on_datagram(bytes, from, to, now, *this);
   }
 
-  PnSimNetwork net;
+ private:
+  PnSimNetwork own_net_;  // the network when the caller names none (made before `net`, which refers to it)
+
+ public:
+  PnSimNetwork& net;
   DcpClient dcp;
   std::unique_ptr<StationFinder> finder;
   std::deque<Ar> ars;
@@ -303,7 +317,10 @@ class SimBench final : private PnSimWire {
       const Bytes f = std::move(frames_.front());
       frames_.pop_front();
       (void)dcp.on_frame(f, now);
-      for (Ar& ar : ars) (void)ar.plan->consumer->on_frame(f, now);
+      for (Ar& ar : ars) {
+        (void)ar.plan->consumer->on_frame(f, now);
+        if (ar.alarms) (void)ar.alarms->on_frame(f, now);
+      }
     }
     while (!datagrams_.empty()) {
       const Datagram g = std::move(datagrams_.front());
@@ -331,10 +348,12 @@ class SimBench final : private PnSimWire {
       }
       ar.plan->provider->start(now);
       ar.plan->consumer->arm(now);
+      if (ar.alarms) ar.alarms->open();
     } else if (!exists && ar.cyclic) {
       ar.cyclic = false;
       ar.plan->provider->stop();
       ar.plan->consumer->disarm();
+      if (ar.alarms) ar.alarms->close();
     }
   }
 

@@ -10,8 +10,7 @@
 #include "adapters/link/udp_endpoint.hpp"
 #include "adapters/profinet/link/profinet_link.hpp"
 #include "adapters/profinet/sim/pn_sim_link.hpp"
-#include "adapters/profinet/wire/byte_order.hpp"
-#include "tests/profinet_sim/sim_bench.hpp"
+#include "tests/profinet_sim/veth_controller.hpp"
 #include "tests/support/netns.hpp"
 
 namespace drivegate::profinet::test {
@@ -50,31 +49,24 @@ class PnSimVeth : public ::testing::Test {
       u.address = local.address;
       return std::make_unique<link::UdpEndpoint>(u);
     });
-    o.interface = veth_->a();
-    controller_link_ = std::make_unique<link::RawSocketLink>(kFrameRules, o);
-    rpc_client_ = std::make_unique<link::UdpEndpoint>(rpc_udp_options(veth_->a()));
-    rpc_server_ = std::make_unique<link::UdpEndpoint>(rpc_udp_options(veth_->a(), kRpcUdpPort));
+    controller_ = std::make_unique<VethController>(veth_->a());
     {
       const NetnsScope in(*ns_dev_);
       runner_->open();
     }
     const NetnsScope in(*ns_ctl_);
-    controller_link_->open();
-    rpc_client_->open();
-    rpc_server_->open();
+    controller_->open();
   }
 
   // Runs both sides until `done` or 10 s, waiting for traffic at most 1 ms at a time.
   bool run_until(const std::function<bool()>& done) {
     std::vector<pollfd> fds;
     for (const int fd : runner_->wait_fds()) fds.push_back({fd, POLLIN, 0});
-    for (const int fd : {controller_link_->wait_fd(), rpc_client_->wait_fd(), rpc_server_->wait_fd()}) {
-      fds.push_back({fd, POLLIN, 0});
-    }
+    for (const int fd : controller_->wait_fds()) fds.push_back({fd, POLLIN, 0});
     const core::SteadyClock clock;
     for (const core::TimePoint end = clock.now() + 10s; clock.now() < end;) {
       const core::TimePoint now = clock.now();
-      controller(now);
+      controller_->poll(now);
       runner_->run_once(now);
       if (done()) return true;
       (void)::poll(fds.data(), fds.size(), 1);
@@ -82,72 +74,29 @@ class PnSimVeth : public ::testing::Test {
     return done();
   }
 
-  void controller(core::TimePoint now) {
-    std::array<std::uint8_t, kMaxFrameSize> buf{};
-    while (const std::size_t n = dcp_.poll(now, buf)) (void)controller_link_->send(std::span<const std::uint8_t>(buf).first(n));
-    std::array<link::FrameBuffer, 16> in{};
-    while (const std::size_t n = controller_link_->receive(in)) {
-      for (std::size_t i = 0; i < n; ++i) {
-        const auto f = std::span<const std::uint8_t>(in[i].bytes).first(in[i].size);
-        (void)dcp_.on_frame(f, now);
-        if (plan_) (void)plan_->consumer->on_frame(f, now);
-      }
-    }
-    if (!cm_) return;
-    link::Datagram d;
-    for (const auto& [port, socket] : {std::pair{rpc_client_.get(), CmSocket::Client}, std::pair{rpc_server_.get(), CmSocket::Server}}) {
-      while (port->receive_from(d)) {
-        cm_->on_datagram(d.view(), {get_be32(d.from.address, 0), d.from.port}, socket, now, out_);
-      }
-    }
-    cm_->poll(now, out_);
-    while (!out_.empty()) {
-      const CmDatagram& g = out_.front();
-      link::DatagramPort& port = g.from == CmSocket::Server ? *rpc_server_ : *rpc_client_;
-      link::Ipv4Endpoint to{{}, g.to.port};
-      put_be32(to.address, 0, g.to.ip);
-      (void)port.send_to(to, g.view());
-      out_.pop();
-    }
-    const CmClientState s = cm_->state();
-    if (!cyclic_ && s != CmClientState::Connecting && s != CmClientState::Idle && s != CmClientState::Failed) {
-      cyclic_ = true;
-      for (std::size_t i = 0; i < plan_->provider->placements().size(); ++i) (void)plan_->provider->set_iops(i, iox_status::kGood);
-      plan_->provider->start(now);
-      plan_->consumer->arm(now);
-    }
-    while (const std::size_t n = plan_->provider->poll(now, buf)) {
-      (void)controller_link_->send(std::span<const std::uint8_t>(buf).first(n));
-    }
-    (void)plan_->consumer->poll(now);
-  }
-
   std::unique_ptr<NetNamespace> ns_ctl_, ns_dev_;
   std::unique_ptr<VethPair> veth_;
   std::unique_ptr<AkdPersona> akd_;
   std::unique_ptr<GenericIoPersona> io_;
   PnSimNetwork net_;
-  std::unique_ptr<link::RawSocketLink> device_link_, controller_link_;
+  std::unique_ptr<link::RawSocketLink> device_link_;
   std::unique_ptr<PnSimLinkRunner> runner_;
-  std::unique_ptr<link::UdpEndpoint> rpc_client_, rpc_server_;
-  DcpClient dcp_{kControllerMac};
+  std::unique_ptr<VethController> controller_;
   std::unique_ptr<ArPlan> plan_;
-  std::unique_ptr<CmClient> cm_;
-  CmOutbox out_;
-  bool cyclic_ = false;
 };
 
 TEST_F(PnSimVeth, IdentifyAndConnectAcrossARealPort) {
+  DcpClient& dcp = controller_->dcp;
   std::array<DcpStation, 8> found{};
-  const DcpRequestId id = dcp_.identify_all(found, 1);
-  ASSERT_TRUE(run_until([&] { return dcp_.result(id).status == DcpRequestStatus::Done; }));
-  ASSERT_EQ(dcp_.stations(id).size(), 2U);
+  const DcpRequestId id = dcp.identify_all(found, 1);
+  ASSERT_TRUE(run_until([&] { return dcp.result(id).status == DcpRequestStatus::Done; }));
+  ASSERT_EQ(dcp.stations(id).size(), 2U);
 
   plan_ = std::make_unique<ArPlan>(akd_plan(1, 4, 4), ip_of(11), device_mac(1), 0);
-  cm_ = std::make_unique<CmClient>(plan_->config);
-  ASSERT_TRUE(cm_->start(core::SteadyClock{}.now(), out_));
-  ASSERT_TRUE(run_until([&] { return cm_->state() == CmClientState::DataExchange || cm_->state() == CmClientState::Failed; }));
-  ASSERT_EQ(cm_->state(), CmClientState::DataExchange) << cm_->reason();
+  ASSERT_TRUE(controller_->connect(*plan_, core::SteadyClock{}.now()));
+  CmClient& cm = controller_->cm();
+  ASSERT_TRUE(run_until([&] { return cm.state() == CmClientState::DataExchange || cm.state() == CmClientState::Failed; }));
+  ASSERT_EQ(cm.state(), CmClientState::DataExchange) << cm.reason();
   ASSERT_TRUE(run_until([&] { return plan_->consumer->counters().frames >= 5; })) << plan_->consumer->reason();
   EXPECT_EQ(plan_->consumer->state(), RtConsumerState::Running);
   EXPECT_EQ(net_.device(0).ar_state(), CmServerState::DataExchange);

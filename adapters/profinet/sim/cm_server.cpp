@@ -254,7 +254,7 @@ void CmServer::on_connect(std::span<const std::uint8_t> datagram, const UdpEndpo
   ConnectResponse res;
   res.ar = {ar_type::kIocarSingle, ar_.ar_uuid, ar_.session_key, config_.mac, kEtherTypePnio};
   res.iocrs = iocrs;
-  res.alarm_cr = {1, 1, std::min<std::uint16_t>(c.alarm_cr.block.max_alarm_data_length, 200)};
+  res.alarm_cr = {1, kDeviceAlarmReference, std::min<std::uint16_t>(c.alarm_cr.block.max_alarm_data_length, 200)};
   res.module_diff = std::span<const ModuleDiffApi>(diff_apis_.data(), diff_api_count_);
   responder_.answer(encode_connect_response(rh, PnioStatus{}, max, res, buf), out);
   set_state(CmServerState::Parameterising);

@@ -56,6 +56,9 @@ struct CmServerConfig {
   ByteOrder order = ByteOrder::Little;  // of the device's own calls
 };
 
+// [sim] The device's LocalAlarmReference, answered in the AlarmCRBlockRes: one AR at a time.
+inline constexpr std::uint16_t kDeviceAlarmReference = 1;
+
 enum class CmServerState : std::uint8_t {
   NoAr,
   Parameterising,    // Connect answered, records and PrmEnd expected

@@ -20,6 +20,9 @@ constexpr std::uint8_t kFieldDataLength = 8;
 constexpr std::uint8_t kFieldReductionRatio = 11;
 constexpr std::uint8_t kFieldFrameOffset = 24;
 constexpr std::uint8_t kFieldSubmoduleDataLength = 14;
+// AlarmCRBlockReq: 7 RTATimeoutFactor, 8 RTARetries.
+constexpr std::uint8_t kFieldRtaTimeoutFactor = 7;
+constexpr std::uint8_t kFieldRtaRetries = 8;
 
 std::uint8_t iocr_field(RtConfigError e) noexcept {
   switch (e) {
@@ -73,7 +76,8 @@ bool PnDevice::on_frame(std::span<const std::uint8_t> frame, core::TimePoint now
     ++counters_.rx_powered_off;
     return false;
   }
-  if (consumer_) {
+  // The AR's engines exist together (from the Connect to the AR's end).
+  if (consumer_ && alarms_) {
     const EthernetView e = decode_ethernet(frame);
     if (e.ok() && e.frame_class == FrameClass::RtCyclic) {
       if (lose_rx_ > 0) {
@@ -82,6 +86,9 @@ bool PnDevice::on_frame(std::span<const std::uint8_t> frame, core::TimePoint now
         return true;
       }
       return consumer_->on_frame(frame, now);
+    }
+    if (e.ok() && (e.frame_class == FrameClass::AlarmHigh || e.frame_class == FrameClass::AlarmLow)) {
+      return alarms_->on_frame(frame, now);
     }
   }
   return dcp_.on_frame(frame, now);
@@ -108,7 +115,17 @@ std::size_t PnDevice::poll(core::TimePoint now, std::span<std::uint8_t> frame, C
     why.format("output CR watchdog: %.*s", static_cast<int>(consumer_->reason().size()), consumer_->reason().data());
     cm_->abort_ar(why.view());
   }
+  // An alarm CR that aborted (its ERR-RTA-PDU went out with the previous poll) ends the AR.
+  if (alarms_ && alarms_->state() == AlarmSenderState::Aborted) {
+    ++counters_.alarm_cr_aborts;
+    core::FixedString<200> why;
+    why.format("alarm CR: %.*s", static_cast<int>(alarms_->reason().size()), alarms_->reason().data());
+    cm_->abort_ar(why.view());
+  }
   if (const std::size_t n = dcp_.poll(now, frame)) return n;
+  if (alarms_) {
+    if (const std::size_t n = alarms_->poll(now, frame)) return n;
+  }
   if (provider_) {
     if (now < provider_->next_deadline()) return 0;
     run_cycle(provider_->period());
@@ -135,6 +152,7 @@ core::TimePoint PnDevice::next_deadline() const noexcept {
   if (!powered_) return core::TimePoint::max();
   core::TimePoint t = std::min(dcp_.next_deadline(), cm_->next_deadline());
   if (consumer_) t = std::min(t, consumer_->next_deadline());
+  if (alarms_) t = std::min(t, alarms_->next_deadline());
   if (provider_) return std::min(t, provider_->next_deadline());
   return std::min(t, idle_started_ ? idle_next_ : core::TimePoint::min());
 }
@@ -167,13 +185,25 @@ PnioStatus PnDevice::on_connect(const CmArSetup& setup) noexcept {
       if (e.has_submodule) persona_.fit(e.api, e.slot, e.module_ident, e.submodule.subslot, e.submodule.ident);
     }
   }
-  const PnioStatus s = set_up_cyclic(setup);
-  if (!s.ok()) ++counters_.connects_refused;
+  // The alarm CR's transport values, before anything is set up [IEC 61158-6-10, AlarmCRBlockReq].
+  const AlarmCrBlockReq& alarm_cr = setup.request.alarm_cr.block;
+  PnioStatus s;
+  switch (validate_alarm_cr(alarm_cr)) {
+    case AlarmCrError::None: s = set_up_cyclic(setup); break;
+    case AlarmCrError::BadTimeoutFactor: s = connect_error(pnio_error_code1::kAlarmCrBlockReq, kFieldRtaTimeoutFactor); break;
+    case AlarmCrError::BadRetries: s = connect_error(pnio_error_code1::kAlarmCrBlockReq, kFieldRtaRetries); break;
+  }
+  if (!s.ok()) {
+    ++counters_.connects_refused;
+    return s;
+  }
+  alarms_.emplace(AlarmSenderConfig{config_.dcp.mac, setup.request.ar.block.initiator_mac, alarm_cr, kDeviceAlarmReference});
+  alarms_->open();
   return s;
 }
 
 PnioStatus PnDevice::set_up_cyclic(const CmArSetup& setup) noexcept {
-  stop_cyclic();
+  stop_ar_engines();
   const std::span<const CmModelSlot> model = persona_.slots();
   auto matches = [&model](const ExpectedEntry& e) {
     const auto slot = std::find_if(model.begin(), model.end(), [&e](const CmModelSlot& m) {
@@ -231,7 +261,7 @@ PnioStatus PnDevice::set_up_cyclic(const CmArSetup& setup) noexcept {
   std::uint8_t field = iocr_mismatch(setup.input, provider_->placements());
   if (field == 0) field = iocr_mismatch(setup.output, consumer_->placements());
   if (field != 0) {
-    stop_cyclic();
+    stop_ar_engines();
     return connect_error(pnio_error_code1::kIocrBlockReq, field);
   }
   submodule_count_ = n;
@@ -275,9 +305,10 @@ std::uint8_t PnDevice::iocr_mismatch(const IocrBlockReqView& v, std::span<const 
   return entries == expected ? 0 : kFieldFrameOffset;
 }
 
-void PnDevice::stop_cyclic() noexcept {
+void PnDevice::stop_ar_engines() noexcept {
   provider_.reset();
   consumer_.reset();
+  alarms_.reset();
   submodule_count_ = 0;
 }
 
@@ -292,7 +323,7 @@ PnioStatus PnDevice::on_record_read(const RecordReqHeader& h, std::span<std::uin
 void PnDevice::on_ar_state(CmServerState state, std::string_view) noexcept {
   switch (state) {
     case CmServerState::NoAr:
-      stop_cyclic();
+      stop_ar_engines();
       dcp_.set_in_operation(false);
       break;
     case CmServerState::Parameterising: dcp_.set_in_operation(true); break;
@@ -309,7 +340,7 @@ void PnDevice::abort_ar(std::string_view why) noexcept { cm_->abort_ar(why); }
 
 void PnDevice::power_loss() noexcept {
   powered_ = false;
-  stop_cyclic();
+  stop_ar_engines();
 }
 
 void PnDevice::power_return(core::TimePoint now) noexcept {

@@ -5,11 +5,16 @@
 // - ethercat buses with transport raw: the line of the bus (adapters/ethercat/sim/line_builder.hpp:
 //   a slave per position, drives by their profile's ethercat.persona, io: slaves generic-io) on a
 //   network interface, normally the other end of a veth pair from the gateway's `interface`
-//   (sim_endpoint.hpp; needs CAP_NET_RAW).
+//   (sim_endpoint.hpp; needs CAP_NET_RAW);
+// - profinet buses: a simulated IO device per station of the bus (adapters/profinet/sim/
+//   network_builder.hpp: an AKD for a station an axis uses, generic IO for an io: entry), each with
+//   its own MAC, its NameOfStation and no IP address until the controller sets one by DCP, on a
+//   network interface like an ethercat line (pn_sim_link.hpp; CAP_NET_RAW). The interface must
+//   carry the stations' configured addresses (ip addr add), so that the devices can take them.
 //
 //   drivegate-sim CONFIG [--bus NAME] [--interface [BUS=]IFACE]...
 //
-// --interface: the interface an ethercat line is served on (BUS= for one bus of several); without
+// --interface: the interface an ethercat line or profinet network is served on (BUS= for one bus of several); without
 // it, the bus' own `interface` (the simulator then runs in another network namespace, whose end of
 // the pair carries the gateway's name).
 //
@@ -21,10 +26,14 @@
 //             service-write NODE INDEX[:SUB] VALUE SIZE
 //   EtherCAT: power-off K | power-on K | break-after K | mend [BUS] | drop N [BUS] |
 //             corrupt N [BUS] | stick K STATE CODE | unstick K   (adapters/ethercat/sim/line_console.hpp)
-//   both:     status
-// NODE is a node-ID, K a position on an EtherCAT line (1 = next to the gateway), each BUS:NODE or
-// BUS:K when more than one bus has it; numbers are decimal or 0x hex. `corrupt` with one number
-// (or a number and a bus name) is EtherCAT's, with a node and a count CANopen's.
+//   PROFINET: power-off STATION | power-on STATION | reboot STATION | abort-ar STATION |
+//             lose STATION rx|tx N | drive-fault STATION NUMBER |
+//             alarm STATION KIND [SLOT[:SUBSLOT]] [ERROR]   (adapters/profinet/sim/pn_console.hpp)
+//   all:      status
+// NODE is a node-ID, K a position on an EtherCAT line (1 = next to the gateway), STATION a
+// PROFINET NameOfStation, each BUS:NODE, BUS:K or BUS:STATION when more than one bus has it;
+// numbers are decimal or 0x hex. `corrupt` with one number (or a number and a bus name) is
+// EtherCAT's, with a node and a count CANopen's; power-off / power-on naming a station PROFINET's.
 #include <poll.h>
 #include <signal.h>
 #include <time.h>
@@ -50,7 +59,14 @@
 #include "adapters/ethercat/sim/line_builder.hpp"
 #include "adapters/ethercat/sim/line_console.hpp"
 #include "adapters/ethercat/sim/sim_endpoint.hpp"
+#include "adapters/link/raw_socket_link.hpp"
+#include "adapters/link/udp_endpoint.hpp"
+#include "adapters/profinet/link/profinet_link.hpp"
+#include "adapters/profinet/sim/network_builder.hpp"
+#include "adapters/profinet/sim/pn_console.hpp"
+#include "adapters/profinet/sim/pn_sim_link.hpp"
 #include "config/ethercat/plan.hpp"
+#include "config/profinet/plan.hpp"
 #include "config/loader.hpp"
 
 namespace {
@@ -77,6 +93,14 @@ struct EcatBus {
   std::unique_ptr<ethercat::sim::BuiltLine> line;
   std::unique_ptr<ethercat::RawSocketLink> wire;
   std::unique_ptr<ethercat::sim::SimEndpoint> endpoint;
+};
+
+// A PROFINET network served on a network interface.
+struct PnBus {
+  std::unique_ptr<profinet::BuiltPnNetwork> network;
+  std::unique_ptr<link::RawSocketLink> wire;
+  std::unique_ptr<profinet::PnSimLinkRunner> runner;
+  std::string reported;  // the runner's last port error said on stderr
 };
 
 void say(const std::string& line) {
@@ -130,22 +154,36 @@ std::string usage_of(const std::string& verb) {
 
 class Simulator {
  public:
-  Simulator(std::vector<SimBus> buses, std::vector<EcatBus> ecat) : buses_(std::move(buses)), ecat_(std::move(ecat)) {
+  Simulator(std::vector<SimBus> buses, std::vector<EcatBus> ecat, std::vector<PnBus> pn)
+      : buses_(std::move(buses)), ecat_(std::move(ecat)), pn_(std::move(pn)) {
     for (auto& e : ecat_) console_.add(*e.line);
+    for (auto& p : pn_) pn_console_.add(*p.network);
   }
 
   void step(core::TimePoint now) noexcept {
     for (auto& b : buses_) b.network->step(now);
   }
 
-  // EtherCAT frames waiting on the interfaces are answered; the lines' 1 ms PDI ticks run.
-  void serve(core::TimePoint now) noexcept {
+  // EtherCAT frames waiting on the interfaces are answered; the lines' 1 ms PDI ticks run; the
+  // PROFINET devices take what arrived and run what is due.
+  void serve(core::TimePoint now) {
     for (auto& e : ecat_) e.endpoint->service(now);
+    for (auto& p : pn_) {
+      p.runner->run_once(now);
+      if (p.runner->port_error() != p.reported) {
+        p.reported = p.runner->port_error();
+        std::fprintf(stderr, "drivegate-sim: %s\n", p.reported.c_str());
+      }
+    }
   }
-  // The descriptors EtherCAT frames arrive on.
+  // The descriptors EtherCAT frames and PROFINET frames and datagrams arrive on (the PROFINET
+  // devices' UDP ports open when DCP gives them an address).
   void wait_fds(std::vector<pollfd>& out) const {
     out.clear();
     for (const auto& e : ecat_) out.push_back(pollfd{e.endpoint->wait_fd(), POLLIN, 0});
+    for (const auto& p : pn_) {
+      for (const int fd : p.runner->wait_fds()) out.push_back(pollfd{fd, POLLIN, 0});
+    }
   }
 
   // One command line in, one answer line out.
@@ -156,12 +194,17 @@ class Simulator {
     in >> verb;
     if (verb.empty()) return "error: empty command";
     if (verb == "status") return status();
+    if (const auto answer = profinet_command(line)) return *answer;
     if (const auto answer = ethercat_command(line)) return *answer;
     if (verb != "power-off" && verb != "power-on" && verb != "fault" && verb != "clear" && verb != "silent" &&
         verb != "abort" && verb != "corrupt" && verb != "service-write" && verb != "emcy") {
-      return "error: unknown command \"" + verb + "\" (" + std::string(buses_.empty() ? "" : kCommands) +
-             (buses_.empty() || console_.empty() ? "" : "; EtherCAT: ") +
-             std::string(console_.empty() ? "" : kEthercatCommands) + ")";
+      std::string known;
+      for (const auto& [name, commands] : {std::pair{"CANopen", buses_.empty() ? std::string_view{} : kCommands},
+                                           std::pair{"EtherCAT", console_.empty() ? std::string_view{} : kEthercatCommands},
+                                           std::pair{"PROFINET", pn_console_.empty() ? std::string_view{} : profinet::PnConsole::kCommands}}) {
+        if (!commands.empty()) known += (known.empty() ? "" : "; ") + std::string(name) + ": " + std::string(commands);
+      }
+      return "error: unknown command \"" + verb + "\" (" + known + ")";
     }
     in >> node_text;
     SlaveNode* node = nullptr;
@@ -279,6 +322,22 @@ class Simulator {
     return std::nullopt;
   }
 
+  // The PROFINET console's answer when the command is one of its own (pn_console.hpp), nullopt
+  // otherwise: its own verbs, and power-off / power-on naming a simulated station.
+  std::optional<std::string> profinet_command(const std::string& line) {
+    std::istringstream in(line);
+    std::string verb;
+    std::string target;
+    in >> verb >> target;
+    if (!profinet::PnConsole::handles(verb) || verb == "status") return std::nullopt;
+    if (verb != "power-off" && verb != "power-on") {
+      if (pn_console_.empty()) return "error: " + verb + " is a PROFINET command and no PROFINET network is simulated";
+      return pn_console_.command(line, clock_.now());
+    }
+    if (pn_console_.matches(target) == 0) return std::nullopt;
+    return pn_console_.command(line, clock_.now());
+  }
+
   // The EtherCAT console's answer when the command is one of its own (line_console.hpp), nullopt
   // when it is CANopen's. Shared verbs go by their target: power-off/power-on to whichever bus type
   // has the node or position (both: the user names the bus), corrupt by its arguments.
@@ -334,12 +393,15 @@ class Simulator {
         s += n.silent() ? " silent;" : ";";
       }
     }
-    return s + console_.status_items();
+    return s + console_.status_items() + pn_console_.status_items();
   }
 
   std::vector<SimBus> buses_;
   std::vector<EcatBus> ecat_;
+  std::vector<PnBus> pn_;
   ethercat::sim::LineConsole console_;
+  profinet::PnConsole pn_console_;
+  core::SteadyClock clock_;
 };
 
 // Reads stdin without blocking the cycle; complete lines go to the simulator.
@@ -384,17 +446,22 @@ long behind_ns(const timespec& deadline, const timespec& now) {
 int usage() {
   std::fputs(
       "usage: drivegate-sim CONFIG [--bus NAME] [--interface [BUS=]IFACE]...\n"
-      "  simulates the devices of CONFIG's canopen buses on udp-multicast and its ethercat buses with\n"
-      "  transport raw; --interface serves an ethercat line on IFACE (default: the bus' interface)\n"
+      "  simulates the devices of CONFIG's canopen buses on udp-multicast, its ethercat buses with\n"
+      "  transport raw and its profinet buses; --interface serves an ethercat line or a profinet\n"
+      "  network on IFACE (default: the bus' interface). PROFINET devices start with their\n"
+      "  NameOfStation and no IP address; IFACE must carry the stations' configured addresses.\n"
       "  stdin takes commands, one a line, answered with one line each:\n"
       "    CANopen:  power-off NODE, power-on NODE, fault NODE CODE [CAUSE], clear NODE, emcy NODE CODE REGISTER,\n"
       "              silent NODE on|off, abort NODE INDEX[:SUB] CODE, corrupt NODE COUNT [dlc|garbage],\n"
       "              service-write NODE INDEX[:SUB] VALUE SIZE\n"
       "    EtherCAT: power-off K, power-on K, break-after K, mend [BUS], drop N [BUS], corrupt N [BUS],\n"
       "              stick K INIT|PRE-OP|SAFE-OP CODE, unstick K\n"
-      "    both:     status\n"
-      "  NODE: a node-ID; K: a position on the line (1 = next to the gateway); BUS:NODE / BUS:K when\n"
-      "  several buses have it\n",
+      "    PROFINET: power-off STATION, power-on STATION, reboot STATION, abort-ar STATION,\n"
+      "              lose STATION rx|tx N, drive-fault STATION NUMBER,\n"
+      "              alarm STATION process|diagnosis|diagnosis-gone|pull|plug|return [SLOT[:SUBSLOT]] [ERROR]\n"
+      "    all:      status\n"
+      "  NODE: a node-ID; K: a position on the line (1 = next to the gateway); STATION: a NameOfStation;\n"
+      "  BUS:NODE / BUS:K / BUS:STATION when several buses have it\n",
       stderr);
   return 2;
 }
@@ -457,6 +524,34 @@ int run(int argc, char** argv) {
                     " (bus " + bus.name + ")");
     ecat.push_back(std::move(b));
   }
+  std::vector<PnBus> pn;
+  std::size_t pn_index = 0;
+  for (const auto& bus : plan.buses) {
+    if (bus.type != "profinet") continue;
+    const std::size_t index = pn_index++;  // the MACs stay the same with --bus
+    if (!only.empty() && bus.name != only) continue;
+    PnBus b;
+    b.network = profinet::build_pn_network(bus, index);
+    link::RawSocketOptions o;
+    o.interface = interface_for(bus.name, interfaces, bus.section<config::ProfinetBusOptions>().interface);
+    b.wire = std::make_unique<link::RawSocketLink>(profinet::kFrameRules, o);
+    b.runner = std::make_unique<profinet::PnSimLinkRunner>(
+        b.network->network(), *b.wire, [iface = o.interface](const link::Ipv4Endpoint& local) {
+          link::UdpOptions u = profinet::rpc_udp_options(iface, local.port);
+          u.address = local.address;
+          return std::make_unique<link::UdpEndpoint>(u);
+        });
+    b.runner->open();
+    for (std::size_t i = 0; i < b.network->size(); ++i) {
+      const profinet::PnSimStation& s = b.network->station(i);
+      ready.push_back("drivegate-sim: " + bus.name + " station " + s.name + ": " + s.persona +
+                      (s.used_by.empty() ? "" : " (" + s.used_by + ")") + ", MAC " + profinet::mac_text(s.device->mac()).data() +
+                      ", no IP address");
+    }
+    ready.push_back("drivegate-sim: " + std::to_string(b.network->size()) + " devices on profinet " + o.interface +
+                    " (bus " + bus.name + ")");
+    pn.push_back(std::move(b));
+  }
   for (const auto& bus : plan.buses) {
     if (bus.type != "canopen" || (!only.empty() && bus.name != only)) continue;
     const auto& options = bus.section<config::CanopenBusOptions>();
@@ -475,8 +570,10 @@ int run(int argc, char** argv) {
                     options.group + ":" + std::to_string(options.port));
     buses.push_back(std::move(b));
   }
-  if (buses.empty() && ecat.empty()) {
-    std::fprintf(stderr, "drivegate-sim: %s has no canopen bus on udp-multicast and no ethercat bus on transport raw%s%s\n",
+  if (buses.empty() && ecat.empty() && pn.empty()) {
+    std::fprintf(stderr,
+                 "drivegate-sim: %s has no canopen bus on udp-multicast, no ethercat bus on transport raw and no "
+                 "profinet bus%s%s\n",
                  file.c_str(), only.empty() ? "" : " named ", only.c_str());
     return 2;
   }
@@ -486,7 +583,7 @@ int run(int argc, char** argv) {
   ::sigaction(SIGINT, &sa, nullptr);
   ::sigaction(SIGTERM, &sa, nullptr);
 
-  Simulator sim(std::move(buses), std::move(ecat));
+  Simulator sim(std::move(buses), std::move(ecat), std::move(pn));
   CommandReader commands;
   const core::SteadyClock clock;
   // Ready once the drives have booted: a request that follows the ready line is answered.
@@ -494,11 +591,11 @@ int run(int argc, char** argv) {
   sim.serve(clock.now());
   for (const auto& line : ready) say(line);
   std::vector<pollfd> fds;
-  sim.wait_fds(fds);
   timespec next{};
   ::clock_gettime(CLOCK_MONOTONIC, &next);
   while (g_stop == 0) {
     add_ns(next, kPeriodNs);
+    sim.wait_fds(fds);
     // Until the next step: EtherCAT frames are answered as they arrive (the master waits for them
     // within its cycle); without EtherCAT lines this is the plain absolute sleep.
     for (;;) {
