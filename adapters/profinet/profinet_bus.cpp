@@ -15,6 +15,7 @@
 #include "adapters/link/raw_socket_link.hpp"
 #include "adapters/link/udp_endpoint.hpp"
 #include "adapters/profinet/link/profinet_link.hpp"
+#include "adapters/profinet/sim_transport.hpp"
 #include "adapters/profinet/wire/blocks_record.hpp"
 #include "profiles/profidrive/master_settings.hpp"
 

@@ -39,7 +39,8 @@ std::unique_ptr<PnSimStation> akd_station(const config::BusPlan& bus, const conf
 std::unique_ptr<PnSimStation> io_station(const config::ProfinetIoDevice* io, const config::ProfinetStation& station) {
   GenericIoPersonaConfig c;
   c.vendor_id = station.vendor_id.value_or(kSimIoVendorId);
-  c.slots.push_back({0, 0, io != nullptr ? io->dap_ident : kSimDapModule, {{1, kSimDapSubmodule, 0, 0}}});
+  c.slots.push_back({0, 0, io != nullptr ? io->dap_ident : kSimDapModule,
+                     {{1, io != nullptr ? io->dap_submodule_ident : kSimDapSubmodule, 0, 0}}});
   if (io != nullptr) {
     for (const config::ProfinetIoSubmodule& m : io->submodules) {
       const auto slot = static_cast<std::uint16_t>(m.slot);

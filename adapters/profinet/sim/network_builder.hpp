@@ -6,7 +6,7 @@
 //   an axis      the persona its device profile names (only kollmorgen-akd-profinet: an
 //                AkdPersona with the axis' telegram plugged in slot 1); another profile is refused
 //   an io: entry a GenericIoPersona: the DAP in slot 0 (module = the entry's DAP ident, one
-//                submodule without IO in subslot 1 with ident kSimDapSubmodule) and the entry's
+//                submodule without IO in subslot 1 with the entry's dap_submodule_ident) and the entry's
 //                submodules with their idents and input/output lengths, API 0
 //   nothing      (the config warns) a GenericIoPersona with only a DAP (ident kSimDapModule)
 //
