@@ -58,7 +58,8 @@ const std::vector<std::string>& known_profidrive_quirks() {
 
 void read_profidrive_device(const MapReader& root, DeviceProfile& p) {
   const MapReader pd = root.map("profidrive", Need::Required);
-  pd.check_keys({"single_turn_bits", "acc_full_scale_rpm_per_s", "peak_current_a", "telegrams", "min_update_time", "quirks"});
+  pd.check_keys({"single_turn_bits", "acc_full_scale_rpm_per_s", "peak_current_a", "telegrams", "min_update_time", "quirks",
+                 "vendor_id", "device_id"});
   auto& spec = p.sections.edit<ProfidriveDeviceSpec>();
   // PNU 1002: 1..31 single-turn bits, so a revolution fits a signed 32-bit position [§17.2].
   spec.single_turn_bits = static_cast<unsigned>(
@@ -84,6 +85,14 @@ void read_profidrive_device(const MapReader& root, DeviceProfile& p) {
         spec.telegrams.push_back(n);
     }
   }
+  // The DeviceID block of a DCP Identify answer: two Unsigned16 [IEC 61158-6-10, DeviceIDValue].
+  if (const auto v = pd.integer("vendor_id", Need::Optional, 0, 0xFFFF, "a PROFINET VendorID (0..0xFFFF)"))
+    spec.vendor_id = static_cast<std::uint16_t>(*v);
+  if (const auto v = pd.integer("device_id", Need::Optional, 0, 0xFFFF, "a PROFINET DeviceID (0..0xFFFF)"))
+    spec.device_id = static_cast<std::uint16_t>(*v);
+  if (spec.vendor_id.has_value() != spec.device_id.has_value())
+    pd.error(spec.vendor_id ? "vendor_id" : "device_id",
+             "give vendor_id and device_id together (the DCP DeviceID block has both)");
   const MapReader quirks = pd.map("quirks", Need::Optional);
   quirks.check_keys(known_profidrive_quirks());
   for (const auto& q : known_profidrive_quirks())
