@@ -3,6 +3,7 @@
 #include <array>
 #include <memory>
 
+#include "adapters/profinet/scan.hpp"
 #include "adapters/profinet/wire/rt.hpp"
 #include "adapters/profinet/wire/station_name.hpp"
 #include "config/profinet/bus_type.hpp"
@@ -63,6 +64,7 @@ std::unique_ptr<core::Bus> make_bus(const config::BusPlan& plan) {
 config::BusTypeInfo bus_type() {
   config::BusTypeInfo t = config::profinet_bus_type({station_name_error, cr_lengths});
   t.make_bus = make_bus;
+  t.scan = {.plan = profinet_scan_plan, .run = run_profinet_scan};
   return t;
 }
 
