@@ -56,7 +56,7 @@ struct FoundDevice {
   std::optional<std::uint32_t> device_type;  // CANopen/CoE 1000h
   std::string device_type_text;              // "CiA 402 servo drive", "" when unknown
   DeviceIdentityNumbers identity;
-  std::optional<std::string> name;              // CANopen 1008h; nullopt: not present
+  std::optional<std::string> name;              // CANopen 1008h, PROFINET TypeOfStation; nullopt: not present
   std::optional<std::string> hardware_version;  // 1009h
   std::optional<std::string> software_version;  // 100Ah
   std::string profile;         // the device profile that fits, "" for none
@@ -67,8 +67,9 @@ struct FoundDevice {
   // A device that carries more than one axis (an EtherCAT multi-axis slave): per axis, the
   // bus-specific key that picks it, as a YAML line ("ethercat: { axis: 1 }"). Empty: one axis.
   std::vector<std::string> axis_keys;
-  // Why its identity cannot be trusted (more than one device answers at its address: a conflict);
-  // "" when it can. Such a device has no profile and is no axis.
+  // Why its identity cannot be trusted (more than one device answers at its address or name: a
+  // conflict); "" when it can. Such a device has no profile and is no axis; next_step, when given,
+  // says how to resolve it.
   std::string conflict;
   std::vector<std::string> notes;  // what a person should know (objects not present, aborts, odd frames)
 };
@@ -82,8 +83,9 @@ struct ScanResult {
   // Options the scan could not learn and assumed: key and what to check, a CHECK comment in the
   // skeleton (CANopen: the bit rate, which SocketCAN does not tell).
   std::vector<std::pair<std::string, std::string>> bus_option_checks;
-  // Lists of the bus entry besides its options (EtherCAT `io:`): the key, then one YAML flow
-  // mapping per item ("{ name: io-3, position: 3, inputs: 2 }"), written as they are.
+  // Lists of the bus entry besides its options (EtherCAT `io:`, PROFINET `devices:`): the key, then
+  // one YAML flow mapping per item ("{ name: io-3, position: 3, inputs: 2 }"), written as they are;
+  // an item starting with '#' is a comment line (an entry a person must complete).
   std::vector<std::pair<std::string, std::vector<std::string>>> bus_lists;
   // What the scan assumed, for the table's first line ("bit rate not given (500 kbit/s assumed ...)");
   // empty: nothing.

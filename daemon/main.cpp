@@ -57,7 +57,10 @@ SIGPIPE, SIGTSTP, SIGTTIN and SIGTTOU are ignored.
   --scan TYPE:WHERE    list the devices on a bus and the device profile that fits each; only reads.
                        canopen:can0 (SocketCAN interface), or canopen:udp-multicast?group=G&port=P&interface=A
                        (quote it in a shell); options: interface, bitrate, group, port
-  --scan-timeout D     how long a device has to answer each request (default 100ms)
+                       ethercat:eth1 (the line on an Ethernet port); options: sdo_timeout, transition_timeout, objects
+                       profinet:eth1 (DCP Identify all on an Ethernet port); option: response_delay (1..6400,
+                       the DCP ResponseDelayFactor, default 16: answers within 2 s)
+  --scan-timeout D     how long a device has to answer each request (default 100ms; canopen, ethercat)
   --device-dir DIR     also look for device profiles in DIR (before the built-in ones)
   --write-config FILE  write a configuration skeleton for what was found (--check-config accepts it)
   --force              replace FILE if it exists (otherwise it is kept and the command fails)

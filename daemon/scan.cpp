@@ -168,8 +168,10 @@ std::string skeleton_text(const core::ScanResult& result, core::Duration cycle_t
     y << "\n";
   }
   for (const auto& [key, items] : result.bus_lists) {
-    y << "    " << key << ":" << (items.empty() ? " []\n" : "\n");
-    for (const auto& item : items) y << "      - " << item << "\n";
+    // An item that starts with '#' is a comment line (an entry left for a person to complete).
+    const bool any_item = std::any_of(items.begin(), items.end(), [](const std::string& i) { return i.rfind('#', 0) != 0; });
+    y << "    " << key << ":" << (any_item ? "\n" : " []\n");
+    for (const auto& item : items) y << "      " << (item.rfind('#', 0) == 0 ? "" : "- ") << item << "\n";
   }
   const auto is_axis = [](const core::FoundDevice& d) { return d.drive && d.conflict.empty(); };
   const bool any = std::any_of(result.devices.begin(), result.devices.end(), is_axis);
@@ -180,7 +182,11 @@ std::string skeleton_text(const core::ScanResult& result, core::Duration cycle_t
     y << "\n  #   " << d.profile_reason << "\n";
     if (!d.conflict.empty()) {
       y << "  #   not an axis here: " << d.conflict << ";\n"
-        << "  #   give every device its own node-ID (and no node-ID another drive's SDO channels use) and scan again\n";
+        << "  #   "
+        << (d.next_step.empty() ? "give every device its own node-ID (and no node-ID another drive's SDO channels use) "
+                                  "and scan again"
+                                : d.next_step)
+        << "\n";
       continue;
     }
     if (!d.drive) {

@@ -26,8 +26,9 @@ core::ScanRequest parse_scan_target(const std::string& target);
 std::string format_scan_table(const core::ScanResult& result);
 
 // A configuration that --check-config accepts as it is: the gateway, the scanned bus with its
-// options, one axis per device that has a device profile and a trusted identity (the rest as
-// comments with the reason), and comments on what to fill in (mechanics, limits, names). Checked
+// options and lists (an item starting with '#' is written as a comment line), one axis per device
+// that has a device profile and a trusted identity (the rest as comments with the reason and its
+// next_step), and comments on what to fill in (mechanics, limits, names). Checked
 // here with the configuration loader, with the first of result.cycle_times it accepts; throws
 // core::ScanError with the loader's problems when none is accepted.
 std::string scan_skeleton(const core::ScanResult& result, const config::LoadOptions& options);

@@ -15,6 +15,7 @@
 #include "config/canopen/bus_options.hpp"
 #include "config/canopen/plan.hpp"
 #include "config/loader.hpp"
+#include "config/scan_plan.hpp"
 #include "profiles/cia402/sdo_abort.hpp"
 
 namespace drivegate::canopen {
@@ -364,52 +365,15 @@ CanopenScanCounters CanopenScan::counters() const noexcept {
 
 // --- the bus a request names ------------------------------------------------------------------
 
-namespace {
-
-// Values go into a generated YAML document: plain scalars only.
-bool plain_value(const std::string& v) {
-  return !v.empty() && std::all_of(v.begin(), v.end(), [](char c) {
-    return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '.' || c == '_' ||
-           c == '-';
-  });
-}
-
-}  // namespace
-
-namespace {
-
-// The canopen bus type as the configuration reads it: enough for the scan's bus plan and for the
-// canopen sections of device profiles (the adapter's own registration is the daemon's business).
-
-}  // namespace
-
-namespace {
-
-// WHERE's options, "?key=value&key=value", in order. Throws core::ScanError.
-std::vector<std::pair<std::string, std::string>> where_options(const std::string& where) {
-  std::vector<std::pair<std::string, std::string>> options;
-  const auto q = where.find('?');
-  if (q == std::string::npos) return options;
-  std::istringstream in(where.substr(q + 1));
-  for (std::string item; std::getline(in, item, '&');) {
-    const auto eq = item.find('=');
-    if (eq == std::string::npos || eq == 0) throw core::ScanError("option \"" + item + "\" is not KEY=VALUE");
-    options.emplace_back(item.substr(0, eq), item.substr(eq + 1));
-  }
-  return options;
-}
-
-}  // namespace
-
 bool scan_option_given(const core::ScanRequest& request, const std::string& key) {
-  const auto options = where_options(request.where);
+  const auto options = config::scan_where_options(request.where);
   return std::any_of(options.begin(), options.end(), [&](const auto& o) { return o.first == key; });
 }
 
 config::BusPlan scan_bus_plan(const core::ScanRequest& request, const config::BusTypeRegistry& types) {
   const std::string& where = request.where;
   std::string transport = where.substr(0, where.find('?'));
-  auto options = where_options(where);
+  auto options = config::scan_where_options(where);
   if (transport.empty())
     throw core::ScanError("name the bus: a CAN interface (canopen:can0) or udp-multicast "
                           "(canopen:udp-multicast?group=239.74.163.2&port=43113&interface=127.0.0.1)");
@@ -432,25 +396,13 @@ config::BusPlan scan_bus_plan(const core::ScanRequest& request, const config::Bu
       throw core::ScanError("\"" + key + "\" is not a scan option of " + transport +
                             "; it takes " + list);
     }
-    if (!plain_value(value))
+    if (!config::scan_plain_value(value))
       throw core::ScanError(key + "=\"" + value +
                             "\": a value is letters, digits, '.', '_' and '-'");
     y << "      " << key << ": " << value << "\n";
   }
   y << "axes: []\n";
-  const config::LoadOptions load{.device_dirs = request.device_dirs, .bus_types = types};
-  try {
-    auto plan = config::load_plan_from_string(y.str(), "scan", load);
-    return std::move(plan.buses.at(0));
-  } catch (const config::ConfigError& e) {
-    std::string what;
-    for (const auto& d : e.problems()) {
-      const auto dot = d.path.rfind('.');
-      what += (what.empty() ? "" : "; ") + (dot == std::string::npos ? d.path : d.path.substr(dot + 1)) + " " +
-              d.message;
-    }
-    throw core::ScanError(what);
-  }
+  return config::scan_bus_plan(y.str(), request, types);
 }
 
 // --- what was found -------------------------------------------------------------------------
@@ -478,13 +430,8 @@ std::string device_type_text(std::uint32_t device_type) {
 
 std::vector<config::DeviceProfile> scan_profiles(const std::vector<std::filesystem::path>& dirs,
                                                  const config::BusTypeRegistry& types, std::vector<std::string>& notes) {
-  config::DeviceCatalog catalog(dirs, types);
-  std::vector<config::DeviceProfile> out;
-  config::Problems problems;
-  for (const auto& name : catalog.available())
-    if (const auto* p = catalog.get(name, problems); p != nullptr && p->has_section<config::CanopenDeviceSpec>()) out.push_back(*p);
-  for (const auto& e : problems.errors()) notes.push_back("device profile not used: " + e.to_string());
-  return out;
+  return config::scan_device_profiles(
+      dirs, types, [](const config::DeviceProfile& p) { return p.has_section<config::CanopenDeviceSpec>(); }, notes);
 }
 
 namespace {

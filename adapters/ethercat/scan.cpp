@@ -11,6 +11,7 @@
 #include "config/device_profile.hpp"
 #include "config/ethercat/plan.hpp"
 #include "config/loader.hpp"
+#include "config/scan_plan.hpp"
 #include "profiles/cia402/sdo_abort.hpp"
 
 namespace drivegate::ethercat {
@@ -339,14 +340,8 @@ std::vector<ScannedSlave> scan_line(Link& link, const EthercatScanSettings& sett
 std::vector<config::DeviceProfile> ethercat_scan_profiles(const std::vector<std::filesystem::path>& dirs,
                                                           const config::BusTypeRegistry& types,
                                                           std::vector<std::string>& notes) {
-  config::DeviceCatalog catalog(dirs, types);
-  std::vector<config::DeviceProfile> out;
-  config::Problems problems;
-  for (const auto& name : catalog.available())
-    if (const auto* p = catalog.get(name, problems); p != nullptr && p->has_section<config::EthercatDeviceSpec>())
-      out.push_back(*p);
-  for (const auto& e : problems.errors()) notes.push_back("device profile not used: " + e.to_string());
-  return out;
+  return config::scan_device_profiles(
+      dirs, types, [](const config::DeviceProfile& p) { return p.has_section<config::EthercatDeviceSpec>(); }, notes);
 }
 
 // --- what was found ------------------------------------------------------------------------------
@@ -594,26 +589,6 @@ core::ScanResult ethercat_scan_result(const std::vector<ScannedSlave>& slaves, c
 
 namespace {
 
-std::vector<std::pair<std::string, std::string>> where_options(const std::string& where) {
-  std::vector<std::pair<std::string, std::string>> options;
-  const auto q = where.find('?');
-  if (q == std::string::npos) return options;
-  std::istringstream in(where.substr(q + 1));
-  for (std::string item; std::getline(in, item, '&');) {
-    const auto eq = item.find('=');
-    if (eq == std::string::npos || eq == 0) throw core::ScanError("option \"" + item + "\" is not KEY=VALUE");
-    options.emplace_back(item.substr(0, eq), item.substr(eq + 1));
-  }
-  return options;
-}
-
-bool plain_value(const std::string& v) {
-  return !v.empty() && std::all_of(v.begin(), v.end(), [](char c) {
-    return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '.' || c == '_' ||
-           c == '-' || c == '@';
-  });
-}
-
 class SteadyScanClock final : public ScanClock {
  public:
   core::TimePoint now() override { return clock_.now(); }
@@ -637,7 +612,7 @@ class SteadyScanClock final : public ScanClock {
 config::BusPlan ethercat_scan_plan(const core::ScanRequest& request, const config::BusTypeRegistry& types) {
   const std::string& where = request.where;
   std::string interface = where.substr(0, where.find('?'));
-  auto options = where_options(where);
+  auto options = config::scan_where_options(where);
   if (interface == "sim")
     throw core::ScanError("sim: a simulated line exists only inside a gateway; scan the interface drivegate-sim "
                           "serves (ethercat:IFACE)");
@@ -648,7 +623,7 @@ config::BusPlan ethercat_scan_plan(const core::ScanRequest& request, const confi
     << "    options:\n      transport: raw\n";
   bool named = false;
   if (!interface.empty()) {
-    if (!plain_value(interface))
+    if (!config::scan_plain_value(interface))
       throw core::ScanError("\"" + interface + "\": an interface name is letters, digits, '.', '_', '-' and '@'");
     y << "      interface: " << interface << "\n";
     named = true;
@@ -662,7 +637,7 @@ config::BusPlan ethercat_scan_plan(const core::ScanRequest& request, const confi
         throw core::ScanError("objects=\"" + value + "\": 1 lists every object's name, 0 (the default) counts them");
       continue;
     }
-    if (!plain_value(value)) throw core::ScanError(key + "=\"" + value + "\": a value is letters, digits, '.', '_' and '-'");
+    if (!config::scan_plain_value(value)) throw core::ScanError(key + "=\"" + value + "\": a value is letters, digits, '.', '_' and '-'");
     if (key == "interface") {
       if (named) throw core::ScanError("the interface is named twice");
       named = true;
@@ -672,23 +647,11 @@ config::BusPlan ethercat_scan_plan(const core::ScanRequest& request, const confi
   if (!named)
     throw core::ScanError("name the Ethernet interface the line is plugged into: ethercat:eth1");
   y << "axes: []\n";
-  const config::LoadOptions load{.device_dirs = request.device_dirs, .bus_types = types};
-  try {
-    auto plan = config::load_plan_from_string(y.str(), "scan", load);
-    return std::move(plan.buses.at(0));
-  } catch (const config::ConfigError& e) {
-    std::string what;
-    for (const auto& d : e.problems()) {
-      const auto dot = d.path.rfind('.');
-      what += (what.empty() ? "" : "; ") + (dot == std::string::npos ? d.path : d.path.substr(dot + 1)) + " " +
-              d.message;
-    }
-    throw core::ScanError(what);
-  }
+  return config::scan_bus_plan(y.str(), request, types);
 }
 
 bool ethercat_scan_object_names(const core::ScanRequest& request) {
-  for (const auto& [key, value] : where_options(request.where))
+  for (const auto& [key, value] : config::scan_where_options(request.where))
     if (key == "objects") return value == "1";
   return false;
 }

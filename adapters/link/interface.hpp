@@ -5,7 +5,9 @@
 #include <net/if.h>
 
 #include <array>
+#include <cstdint>
 #include <string>
+#include <vector>
 
 namespace drivegate::link {
 
@@ -23,6 +25,20 @@ ifreq request_for(const InterfaceName& name) noexcept;
 std::string no_interface_text(const std::string& name, const char* peers);
 // "interface 'NAME' is down; bring it up with 'ip link set NAME up'"
 std::string interface_down_text(const std::string& name);
+// What the kernel says of an interface (in the caller's network namespace): its hardware address
+// and its IPv4 addresses with their netmasks, a.b.c.d as a << 24 | ... (getifaddrs).
+struct InterfaceAddresses {
+  bool found = false;  // an interface of that name exists
+  bool has_mac = false;
+  std::array<std::uint8_t, 6> mac{};
+  struct Ipv4 {
+    std::uint32_t address = 0;
+    std::uint32_t netmask = 0;
+  };
+  std::vector<Ipv4> ipv4;
+};
+InterfaceAddresses interface_addresses(const std::string& name);
+
 // The running binary's path for setcap hints (/proc/self/exe), or a placeholder.
 std::string own_binary();
 

@@ -49,16 +49,13 @@ void read_ip_suite(const MapReader& m, ProfinetStation& s) {
   const auto mask = read_ipv4(m, "netmask", Need::Optional);
   const auto gateway = read_ipv4(m, "gateway", Need::Optional);
   s.netmask = mask.value_or(0xFFFFFF00U);
-  if (mask && (s.netmask == 0 || !power_of_two(std::int64_t{~s.netmask} + 1))) {
-    m.error("netmask", "must be a contiguous netmask such as 255.255.255.0, got " + ipv4_text(s.netmask));
+  if (const std::string problem = ipv4_netmask_problem(s.netmask); mask && !problem.empty()) {
+    m.error("netmask", problem);
     return;
   }
   if (!ip) return;
   s.ip = *ip;
-  const std::uint32_t host = s.ip & ~s.netmask;
-  if ((s.ip >> 24) == 0 || (s.ip >> 24) == 127 || (s.ip >> 28) >= 14 || (~s.netmask > 1 && (host == 0 || host == ~s.netmask)))
-    m.error("ip", "must be a unicast host address of its subnet (" + ipv4_text(s.ip & s.netmask) + "/" +
-                      std::to_string(std::popcount(s.netmask)) + "), got " + ipv4_text(s.ip));
+  if (const std::string problem = ipv4_host_problem(s.ip, s.netmask); !problem.empty()) m.error("ip", problem);
   if (gateway) {
     s.gateway = *gateway;
     if ((s.gateway & s.netmask) != (s.ip & s.netmask) || s.gateway == s.ip)
@@ -312,6 +309,19 @@ const char* to_string(ProfinetIpAssignment a) noexcept {
 std::string ipv4_text(std::uint32_t a) {
   return std::to_string(a >> 24) + "." + std::to_string((a >> 16) & 0xFF) + "." + std::to_string((a >> 8) & 0xFF) + "." +
          std::to_string(a & 0xFF);
+}
+
+std::string ipv4_netmask_problem(std::uint32_t netmask) {
+  if (netmask != 0 && power_of_two(std::int64_t{~netmask} + 1)) return {};
+  return "must be a contiguous netmask such as 255.255.255.0, got " + ipv4_text(netmask);
+}
+
+std::string ipv4_host_problem(std::uint32_t ip, std::uint32_t netmask) {
+  const std::uint32_t host = ip & ~netmask;
+  if ((ip >> 24) != 0 && (ip >> 24) != 127 && (ip >> 28) < 14 && (~netmask <= 1 || (host != 0 && host != ~netmask)))
+    return {};
+  return "must be a unicast host address of its subnet (" + ipv4_text(ip & netmask) + "/" +
+         std::to_string(std::popcount(netmask)) + "), got " + ipv4_text(ip);
 }
 
 void read_profinet_bus(const ProfinetWireRules& rules, const MapReader& b, const MapReader& m, BusPlan& bus) {

@@ -23,4 +23,10 @@ void read_profinet_bus(const ProfinetWireRules& rules, const MapReader& bus_map,
 const char* to_string(ProfinetIpAssignment a) noexcept;  // "temporary", "permanent"
 std::string ipv4_text(std::uint32_t address);             // "192.168.0.10"
 
+// What keeps `ip` with `netmask` from being a station's IP suite ("" when nothing): the netmask
+// must be contiguous, the address a unicast host of its subnet (not 0.x, 127.x, multicast or
+// reserved, not the subnet's first or last address). The message follows "must be ..." / "got".
+std::string ipv4_netmask_problem(std::uint32_t netmask);
+std::string ipv4_host_problem(std::uint32_t ip, std::uint32_t netmask);
+
 }  // namespace drivegate::config

@@ -58,7 +58,8 @@ const std::vector<std::string>& known_profidrive_quirks() {
 
 void read_profidrive_device(const MapReader& root, DeviceProfile& p) {
   const MapReader pd = root.map("profidrive", Need::Required);
-  pd.check_keys({"single_turn_bits", "acc_full_scale_rpm_per_s", "peak_current_a", "telegrams", "min_update_time", "quirks", "idents"});
+  pd.check_keys({"single_turn_bits", "acc_full_scale_rpm_per_s", "peak_current_a", "telegrams", "min_update_time", "quirks",
+                 "vendor_id", "device_id", "idents"});
   auto& spec = p.sections.edit<ProfidriveDeviceSpec>();
   // PNU 1002: 1..31 single-turn bits, so a revolution fits a signed 32-bit position [§17.2].
   spec.single_turn_bits = static_cast<unsigned>(
@@ -84,19 +85,8 @@ void read_profidrive_device(const MapReader& root, DeviceProfile& p) {
         spec.telegrams.push_back(n);
     }
   }
-  if (const MapReader ids = pd.map("idents", Need::Optional); ids.present()) {
-    ids.check_keys({"api", "dap_module", "dap_submodule", "telegram_module", "telegram_submodule"});
-    const auto u32 = [&](const char* key, Need need, std::uint32_t fallback) {
-      return static_cast<std::uint32_t>(ids.integer(key, need, 0, 0xFFFFFFFF, "a 32-bit ident number").value_or(fallback));
-    };
-    ProfidriveIdents id;
-    id.api = u32("api", Need::Optional, id.api);
-    id.dap_module = u32("dap_module", Need::Required, 0);
-    id.dap_submodule = u32("dap_submodule", Need::Required, 0);
-    id.telegram_module_base = u32("telegram_module", Need::Required, 0);
-    id.telegram_submodule_base = u32("telegram_submodule", Need::Required, 0);
-    spec.idents = id;
-  }
+  pd.check_keys({"single_turn_bits", "acc_full_scale_rpm_per_s", "peak_current_a", "telegrams", "min_update_time", "quirks",
+                 "vendor_id", "device_id", "idents"});
   const MapReader quirks = pd.map("quirks", Need::Optional);
   quirks.check_keys(known_profidrive_quirks());
   for (const auto& q : known_profidrive_quirks())

@@ -120,6 +120,10 @@ struct ProfidriveDeviceSpec {
   core::Duration min_update_time = std::chrono::milliseconds(1);  // fastest cyclic update [§2]
   std::map<std::string, bool> quirks;        // only names from known_profidrive_quirks()
   std::optional<ProfidriveIdents> idents;    // absent: a PROFINET bus cannot connect the drive
+  // The DCP identity (DeviceID block: VendorID, DeviceID) the drive answers an Identify with: how
+  // `drivegated --scan profinet:IFACE` knows the drive. Both or neither.
+  std::optional<std::uint16_t> vendor_id;
+  std::optional<std::uint16_t> device_id;
   [[nodiscard]] bool offers(std::uint16_t telegram) const noexcept {
     for (const auto t : telegrams)
       if (t == telegram) return true;

@@ -173,11 +173,13 @@ TEST(ScanProcess, RefusalsAreOneClearLine) {
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.out.find("drivegated: --scan ethercat:dgscan9: "), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("dgscan9"), r.out.rfind("dgscan9")) << "the link's line names the interface: " << r.out;
-  r = drivegated("--scan profinet:eth0");
-  EXPECT_NE(r.out.find("cannot scan profinet: profinet has no bus scan (scans: canopen, ethercat)"), std::string::npos) << r.out;
+  r = drivegated("--scan profinet:dgscan9");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.out.find("drivegated: --scan profinet:dgscan9: cannot open the network: profinet: "), std::string::npos)
+      << r.out;
   r = drivegated("--scan sim:x");
   EXPECT_EQ(r.status, 1);
-  EXPECT_NE(r.out.find("cannot scan sim: sim has no bus scan (scans: canopen, ethercat)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("cannot scan sim: sim has no bus scan (scans: canopen, ethercat, profinet)"), std::string::npos) << r.out;
   r = drivegated("--scan can0");
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.out.find("expected TYPE:WHERE"), std::string::npos) << r.out;

@@ -21,6 +21,8 @@ TEST(ProfinetProfiles, KollmorgenAkdProfinetIsTheDigestsDrive) {
   EXPECT_FALSE(s.peak_current_a.has_value());
   EXPECT_EQ(s.telegrams, (std::vector<std::uint16_t>{0, 1, 7, 9, 350, 351, 352, 353, 400}));  // §4.3
   EXPECT_EQ(s.min_update_time, 16ms);                                                        // §2
+  EXPECT_EQ(s.vendor_id, 0x0118);  // [sim]: the simulated AKD's DCP identity (the digest has none, §4.1)
+  EXPECT_EQ(s.device_id, 0x0501);
   EXPECT_TRUE(s.quirks.at("control_by_plc_bit10"));
   EXPECT_TRUE(p.modes.contains(core::Mode::TraversingBlock));
   EXPECT_FALSE(p.modes.contains(core::Mode::ProfileTorque));
@@ -75,6 +77,12 @@ TEST_F(ProfinetProfileErrors, TelegramsModesAndQuirksAreChecked) {
                      "353, 400), got 2");
   EXPECT_REPORTED(e, "profidrive.telegrams[2]: telegram 1 is listed twice");
   EXPECT_REPORTED(e, "profidrive.quirks.bit10: unknown field");
+  EXPECT_REPORTED(errors("modes: [pv]\n" + kUnits + "profidrive: { single_turn_bits: 16, acc_full_scale_rpm_per_s: 50e6, "
+                                                    "telegrams: [1], min_update_time: 4ms, vendor_id: 0x10000 }\n"),
+                  "profidrive.vendor_id: must be a PROFINET VendorID (0..0xFFFF)");
+  EXPECT_REPORTED(errors("modes: [pv]\n" + kUnits + "profidrive: { single_turn_bits: 16, acc_full_scale_rpm_per_s: 50e6, "
+                                                    "telegrams: [1], min_update_time: 4ms, device_id: 7 }\n"),
+                  "profidrive.device_id: give vendor_id and device_id together");
   EXPECT_REPORTED(errors("modes: [pv]\n" + kUnits + "profidrive: { single_turn_bits: 16 }\n"),
                   "profidrive.telegrams: missing");
 }
