@@ -116,7 +116,8 @@ class SlaveAccess final : public cia402::ObjectAccess {
     std::array<std::uint8_t, kMaxTransfer> buffer{};
   };
   [[nodiscard]] const MappedObject* at(cia402::ImageRef ref) const noexcept {
-    return ref.current(mapping_generation()) && ref.slot() < table_.size() && table_[ref.slot()].id.index != 0 ? &table_[ref.slot()] : nullptr;
+    const bool ok = ref.current(mapping_generation()) && ref.slot() < table_.size() && table_[ref.slot()].id.index != 0;
+    return ok ? &table_[ref.slot()] : nullptr;
   }
   Pending* free_slot() noexcept;
   Pending* slot_for(CoeSdoId id) noexcept;

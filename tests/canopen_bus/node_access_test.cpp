@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <initializer_list>
 
 #include "adapters/canopen/node_access.hpp"
 #include "adapters/canopen/wire/cob_id.hpp"
@@ -18,9 +19,16 @@ constexpr NodeId kNode = 5;
 
 PdoLayout layout_of(std::initializer_list<cia402::ObjectDef> defs) {
   PdoLayout l;
-  for (const auto& d : defs) EXPECT_EQ(l.add(d, static_cast<std::uint8_t>(8 * cia402::size_of(d.type))), PdoLayout::Error::None);
+  for (const auto& d : defs)
+    EXPECT_EQ(l.add(d, static_cast<std::uint8_t>(8 * cia402::size_of(d.type))), PdoLayout::Error::None);
   return l;
 }
+
+// The node's first RPDO or TPDO, synchronous.
+RpdoConfig rpdo(std::initializer_list<cia402::ObjectDef> defs) {
+  return {cob::rpdo(0, kNode), layout_of(defs), 1, {}, 0};
+}
+TpdoConfig tpdo(std::initializer_list<cia402::ObjectDef> defs) { return {cob::tpdo(0, kNode), layout_of(defs), 1, {}}; }
 
 struct Node {
   NodePdos pdos;
@@ -31,8 +39,8 @@ struct Node {
 
 TEST(CanopenNodeAccess, ReferencesReadAndWriteTheImage) {
   Node n;
-  const std::array<RpdoConfig, 1> rx{{{cob::rpdo(0, kNode), layout_of({obj::kControlword, obj::kTargetVelocity}), 1, {}, 0}}};
-  const std::array<TpdoConfig, 1> tx{{{cob::tpdo(0, kNode), layout_of({obj::kStatusword, obj::kVelocityActual}), 1, {}}}};
+  const std::array<RpdoConfig, 1> rx{rpdo({obj::kControlword, obj::kTargetVelocity})};
+  const std::array<TpdoConfig, 1> tx{tpdo({obj::kStatusword, obj::kVelocityActual})};
   ASSERT_TRUE(n.pdos.configure(rx, tx));
   const cia402::ImageRef cw = n.io.resolve(obj::kControlword.id);
   const cia402::ImageRef sw = n.io.resolve(obj::kStatusword.id);
@@ -54,13 +62,13 @@ TEST(CanopenNodeAccess, ReferencesReadAndWriteTheImage) {
 
 TEST(CanopenNodeAccess, ReconfigurationMakesReferencesStale) {
   Node n;
-  const std::array<RpdoConfig, 1> rx{{{cob::rpdo(0, kNode), layout_of({obj::kControlword, obj::kTargetVelocity}), 1, {}, 0}}};
+  const std::array<RpdoConfig, 1> rx{rpdo({obj::kControlword, obj::kTargetVelocity})};
   ASSERT_TRUE(n.pdos.configure(rx, {}));
   const cia402::ImageRef velocity = n.io.resolve(obj::kTargetVelocity.id);
   const std::uint32_t before = n.io.mapping_generation();
 
   // After a reboot the node gets another mapping: 6071h sits where 60FFh was.
-  const std::array<RpdoConfig, 1> other{{{cob::rpdo(0, kNode), layout_of({obj::kControlword, obj::kTargetTorque}), 1, {}, 0}}};
+  const std::array<RpdoConfig, 1> other{rpdo({obj::kControlword, obj::kTargetTorque})};
   ASSERT_TRUE(n.pdos.configure(other, {}));
   EXPECT_NE(n.io.mapping_generation(), before);
   EXPECT_FALSE(velocity.current(n.io.mapping_generation()));
