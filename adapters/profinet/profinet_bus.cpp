@@ -1,10 +1,5 @@
 #include "adapters/profinet/profinet_bus.hpp"
 
-#include <net/if.h>
-#include <sys/ioctl.h>
-#include <sys/socket.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <cstdarg>
 #include <random>
@@ -57,18 +52,6 @@ Uuid make_uuid(std::uint64_t seed, std::uint32_t a, std::uint32_t b) noexcept {
                       static_cast<std::uint8_t>(a >> 24), static_cast<std::uint8_t>(a >> 16),
                       static_cast<std::uint8_t>(a >> 8), static_cast<std::uint8_t>(a)};
   return u;
-}
-
-MacAddress interface_mac(const std::string& name) {
-  const int fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
-  if (fd < 0) throw core::BusError("cannot open a socket to read the MAC address of '" + name + "'");
-  ifreq r = link::request_for(link::interface_name(name));
-  const int rc = ::ioctl(fd, SIOCGIFHWADDR, &r);
-  ::close(fd);
-  if (rc != 0) throw core::BusError("cannot read the MAC address of '" + name + "'");
-  MacAddress mac{};
-  for (std::size_t i = 0; i < mac.size(); ++i) mac[i] = static_cast<std::uint8_t>(r.ifr_hwaddr.sa_data[i]);
-  return mac;
 }
 
 bool ar_exists(CmClientState s) noexcept {
@@ -363,11 +346,9 @@ void ProfinetBus::open(core::TimePoint now) {
     throw core::BusError("bus '" + name_ + "': " + e.what());
   }
   if (transport_.mac == MacAddress{}) {
-    try {
-      transport_.mac = interface_mac(transport_.interface);
-    } catch (const core::BusError& e) {
-      throw core::BusError("bus '" + name_ + "': " + e.what());
-    }
+    const link::InterfaceAddresses a = link::interface_addresses(transport_.interface);
+    if (!a.has_mac) throw core::BusError("bus '" + name_ + "': cannot read the MAC address of '" + transport_.interface + "'");
+    transport_.mac = a.mac;
   }
   for (auto& d : devices_) {
     // Each device's client has its own Xid range, so that the devices are searched for at once.

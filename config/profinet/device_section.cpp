@@ -85,8 +85,27 @@ void read_profidrive_device(const MapReader& root, DeviceProfile& p) {
         spec.telegrams.push_back(n);
     }
   }
-  pd.check_keys({"single_turn_bits", "acc_full_scale_rpm_per_s", "peak_current_a", "telegrams", "min_update_time", "quirks",
-                 "vendor_id", "device_id", "idents"});
+  if (const MapReader ids = pd.map("idents", Need::Optional); ids.present()) {
+    ids.check_keys({"api", "dap_module", "dap_submodule", "telegram_module", "telegram_submodule"});
+    const auto u32 = [&](const char* key, Need need, std::uint32_t fallback) {
+      return static_cast<std::uint32_t>(ids.integer(key, need, 0, 0xFFFFFFFF, "a 32-bit ident number").value_or(fallback));
+    };
+    ProfidriveIdents id;
+    id.api = u32("api", Need::Optional, id.api);
+    id.dap_module = u32("dap_module", Need::Required, 0);
+    id.dap_submodule = u32("dap_submodule", Need::Required, 0);
+    id.telegram_module_base = u32("telegram_module", Need::Required, 0);
+    id.telegram_submodule_base = u32("telegram_submodule", Need::Required, 0);
+    spec.idents = id;
+  }
+  // The DeviceID block of a DCP Identify answer: two Unsigned16 [IEC 61158-6-10, DeviceIDValue].
+  if (const auto v = pd.integer("vendor_id", Need::Optional, 0, 0xFFFF, "a PROFINET VendorID (0..0xFFFF)"))
+    spec.vendor_id = static_cast<std::uint16_t>(*v);
+  if (const auto v = pd.integer("device_id", Need::Optional, 0, 0xFFFF, "a PROFINET DeviceID (0..0xFFFF)"))
+    spec.device_id = static_cast<std::uint16_t>(*v);
+  if (spec.vendor_id.has_value() != spec.device_id.has_value())
+    pd.error(spec.vendor_id ? "vendor_id" : "device_id",
+             "give vendor_id and device_id together (the DCP DeviceID block has both)");
   const MapReader quirks = pd.map("quirks", Need::Optional);
   quirks.check_keys(known_profidrive_quirks());
   for (const auto& q : known_profidrive_quirks())
