@@ -315,11 +315,7 @@ bool CanopenBus::next_event(core::Event& out) noexcept {
                       unsigned{n->id});
     return true;
   }
-  if (emcy_count_ == 0) return false;
-  out = emcy_events_[emcy_head_];
-  emcy_head_ = (emcy_head_ + 1) % emcy_events_.size();
-  --emcy_count_;
-  return true;
+  return emcy_events_.pop(out);
 }
 
 bool CanopenBus::take_emcy_token(Node& n, core::TimePoint now) noexcept {
@@ -339,11 +335,8 @@ bool CanopenBus::take_emcy_token(Node& n, core::TimePoint now) noexcept {
 // A node that floods EMCYs is limited by its token bucket; what is held back is counted and summed
 // up in one warning once the node has a token again.
 void CanopenBus::publish_emcy(core::TimePoint now) noexcept {
-  const auto room = [&] { return emcy_count_ < emcy_events_.size(); };
-  const auto push = [&](const core::Event& e) {
-    emcy_events_[(emcy_head_ + emcy_count_) % emcy_events_.size()] = e;
-    ++emcy_count_;
-  };
+  const auto room = [&] { return !emcy_events_.full(); };
+  const auto push = [&](const core::Event& e) { (void)emcy_events_.push(e); };
   for (auto& np : nodes_) {
     Node& n = *np;
     if (n.emcy_held_back == 0 || !room() || !take_emcy_token(n, now)) continue;

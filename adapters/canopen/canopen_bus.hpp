@@ -68,6 +68,7 @@
 #include "adapters/canopen/transport/transport.hpp"
 #include "config/canopen/plan.hpp"
 #include "core/bus.hpp"
+#include "core/event_ring.hpp"
 #include "profiles/cia402/cia402_master.hpp"
 
 namespace drivegate::canopen {
@@ -228,9 +229,7 @@ class CanopenBus final : public core::Bus {
   std::uint64_t unexpected_ = 0;
   std::uint64_t tx_dropped_ = 0;
   // EMCY events waiting for next_event(); reports stay in the consumer while this is full.
-  std::array<core::Event, 16> emcy_events_{};
-  std::size_t emcy_head_ = 0;
-  std::size_t emcy_count_ = 0;
+  core::EventRing<16> emcy_events_;
   std::uint64_t emcy_rate_dropped_ = 0;
 
   // counters() may be called from any thread.

@@ -301,14 +301,7 @@ std::string_view EthercatBus::link_detail(std::size_t axis) const noexcept {
   return slaves_[axes_[axis].slave]->detail.view();
 }
 
-void EthercatBus::push_event(const core::Event& e) noexcept {
-  if (event_count_ == events_.size()) {
-    ++events_dropped_;
-    return;
-  }
-  events_[(event_head_ + event_count_) % events_.size()] = e;
-  ++event_count_;
-}
+void EthercatBus::push_event(const core::Event& e) noexcept { (void)events_.push(e); }
 
 void EthercatBus::bus_event(core::EventKind kind, std::string_view text) noexcept {
   core::Event e;
@@ -317,13 +310,7 @@ void EthercatBus::bus_event(core::EventKind kind, std::string_view text) noexcep
   push_event(e);
 }
 
-bool EthercatBus::next_event(core::Event& out) noexcept {
-  if (event_count_ == 0) return false;
-  out = events_[event_head_];
-  event_head_ = (event_head_ + 1) % events_.size();
-  --event_count_;
-  return true;
-}
+bool EthercatBus::next_event(core::Event& out) noexcept { return events_.pop(out); }
 
 void EthercatBus::on_emergency(std::uint16_t station, const CoeEmergency& e) noexcept {
   if (station < kFirstStation || static_cast<std::size_t>(station - kFirstStation) >= slaves_.size()) return;

@@ -66,6 +66,7 @@
 #include "config/ethercat/plan.hpp"
 #include "config/plan.hpp"
 #include "core/bus.hpp"
+#include "core/event_ring.hpp"
 #include "profiles/cia402/cia402_master.hpp"
 
 namespace drivegate::ethercat {
@@ -146,7 +147,7 @@ class EthercatBus final : public core::Bus, private EmergencySink, private Datag
   [[nodiscard]] const Transactions& transactions() const noexcept { return tx_; }
   [[nodiscard]] std::uint64_t restarts(std::size_t slave) const noexcept { return slaves_[slave]->restarts; }
   [[nodiscard]] SlaveAccess& access(std::size_t axis) noexcept { return *axes_[axis].io; }
-  [[nodiscard]] std::uint64_t events_dropped() const noexcept { return events_dropped_; }
+  [[nodiscard]] std::uint64_t events_dropped() const noexcept { return events_.dropped(); }
   [[nodiscard]] Link& link() noexcept { return *link_; }
   // Distributed clocks (bus thread): the line's setup, the cyclic FRMW, per slave its verdict.
   [[nodiscard]] const BusDc& dc() const noexcept { return *dc_; }
@@ -270,10 +271,7 @@ class EthercatBus final : public core::Bus, private EmergencySink, private Datag
   bool counting_errors_ = false;
   std::uint64_t tx_unsent_ = 0;
 
-  std::array<core::Event, kMaxEvents> events_{};
-  std::size_t event_head_ = 0;
-  std::size_t event_count_ = 0;
-  std::uint64_t events_dropped_ = 0;
+  core::EventRing<kMaxEvents> events_;
 
   std::atomic<std::uint64_t> sent_{0};
   std::atomic<std::uint64_t> received_{0};

@@ -752,22 +752,9 @@ std::string_view ProfinetBus::link_detail(std::size_t axis) const noexcept {
   return devices_[axes_[axis]->device]->detail.view();
 }
 
-void ProfinetBus::push_event(const core::Event& e) noexcept {
-  if (event_count_ == events_.size()) {
-    ++events_dropped_;
-    return;
-  }
-  events_[(event_head_ + event_count_) % events_.size()] = e;
-  ++event_count_;
-}
+void ProfinetBus::push_event(const core::Event& e) noexcept { (void)events_.push(e); }
 
-bool ProfinetBus::next_event(core::Event& out) noexcept {
-  if (event_count_ == 0) return false;
-  out = events_[event_head_];
-  event_head_ = (event_head_ + 1) % events_.size();
-  --event_count_;
-  return true;
-}
+bool ProfinetBus::next_event(core::Event& out) noexcept { return events_.pop(out); }
 
 core::BusCounters ProfinetBus::counters() const noexcept {
   core::BusCounters c;

@@ -58,6 +58,7 @@
 #include "config/plan.hpp"
 #include "config/profinet/plan.hpp"
 #include "core/bus.hpp"
+#include "core/event_ring.hpp"
 #include "profiles/profidrive/profidrive_master.hpp"
 
 namespace drivegate::profinet {
@@ -126,7 +127,7 @@ class ProfinetBus final : public core::Bus {
   [[nodiscard]] const AlarmChannel* alarms(std::size_t device) const noexcept {
     return devices_[device]->alarms ? &*devices_[device]->alarms : nullptr;
   }
-  [[nodiscard]] std::uint64_t events_dropped() const noexcept { return events_dropped_; }
+  [[nodiscard]] std::uint64_t events_dropped() const noexcept { return events_.dropped(); }
 
  private:
   struct Device;
@@ -270,10 +271,7 @@ class ProfinetBus final : public core::Bus {
   link::Datagram datagram_{};
   std::array<std::uint8_t, link::kMaxFrameBytes> tx_{};
 
-  std::array<core::Event, kMaxEvents> events_{};
-  std::size_t event_head_ = 0;
-  std::size_t event_count_ = 0;
-  std::uint64_t events_dropped_ = 0;
+  core::EventRing<kMaxEvents> events_;
 
   std::atomic<std::uint64_t> sent_{0};
   std::atomic<std::uint64_t> received_{0};
