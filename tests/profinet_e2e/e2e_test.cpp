@@ -74,7 +74,10 @@ class ProfinetE2e : public E2eClientTest {
       const NetnsScope in(*ns_sim_);
       sim_ = std::make_unique<SimProcess>(sim_config_);
     }
-    const auto ready = sim_->wait_ready(20s);
+    // One line per device (its MAC), then the ready line.
+    std::optional<std::string> ready;
+    for (int i = 0; i < 4 && (!ready || ready->find(" devices on profinet ") == std::string::npos); ++i)
+      ready = sim_->wait_ready(20s);
     ASSERT_TRUE(ready) << sim_->log();
     ASSERT_EQ(*ready, "drivegate-sim: 3 devices on profinet " + veth_->b() + " (bus pn0)");
     in_gw_ = std::make_unique<NetnsScope>(*ns_gw_);
