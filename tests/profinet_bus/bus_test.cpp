@@ -2,8 +2,8 @@
 // exchange, an AKD enabled and run in speed mode through its telegram, a PNU read over record 47,
 // the IO device's bytes both ways, losses (power, AR abort) that reconnect only the device that
 // was lost with a new AR and its axis disabled, a missing station and a wrong module named, the
-// ARs released on close, no allocation per cycle in data exchange, and a drive fault read from
-// the fault buffer over record 47 and acknowledged.
+// ARs released on close, no allocation per cycle in data exchange, a drive fault read from the
+// fault buffer over record 47 and acknowledged, and alarms as events.
 #include <gtest/gtest.h>
 
 #include <array>
@@ -229,6 +229,42 @@ TEST(ProfinetBus, DriveFaultIsReadFromTheFaultBufferAndAcknowledged) {
   const auto reset = h.push("x", core::CommandKind::FaultReset);
   ASSERT_EQ(h.wait_final(reset, 3s), core::ReplyStatus::Completed) << h.reason(reset);
   EXPECT_EQ(h.snap("x").state, core::AxisState::SwitchOnDisabled);
+  EXPECT_EQ(h.bus->ars(0), 1U);
+}
+
+}  // namespace
+}  // namespace drivegate::profinet::test
+
+namespace drivegate::profinet::test {
+namespace {
+
+TEST(ProfinetBus, AlarmsBecomeEventsOfTheDevicesAxesOrOfTheBus) {
+  PnHarness h;
+  ASSERT_TRUE(h.run_until([&] { return h.all_up(); }, 5s)) << h.details();
+  AlarmNotification n;
+  n.priority = AlarmPriority::Low;
+  n.alarm_type = alarm_type::kPull;
+  n.api = 0x3A00;
+  n.slot = 1;
+  n.subslot = 1;
+  ASSERT_TRUE(h.sim->x->send_alarm(n));
+  ASSERT_TRUE(h.run_until([&] { return h.events_text().find("Pull") != std::string::npos; }, 1s)) << h.events_text();
+  bool on_x = false;
+  for (const auto& e : h.events)
+    if (e.kind == core::EventKind::Warning && e.axis == h.axis("x") && e.text.view().find("Pull") != std::string_view::npos)
+      on_x = true;
+  EXPECT_TRUE(on_x) << h.events_text();
+  // The IO device's alarm is the bus'.
+  n.alarm_type = alarm_type::kProcess;
+  n.priority = AlarmPriority::High;
+  n.api = 0;
+  ASSERT_TRUE(h.sim->block->send_alarm(n));
+  ASSERT_TRUE(h.run_until([&] { return h.events_text().find("station io-block: alarm high: Process") != std::string::npos; }, 1s))
+      << h.events_text();
+  // Acknowledged: the ARs run on.
+  h.run_for(500ms);
+  EXPECT_TRUE(h.all_up()) << h.details();
+  EXPECT_EQ(h.bus->alarms(0)->counters().alarms, 1U);
   EXPECT_EQ(h.bus->ars(0), 1U);
 }
 
