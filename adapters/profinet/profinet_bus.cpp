@@ -31,16 +31,6 @@ constexpr std::uint32_t kDefaultApi = 0;
 // the device's IOCRBlockRes has the last word, and the CRs use its values.
 constexpr std::uint16_t kFirstFrameId = 0xC000;
 
-std::uint32_t host_ip(const std::array<std::uint8_t, 4>& a) noexcept {
-  return static_cast<std::uint32_t>(a[0]) << 24 | static_cast<std::uint32_t>(a[1]) << 16 |
-         static_cast<std::uint32_t>(a[2]) << 8 | a[3];
-}
-
-std::array<std::uint8_t, 4> ip_bytes(std::uint32_t ip) noexcept {
-  return {static_cast<std::uint8_t>(ip >> 24), static_cast<std::uint8_t>(ip >> 16), static_cast<std::uint8_t>(ip >> 8),
-          static_cast<std::uint8_t>(ip)};
-}
-
 // A version 4 (random) UUID from the bus' seed and two numbers that make it unique per AR.
 Uuid make_uuid(std::uint64_t seed, std::uint32_t a, std::uint32_t b) noexcept {
   Uuid u;
@@ -232,9 +222,9 @@ ProfinetBus::ProfinetBus(const config::BusPlan& plan, ProfinetTransport transpor
     d->bus = this;
     d->index = devices_.size();
     d->station.name = s.name;
-    d->station.ip.address = ip_bytes(s.ip);
-    d->station.ip.netmask = ip_bytes(s.netmask);
-    d->station.ip.gateway = ip_bytes(s.gateway);
+    d->station.ip.address = ipv4_octets(s.ip);
+    d->station.ip.netmask = ipv4_octets(s.netmask);
+    d->station.ip.gateway = ipv4_octets(s.gateway);
     d->station.vendor_id = s.vendor_id;
     d->station.device_id = s.device_id;
     devices_.push_back(std::move(d));
@@ -411,7 +401,7 @@ void ProfinetBus::set_detail(Device& d, const char* fmt, ...) noexcept {
   va_end(args);
   if (d.ip != 0) {
     const auto mac = mac_text(d.mac);
-    const auto ip = ip_bytes(d.ip);
+    const auto ip = ipv4_octets(d.ip);
     d.detail.format("station \"%s\" (%s at %u.%u.%u.%u): %s", d.station.name.c_str(), mac.data(), ip[0], ip[1], ip[2], ip[3],
                     what);
   } else {
@@ -461,7 +451,7 @@ void ProfinetBus::found(Device& d, core::TimePoint now) noexcept {
     return;
   }
   d.mac = r.mac;
-  d.ip = host_ip(r.ip.address);
+  d.ip = ipv4_host(r.ip.address);
   d.vendor_id = r.vendor_id;
   d.device_id = r.device_id;
   d.finder.reset();
@@ -721,7 +711,7 @@ void ProfinetBus::dispatch_frame(std::span<const std::uint8_t> frame, core::Time
 }
 
 void ProfinetBus::dispatch_datagram(const link::Datagram& g, CmSocket socket, core::TimePoint now) noexcept {
-  const std::uint32_t ip = host_ip(g.from.address);
+  const std::uint32_t ip = ipv4_host(g.from.address);
   for (auto& d : devices_) {
     if (!d->cm || d->ip != ip) continue;
     d->cm->on_datagram(g.view(), UdpEndpoint{ip, g.from.port}, socket, now, out_);
@@ -735,7 +725,7 @@ void ProfinetBus::flush_datagrams() noexcept {
   while (!out_.empty()) {
     const CmDatagram& g = out_.front();
     link::DatagramPort& port = g.from == CmSocket::Server ? *transport_.server : *transport_.client;
-    const link::DatagramStatus s = port.send_to(link::Ipv4Endpoint{ip_bytes(g.to.ip), g.to.port},
+    const link::DatagramStatus s = port.send_to(link::Ipv4Endpoint{ipv4_octets(g.to.ip), g.to.port},
                                                 std::span<const std::uint8_t>(g.bytes).first(g.size));
     if (s != link::DatagramStatus::Sent) errors_.fetch_add(1, std::memory_order_relaxed);
     out_.pop();

@@ -38,10 +38,6 @@ std::string hex4(std::uint32_t v) {
   return b;
 }
 
-std::uint32_t ip_of(const std::array<std::uint8_t, 4>& a) {
-  return std::uint32_t{a[0]} << 24 | std::uint32_t{a[1]} << 16 | std::uint32_t{a[2]} << 8 | a[3];
-}
-
 std::string mac_words(const MacAddress& mac) { return mac_text(mac).data(); }
 
 // DeviceRoleDetails in words [IEC 61158-6-10 §4.3]: "IO device", "IO device + IO controller".
@@ -67,8 +63,8 @@ std::string ip_block_words(std::uint16_t info) {
 }
 
 std::string suite_words(const DcpStation& s) {
-  return config::ipv4_text(ip_of(s.ip.address)) + "/" + config::ipv4_text(ip_of(s.ip.netmask)) + " gateway " +
-         config::ipv4_text(ip_of(s.ip.gateway));
+  return config::ipv4_text(ipv4_host(s.ip.address)) + "/" + config::ipv4_text(ipv4_host(s.ip.netmask)) + " gateway " +
+         config::ipv4_text(ipv4_host(s.ip.gateway));
 }
 
 // Why the configuration cannot name this station ("" when it can).
@@ -92,13 +88,13 @@ class AddressPlanner {
   AddressPlanner(const ScanInterface& iface, std::span<const DcpStation> stations) : iface_(iface) {
     if (iface.address != 0) used_.insert(iface.address);
     for (const auto& s : stations)
-      if (s.has_ip && ip_of(s.ip.address) != 0) used_.insert(ip_of(s.ip.address));
+      if (s.has_ip && ipv4_host(s.ip.address) != 0) used_.insert(ipv4_host(s.ip.address));
   }
 
   SkeletonSuite plan(const DcpStation& s) {
     SkeletonSuite out;
-    const std::uint32_t ip = s.has_ip ? ip_of(s.ip.address) : 0;
-    const std::uint32_t mask = s.has_ip ? ip_of(s.ip.netmask) : 0;
+    const std::uint32_t ip = s.has_ip ? ipv4_host(s.ip.address) : 0;
+    const std::uint32_t mask = s.has_ip ? ipv4_host(s.ip.netmask) : 0;
     std::string why;
     if (ip == 0) {
       why = "the station has no IP address";
@@ -112,7 +108,7 @@ class AddressPlanner {
     } else {
       out.ip = ip;
       out.netmask = mask;
-      const std::uint32_t gw = ip_of(s.ip.gateway);
+      const std::uint32_t gw = ipv4_host(s.ip.gateway);
       // 0.0.0.0 (or the station's own address, as some devices say it) is no gateway.
       if (gw != 0 && gw != ip && (gw & mask) == (ip & mask)) out.gateway = gw;
       return out;
@@ -234,8 +230,8 @@ core::ScanResult profinet_scan_result(std::span<const DcpStation> stations, cons
     core::FoundDevice d;
     d.address.number = static_cast<int>(r.devices.size()) + 1;
     const std::string station = s.has_name && s.name_length > 0 ? std::string(s.name()) : "(no name)";
-    const bool has_ip = s.has_ip && ip_of(s.ip.address) != 0;
-    d.address.text = station + " " + (has_ip ? config::ipv4_text(ip_of(s.ip.address)) : std::string("(no IP)")) + " " +
+    const bool has_ip = s.has_ip && ipv4_host(s.ip.address) != 0;
+    d.address.text = station + " " + (has_ip ? config::ipv4_text(ipv4_host(s.ip.address)) : std::string("(no IP)")) + " " +
                      mac_words(s.mac);
     d.device_type_text = role_words(s);
     if (s.has_device_id) {

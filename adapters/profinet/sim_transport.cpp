@@ -12,17 +12,6 @@ namespace drivegate::profinet {
 
 namespace {
 
-link::Ipv4Endpoint endpoint(std::uint32_t ip, std::uint16_t port) noexcept {
-  return {{static_cast<std::uint8_t>(ip >> 24), static_cast<std::uint8_t>(ip >> 16), static_cast<std::uint8_t>(ip >> 8),
-           static_cast<std::uint8_t>(ip)},
-          port};
-}
-
-std::uint32_t host_ip(const link::Ipv4Endpoint& e) noexcept {
-  return static_cast<std::uint32_t>(e.address[0]) << 24 | static_cast<std::uint32_t>(e.address[1]) << 16 |
-         static_cast<std::uint32_t>(e.address[2]) << 8 | e.address[3];
-}
-
 // The shared state: the network, the controller's receive queues and the time of the last step.
 class Hub final : public PnSimWire {
  public:
@@ -31,16 +20,16 @@ class Hub final : public PnSimWire {
         keep_(std::move(keep)),
         address_(a),
         frames_(kFrameRules, 512),
-        client_(endpoint(a.ip, a.client_port), 64),
-        server_(endpoint(a.ip, kRpcUdpPort), 64) {}
+        client_(link::Ipv4Endpoint{ipv4_octets(a.ip), a.client_port}, 64),
+        server_(link::Ipv4Endpoint{ipv4_octets(a.ip), kRpcUdpPort}, 64) {}
 
   void send_frame(std::span<const std::uint8_t> frame) noexcept override { (void)frames_.deliver(frame); }
   void send_datagram(const UdpEndpoint& from, const UdpEndpoint& to, std::span<const std::uint8_t> bytes) noexcept override {
     if (to.ip != address_.ip) return;
     if (to.port == kRpcUdpPort)
-      (void)server_.deliver(endpoint(from.ip, from.port), bytes);
+      (void)server_.deliver(link::Ipv4Endpoint{ipv4_octets(from.ip), from.port}, bytes);
     else if (to.port == address_.client_port)
-      (void)client_.deliver(endpoint(from.ip, from.port), bytes);
+      (void)client_.deliver(link::Ipv4Endpoint{ipv4_octets(from.ip), from.port}, bytes);
   }
 
   PnSimNetwork& network_;
@@ -92,7 +81,7 @@ class HubPort final : public link::DatagramPort {
     if (!queue_.is_open()) return link::DatagramStatus::Down;
     if (!link::sendable_datagram(payload)) return link::DatagramStatus::Invalid;
     const link::Ipv4Endpoint self = queue_.local();
-    (void)hub_->network_.on_datagram(payload, UdpEndpoint{host_ip(self), self.port}, UdpEndpoint{host_ip(to), to.port},
+    (void)hub_->network_.on_datagram(payload, UdpEndpoint{ipv4_host(self.address), self.port}, UdpEndpoint{ipv4_host(to.address), to.port},
                                      hub_->now_, *hub_);
     return link::DatagramStatus::Sent;
   }

@@ -6,6 +6,7 @@
 //
 // RT cyclic and alarm frames carry an 802.1Q priority tag, DCP frames go untagged (wire/ethernet.hpp);
 // the link hands up both as they were sent, so wire::decode_ethernet sees the tag and its priority.
+#include <array>
 #include <cstdint>
 #include <string>
 #include <utility>
@@ -23,6 +24,16 @@ inline constexpr link::FrameRules kFrameRules{.ether_type = kEtherType,
                                               .name = "profinet",
                                               .peers = "devices"};
 static_assert(kMaxFrameSize == link::kMaxFrameBytes && kVlanTpid == link::kVlanTpid);
+
+// IPv4 addresses as the engines and the config hold them (host order, a.b.c.d = a << 24 | ...) and
+// as the links and DCP blocks carry them (four octets in network order).
+constexpr std::uint32_t ipv4_host(const std::array<std::uint8_t, 4>& a) noexcept {
+  return std::uint32_t{a[0]} << 24 | std::uint32_t{a[1]} << 16 | std::uint32_t{a[2]} << 8 | a[3];
+}
+constexpr std::array<std::uint8_t, 4> ipv4_octets(std::uint32_t ip) noexcept {
+  return {static_cast<std::uint8_t>(ip >> 24), static_cast<std::uint8_t>(ip >> 16), static_cast<std::uint8_t>(ip >> 8),
+          static_cast<std::uint8_t>(ip)};
+}
 
 // The UDP endpoint for DCE/RPC on `interface`: a controller's with port 0 (the kernel picks one; it
 // sends to the device's wire/rpc.hpp kRpcUdpPort), a device's (or a simulated one's) with kRpcUdpPort.
