@@ -163,13 +163,22 @@ void ProfidriveMaster::run_device(core::TimePoint now, core::ControllerSink& sin
       break;
     }
     case DeviceGoal::Disable:
-      // OFF1: S4 ramps down through S5 to S2; S3 goes to S2 [§7].
-      device_stw1_ = stw1_word::kShutdown;
-      done = !state_.stopping && (state_.state == AxisState::ReadyToSwitchOn ||
-                                  state_.state == AxisState::SwitchOnDisabled ||
+      // Disabled means S1 on every bus (CiA 402: switch on disabled), so a client sees one state
+      // for "off". OFF1 first: S4 ramps down through S5 to S2, S3 goes to S2 [§7]; then, with the
+      // power stage off, bit 2 low takes S2 to S1 and bit 0 low keeps it there [§7: S2 -> S1].
+      // Never OFF3 while the OFF1 ramp runs: that would turn a ramp stop into a quick stop. A quick
+      // or coast stop already under way goes on to S1 under the same word.
+      if (state_.state == AxisState::OperationEnabled || state_.state == AxisState::SwitchedOn ||
+          (state_.state == AxisState::ReadyToSwitchOn && state_.stopping)) {
+        device_stw1_ = stw1_word::kShutdown;
+        step = "OFF1 to S2 (STW1 bit 0 low)";
+      } else {
+        device_stw1_ = stw1_word::kQuickStop;
+        step = "S2 to S1 (STW1 bit 2 low)";
+      }
+      done = !state_.stopping && (state_.state == AxisState::SwitchOnDisabled ||
                                   state_.state == AxisState::NotReadyToSwitchOn);
-      step = "OFF1 to S2 (STW1 bit 0 low)";
-      hold_stw1_ = stw1_word::kShutdown;
+      hold_stw1_ = stw1_word::kQuickStop;
       break;
     case DeviceGoal::QuickStop:
       // OFF3: quick stop from S4, then S1; bit 0 low so S1 is where it stays [§7].

@@ -42,17 +42,26 @@ TEST(ProfidriveMaster, EnableWalksTheManualSequenceOneStepACycle) {
   EXPECT_EQ(h.drive.last.nsoll_a, 0);  // nothing moves until a velocity command
 }
 
-TEST(ProfidriveMaster, DisableIsOff1ToS2AndQuickStopIsOff3ToS1) {
+TEST(ProfidriveMaster, DisableIsOff1ThenS1AndQuickStopIsOff3ToS1) {
   Harness h(1);
+  h.drive.stop_cycles = 5;
   h.enable();
   ASSERT_TRUE(h.submit(command(2, CommandKind::Disable)).accepted);
-  h.cycle();
-  EXPECT_EQ(h.drive.sent().stw1, 0x0406);  // OFF1
-  h.cycle();
-  EXPECT_TRUE(h.master.feedback().stopping);  // S5: ramping down to S2
-  ASSERT_TRUE(h.wait(2));
+  std::vector<std::uint16_t> words;
+  std::vector<State> states;
+  for (int i = 0; i < 40 && !h.finished(2); ++i) {
+    h.cycle();
+    if (words.empty() || words.back() != h.drive.sent().stw1) words.push_back(h.drive.sent().stw1);
+    if (states.empty() || states.back() != h.drive.state) states.push_back(h.drive.state);
+  }
+  // OFF1 ramps down through S5 to S2 with no OFF3 in between, then bit 2 low takes S2 to S1 [§7]:
+  // "disabled" is switch_on_disabled on every bus.
+  EXPECT_EQ(words, (std::vector<std::uint16_t>{0x0406, 0x0402}));
+  EXPECT_EQ(states, (std::vector<State>{State::S4, State::S5Off1, State::S2, State::S1}));
   EXPECT_TRUE(h.sink.done(2));
-  EXPECT_EQ(h.drive.state, State::S2);
+  EXPECT_EQ(h.master.feedback().state, AxisState::SwitchOnDisabled);
+  h.run(20);
+  EXPECT_EQ(h.drive.state, State::S1);  // bit 0 low: it stays there
 
   ASSERT_TRUE(h.submit(command(3, CommandKind::Enable)).accepted);
   ASSERT_TRUE(h.wait(3));
