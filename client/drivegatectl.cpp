@@ -560,11 +560,8 @@ int cmd_param(Context& ctx) {
   req.axis = word(ctx, 1, "AXIS");
   req.gateway = ctx.gateway;
   const std::string& object = word(ctx, 2, "OBJECT");
-  const bool record = core::is_record_address(object);
-  if (record) {
-    if (const auto parsed = core::parse_record_address(object); !parsed.address) throw UsageError("param: " + parsed.error);
-    req.name = object;
-  } else if (is_object_name(object)) {
+  const bool record = core::is_record_address(object);  // its syntax was checked before discovery
+  if (record || is_object_name(object)) {
     req.name = object;
   } else {
     const ObjectAddress addr = parse_address(object);
@@ -820,6 +817,10 @@ int run(int argc, char** argv) {
   Context ctx{client, args, args.flag("json"), Millis(static_cast<std::int64_t>(timeout_s * 1000)),
               args.option_or("gateway", ""), {args.positional().begin() + 1, args.positional().end()}};
 
+  // A record address is checked before anything goes out (discovery included).
+  if (command == "param" && ctx.words.size() >= 3 && core::is_record_address(ctx.words[2]))
+    if (const auto parsed = core::parse_record_address(ctx.words[2]); !parsed.address)
+      throw UsageError("param: " + parsed.error);
   if (int rc = require_gateways(ctx)) return rc;
   if (command == "list") return cmd_list(ctx);
   if (command == "status") return cmd_status(ctx);

@@ -396,6 +396,11 @@ TEST(DrivegatectlUsage, BadUsageExitsWithTwo) {
   EXPECT_EQ(ctl("move x").status, 2);
   EXPECT_EQ(ctl("move x 1 --bogus 3").status, 2);
   EXPECT_EQ(ctl("frobnicate").status, 2);
+  // A bad record address stops drivegatectl before discovery (no gateway runs here).
+  const CtlRun bad = ctl("param get x rec:0:1:0xAFF0@api");
+  EXPECT_EQ(bad.status, 2) << bad.output;
+  EXPECT_NE(bad.output.find("record address 'rec:0:1:0xAFF0@api': the API 'api' is no 32-bit number"), std::string::npos)
+      << bad.output;
   const CtlRun help = ctl("move --help");
   EXPECT_EQ(help.status, 0);
   EXPECT_NE(help.output.find("--relative"), std::string::npos);
