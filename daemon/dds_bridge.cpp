@@ -738,7 +738,11 @@ void DdsBridge::Impl::handle_param(const msg::ParameterRequest& in, const Prefix
   const auto ios = rt_.io_slaves();
   for (std::size_t i = 0; !axis && record && i < ios.size(); ++i)
     if (ios[i].name == in.axis()) {
-      if (io) return fail_param(in, from, "IO device '" + in.axis() + "' is on more than one bus: name an axis", now);
+      if (io)
+        return fail_param(in, from,
+                          "IO device '" + in.axis() + "' is on more than one bus of gateway '" + gateway_ +
+                              "': its records cannot be told apart",
+                          now);
       io = i;
     }
   if (!axis && !io)
