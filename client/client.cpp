@@ -25,6 +25,7 @@
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 
 #include "client/settled.hpp"
+#include "core/record_address.hpp"
 #include "drivegate.h"
 #include "idl/dds_node.hpp"
 
@@ -400,7 +401,12 @@ class Client::Impl : public dds::DataReaderListener, public dds::DataWriterListe
       result.error = parameter_refusal_;
       return result;
     }
-    const Route r = wait_route(req.axis, req.gateway, timeout);
+    Route r = wait_route(req.axis, req.gateway, timeout);
+    // A record may go to an IO device (no axis): the gateway that publishes it.
+    if (!r.error.empty() && core::is_record_address(req.name)) {
+      const Route io = io_owner(req.axis, {}, deadline);
+      if (io.error.empty()) r = io;
+    }
     if (!r.error.empty()) {
       result.error = r.error;
       return result;
@@ -482,30 +488,12 @@ class Client::Impl : public dds::DataReaderListener, public dds::DataWriterListe
     // The owner: the gateway named, else the one whose io_state names the slave (on the bus).
     std::string gateway = req.gateway;
     if (gateway.empty()) {
-      subscribe_io();
-      std::set<std::string> owners;
-      std::string list;
-      {
-        std::unique_lock lock(mutex_);
-        cv_.wait_until(lock, deadline, [&] {
-          owners.clear();
-          for (const auto& [key, st] : io_states_)
-            if (st.slave == req.slave && (req.bus.empty() || st.bus == req.bus)) owners.insert(st.gateway);
-          return !owners.empty();
-        });
-        for (const auto& [key, st] : io_states_) list += (list.empty() ? "" : ", ") + st.slave + " (" + st.gateway + "/" + st.bus + ")";
-      }
-      if (owners.empty()) {
-        result.error = "no gateway publishes an I/O slave '" + req.slave + "'" +
-                       (req.bus.empty() ? std::string() : " on bus " + req.bus) + "; I/O slaves: " +
-                       (list.empty() ? "(none)" : list);
+      const Route owner = io_owner(req.slave, req.bus, deadline);
+      if (!owner.error.empty()) {
+        result.error = owner.error;
         return result;
       }
-      if (owners.size() > 1) {
-        result.error = "I/O slave '" + req.slave + "' is on more than one gateway: name the gateway";
-        return result;
-      }
-      gateway = *owners.begin();
+      gateway = owner.gateway;
     }
     result.gateway = gateway;
     result.bus = req.bus;
@@ -732,6 +720,28 @@ class Client::Impl : public dds::DataReaderListener, public dds::DataWriterListe
 
   // The route for an axis, waiting for discovery: until the axis has an owner, or gateways are known
   // and none appeared for a while (then the axis really is unknown and waiting longer is pointless).
+  // The gateway whose io_state names the I/O slave (on `bus` when given), waiting until `deadline`.
+  Route io_owner(const std::string& slave, const std::string& bus, SteadyClock::time_point deadline) {
+    subscribe_io();
+    std::set<std::string> owners;
+    std::string list;
+    {
+      std::unique_lock lock(mutex_);
+      cv_.wait_until(lock, deadline, [&] {
+        owners.clear();
+        for (const auto& [key, st] : io_states_)
+          if (st.slave == slave && (bus.empty() || st.bus == bus)) owners.insert(st.gateway);
+        return !owners.empty();
+      });
+      for (const auto& [key, st] : io_states_) list += (list.empty() ? "" : ", ") + st.slave + " (" + st.gateway + "/" + st.bus + ")";
+    }
+    if (owners.empty())
+      return {{}, "no gateway publishes an I/O slave '" + slave + "'" + (bus.empty() ? std::string() : " on bus " + bus) +
+                      "; I/O slaves: " + (list.empty() ? "(none)" : list)};
+    if (owners.size() > 1) return {{}, "I/O slave '" + slave + "' is on more than one gateway: name the gateway"};
+    return {*owners.begin(), {}};
+  }
+
   Route wait_route(std::string_view axis, std::string_view gateway, Millis timeout) const {
     Route r;
     wait_until(

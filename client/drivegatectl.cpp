@@ -15,6 +15,8 @@
 #include "client/json_writer.hpp"
 #include "client/node_ids.hpp"
 #include "client/status_table.hpp"
+#include "core/device_identity.hpp"
+#include "core/record_address.hpp"
 
 namespace {
 
@@ -60,7 +62,10 @@ constexpr CommandHelp kCommands[] = {
      "  OBJECT is INDEX[:SUB] in hex (6060, 0x6099:1, 6060h) or a name: an EDS ParameterName or a\n"
      "  vendor parameter such as A83. The type comes from the axis' EDS, the device profile or CiA\n"
      "  301/402; --type names it otherwise: u8 u16 u24 u32 u40 u48 u56 u64, i8 .. i64, r32 r64, bool,\n"
-     "  string, unicode, octets, domain (VALUE: decimal or 0x hex, a real, text, hex bytes \"01 02 0a\")",
+     "  string, unicode, octets, domain (VALUE: decimal or 0x hex, a real, text, hex bytes \"01 02 0a\")\n"
+     "  PROFINET: OBJECT rec:SLOT:SUBSLOT:INDEX[@API] (decimal or 0x hex) reads or writes a record of the\n"
+     "  axis' device (IODReadReq/IODWriteReq), e.g. rec:0:1:0xAFF0 for I&M0; its bytes unless --type\n"
+     "  names a value (big-endian in the record); @API defaults to the configured submodule's",
      "read/write a drive object; INDEX is hex (0x optional), SUB decimal or 0x-hex", 3, 4},
     {"buses", "buses", "bus status: cycle timing, lateness, frame counters", 0, 0},
     {"io",
@@ -194,8 +199,17 @@ int cmd_list(Context& ctx) {
       w.field("pid", static_cast<std::uint64_t>(g.pid)).key("axes").begin_array();
       for (const auto& a : g.axes) {
         w.begin_object().field("name", std::string_view(a.name)).field("bus", std::string_view(a.bus));
-        if (const auto l = ctx.client.link(a.name, g.name))
-          w.field("bus_type", std::string_view(l->bus_type)).field("address", static_cast<std::uint64_t>(l->address));
+        const auto l = ctx.client.link(a.name, g.name);
+        if (l) w.field("bus_type", std::string_view(l->bus_type)).field("address", static_cast<std::uint64_t>(l->address));
+        if (const auto id = l ? core::identity_in_link_detail(l->detail) : std::nullopt) {
+          w.key("identity")
+              .begin_object()
+              .field("order_id", std::string_view(id->order_id))
+              .field("serial_number", std::string_view(id->serial_number))
+              .field("hardware_revision", std::string_view(id->hardware_revision))
+              .field("software_revision", std::string_view(id->software_revision))
+              .end_object();
+        }
         w.field("device", std::string_view(a.device))
             .field("unit", std::string_view(a.unit))
             .key("modes")
@@ -215,6 +229,10 @@ int cmd_list(Context& ctx) {
       std::cout << "  " << a.name << "  bus=" << a.bus
                 << (l ? "  address=" + format_address(l->bus_type, l->address) : std::string{})
                 << "  device=" << a.device << "  unit=" << a.unit << "  modes=" << modes << "\n";
+      // The device's identity where the bus names it (PROFINET: I&M0 read at connect).
+      if (const auto id = l ? core::identity_in_link_detail(l->detail) : std::nullopt)
+        std::cout << "      order " << id->order_id << "  serial " << id->serial_number << "  hw "
+                  << id->hardware_revision << "  sw " << id->software_revision << "\n";
     }
   }
   return 0;
@@ -542,7 +560,8 @@ int cmd_param(Context& ctx) {
   req.axis = word(ctx, 1, "AXIS");
   req.gateway = ctx.gateway;
   const std::string& object = word(ctx, 2, "OBJECT");
-  if (is_object_name(object)) {
+  const bool record = core::is_record_address(object);  // its syntax was checked before discovery
+  if (record || is_object_name(object)) {
     req.name = object;
   } else {
     const ObjectAddress addr = parse_address(object);
@@ -560,7 +579,7 @@ int cmd_param(Context& ctx) {
   char where[96];
   if (req.name.empty())
     std::snprintf(where, sizeof where, "%04Xh:%02X", req.index, static_cast<unsigned>(req.subindex));
-  else if (r.ok)
+  else if (r.ok && !record)
     std::snprintf(where, sizeof where, "%.60s (%04Xh:%02X)", req.name.c_str(), r.index,
                   static_cast<unsigned>(r.subindex));
   else
@@ -798,6 +817,10 @@ int run(int argc, char** argv) {
   Context ctx{client, args, args.flag("json"), Millis(static_cast<std::int64_t>(timeout_s * 1000)),
               args.option_or("gateway", ""), {args.positional().begin() + 1, args.positional().end()}};
 
+  // A record address is checked before anything goes out (discovery included).
+  if (command == "param" && ctx.words.size() >= 3 && core::is_record_address(ctx.words[2]))
+    if (const auto parsed = core::parse_record_address(ctx.words[2]); !parsed.address)
+      throw UsageError("param: " + parsed.error);
   if (int rc = require_gateways(ctx)) return rc;
   if (command == "list") return cmd_list(ctx);
   if (command == "status") return cmd_status(ctx);

@@ -103,6 +103,15 @@ class Bus {
     return IoWriteStatus::UnknownSlave;
   }
 
+  // Record access (a ParamRequest with `record` valid: PROFINET's IODReadReq/IODWriteReq) to the
+  // device of the request's axis or of I/O device `record.io`; the cyclic path (the runner calls
+  // it after receive()). An accepted request gets exactly one reply from next_record_reply(); a
+  // busy refusal is offered again later. The default: the bus has no records.
+  virtual Admission record(const ParamRequest& /*req*/, TimePoint /*now*/) noexcept {
+    return Admission::reject("this bus has no records (rec:SLOT:SUBSLOT:INDEX is PROFINET's record access)");
+  }
+  virtual bool next_record_reply(ParamReply& /*out*/) noexcept { return false; }
+
   // May be called from any thread while the bus runs (implementations keep relaxed atomics).
   [[nodiscard]] virtual BusCounters counters() const noexcept = 0;
   // Same threading as counters(). The default: the bus synchronises no clocks.

@@ -36,6 +36,7 @@ bool BusRunner::cycle(TimePoint now) noexcept {
     event(bus_event);
   }
   for (std::size_t i = 0; i < axes_.size(); ++i) axes_[i].observe_link(now, bus_.link_state(i), bus_.link_detail(i), *this);
+  while (bus_.next_record_reply(record_reply_)) parameter_reply(record_reply_);
 
   Command cmd;
   for (std::size_t n = 0; n < kMaxCommandsPerCycle && room_for_command() && commands_.pop(cmd); ++n)
@@ -46,9 +47,10 @@ bool BusRunner::cycle(TimePoint now) noexcept {
   for (std::size_t n = 0; n < kMaxParamsPerCycle && room_for_parameter(); ++n) {
     if (!param_held_ && !params_.pop(held_param_)) break;
     param_held_ = false;
-    if (held_param_.axis >= axes_.size()) continue;
+    const bool record = held_param_.record.valid;
+    if (!record && held_param_.axis >= axes_.size()) continue;  // a record's target is the bus' to judge
     ++params_in_flight_;
-    if (!axes_[held_param_.axis].parameter(held_param_, now, *this)) {
+    if (record ? !this->record(held_param_, now) : !axes_[held_param_.axis].parameter(held_param_, now, *this)) {
       // Its axis has every request slot in use: it goes first again next cycle, in order.
       --params_in_flight_;
       param_held_ = true;
@@ -87,6 +89,19 @@ bool BusRunner::cycle(TimePoint now) noexcept {
   }
   bus_.transmit(now);
   return queued_;
+}
+
+bool BusRunner::record(const ParamRequest& req, TimePoint now) noexcept {
+  const Admission adm = bus_.record(req, now);
+  if (!adm.accepted && adm.busy) return false;
+  if (!adm.accepted) {
+    record_reply_ = ParamReply{};
+    record_reply_.id = req.id;
+    record_reply_.axis = req.axis;
+    record_reply_.error = adm.reason;
+    parameter_reply(record_reply_);
+  }
+  return true;
 }
 
 void BusRunner::reply(const Reply& r) noexcept {

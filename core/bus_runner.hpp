@@ -53,6 +53,8 @@ class BusRunner final : private RunnerOutput {
   void reply(const Reply& r) noexcept override;
   void event(const Event& e) noexcept override;
   void parameter_reply(const ParamReply& r) noexcept override;
+  // A record request (ParamRequest::record) to the bus; false: the bus is busy, offer it again.
+  bool record(const ParamRequest& req, TimePoint now) noexcept;
 
   // Per cycle, at most this many inbound items are taken so one burst cannot stretch a cycle.
   static constexpr std::size_t kMaxCommandsPerCycle = 16;
@@ -89,6 +91,7 @@ class BusRunner final : private RunnerOutput {
   std::size_t params_in_flight_ = 0;  // taken, reply not yet queued
   ParamRequest held_param_{};         // refused for now by its axis (no free slot): offered again first
   bool param_held_ = false;
+  ParamReply record_reply_{};  // a record's reply on its way (kept here: it is large for the stack)
   bool queued_ = false;  // this cycle queued outputs
 };
 

@@ -148,15 +148,33 @@ struct Event {
   std::int64_t stamp_ns = 0;
 };
 
+// A PROFINET record (IODReadReq/IODWriteReq) [IEC 61158-6-10], for a ParamRequest that names
+// one instead of an object (core/record_address.hpp reads and writes them as text). The record
+// goes to the device of the request's axis, or with `io` set to the bus' I/O device of that index.
+inline constexpr std::uint16_t kNoIo = 0xFFFF;
+struct RecordAddress {
+  bool valid = false;      // false: the request is object access (index/sub)
+  bool api_given = false;  // false: the API of the submodule the configuration puts there, else 0
+  std::uint32_t api = 0;
+  std::uint16_t slot = 0;
+  std::uint16_t subslot = 0;
+  std::uint16_t index = 0;
+  std::uint16_t io = kNoIo;
+};
+
 // Parameter access by object index/sub-index (CiA 402 drives) for the DDS parameter topic: the
 // object's bytes as they travel on the bus (little-endian), typed by core/param_value.hpp. The
 // daemon resolved the type (request, EDS, device profile) and encoded a write's value already.
+// With `record` valid it is a record's access instead: its bytes as the record carries them,
+// except that a value of a fixed-size type (integers, reals) is little-endian here like the
+// others and the bus turns it into the record's big-endian order [IEC 61158-6-10].
 struct ParamRequest {
   CommandId id = 0;
   AxisIndex axis = kNoAxis;
   bool write = false;
   std::uint16_t index = 0;
   std::uint8_t sub = 0;
+  RecordAddress record{};
   ParamType type = ParamType::Unknown;  // Unknown: reads take whatever size the drive sends
   std::uint16_t size = 0;               // write: bytes in data
   std::array<std::uint8_t, kMaxParamBytes> data{};
@@ -167,7 +185,7 @@ struct ParamReply {
   CommandId id = 0;
   AxisIndex axis = kNoAxis;
   bool ok = false;
-  std::uint32_t error_code = 0;  // e.g. CiA 301 SDO abort code
+  std::uint32_t error_code = 0;  // e.g. CiA 301 SDO abort code; a record's PNIOStatus (code, decode, code 1, code 2)
   Text error;                    // in words
   ParamType type = ParamType::Unknown;
   std::uint16_t size = 0;  // bytes in data: what was read, or what was written
@@ -176,6 +194,7 @@ struct ParamReply {
 };
 
 static_assert(std::is_trivially_copyable_v<Command>);
+static_assert(std::is_trivially_copyable_v<RecordAddress>);
 static_assert(std::is_trivially_copyable_v<ParamRequest>);
 static_assert(std::is_trivially_copyable_v<ParamReply>);
 static_assert(std::is_trivially_copyable_v<AxisSnapshot>);

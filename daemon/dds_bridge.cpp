@@ -29,6 +29,7 @@
 #include <spdlog/spdlog.h>
 
 #include "core/param_value.hpp"
+#include "core/record_address.hpp"
 #include "daemon/log_limiter.hpp"
 #include "drivegate.h"
 #include "idl/dds_node.hpp"
@@ -101,6 +102,27 @@ std::string hex_object(std::uint16_t index, std::uint8_t sub) {
   std::array<char, 16> buf{};
   std::snprintf(buf.data(), buf.size(), "%04Xh:%02X", static_cast<unsigned>(index), static_cast<unsigned>(sub));
   return buf.data();
+}
+
+// A record address (core/record_address.hpp) for `who` ("axis 'y'") on bus `bus` of type `bus_type`:
+// PROFINET only.
+ParameterLookup record_lookup(const std::string& name, const std::string& who, const std::string& bus,
+                              const std::string& bus_type) {
+  ParameterLookup out;
+  if (bus_type != "profinet") {
+    out.error = who + " is on " + bus_type + " bus '" + bus + "': '" + name + "' is a PROFINET record address (" +
+                std::string(core::kRecordSyntax) + "); give an object as INDEX:SUB or by its name";
+    return out;
+  }
+  const core::ParsedRecordAddress parsed = core::parse_record_address(name);
+  if (!parsed.address) {
+    out.error = parsed.error;
+    return out;
+  }
+  out.ok = true;
+  out.record = *parsed.address;
+  out.index = out.record.index;
+  return out;
 }
 
 // The reply topics whose readers the gateway waits for (write_replies()).
@@ -709,13 +731,37 @@ void DdsBridge::Impl::fail_param(const msg::ParameterRequest& in, const Prefix& 
 void DdsBridge::Impl::handle_param(const msg::ParameterRequest& in, const Prefix& from, Clock::time_point now) {
   ++summary_params_;
   summary_clients_.insert(in.client());
+  const bool record = core::is_record_address(in.name());
   const auto axis = find_axis(in.axis());
-  if (!axis)
+  // A record may go to an IO device (which has no axis) too: by its name.
+  std::optional<std::size_t> io;
+  const auto ios = rt_.io_slaves();
+  for (std::size_t i = 0; !axis && record && i < ios.size(); ++i)
+    if (ios[i].name == in.axis()) {
+      if (io)
+        return fail_param(in, from,
+                          "IO device '" + in.axis() + "' is on more than one bus of gateway '" + gateway_ +
+                              "': its records cannot be told apart",
+                          now);
+      io = i;
+    }
+  if (!axis && !io)
     return fail_param(in, from,
-                      "unknown axis '" + in.axis() + "' on gateway '" + gateway_ + "'; axes here: " + axis_list(), now);
-  const ParameterLookup p = rt_.lookup_parameter(*axis, in.name(), in.index(), in.subindex());
+                      "unknown axis '" + in.axis() + "' on gateway '" + gateway_ + "'; axes here: " + axis_list() +
+                          (record ? "; IO devices: " + io_list() : std::string{}),
+                      now);
+  ParameterLookup p;
+  if (axis && !record) {
+    p = rt_.lookup_parameter(*axis, in.name(), in.index(), in.subindex());
+  } else if (axis) {
+    const AxisInfo& a = rt_.axes()[*axis];
+    p = record_lookup(in.name(), "axis '" + a.name + "'", a.bus, a.bus_type);
+  } else {
+    p = record_lookup(in.name(), "IO device '" + ios[*io].name + "'", ios[*io].bus, ios[*io].bus_type);
+    p.record.io = static_cast<std::uint16_t>(*io);
+  }
   if (!p.ok) return fail_param(in, from, p.error, now);
-  const std::string where = hex_object(p.index, p.sub);
+  const std::string where = p.record.valid ? core::format_record_address(p.record) : hex_object(p.index, p.sub);
   core::ParamType type = p.type;
   if (!in.type().empty()) {
     const auto asked = core::param_type_from_name(in.type());
@@ -737,11 +783,13 @@ void DdsBridge::Impl::handle_param(const msg::ParameterRequest& in, const Prefix
                         now);
     type = *asked;
   }
+  if (p.record.valid && type == core::ParamType::Unknown) type = core::ParamType::OctetString;  // a record's bytes
   core::ParamRequest req;
   req.id = next_id_++;
   req.write = in.write();
   req.index = p.index;
   req.sub = p.sub;
+  req.record = p.record;
   req.type = type;
   if (in.write()) {
     if (type == core::ParamType::Unknown)
@@ -765,8 +813,8 @@ void DdsBridge::Impl::handle_param(const msg::ParameterRequest& in, const Prefix
   Pending pending{in.client(), in.id(), in.axis(), from, req.index, req.sub};
   spdlog::debug("dds: parameter {} {:04X}:{} for axis '{}' from '{}' id {} -> request {}",
                 in.write() ? "write" : "read", req.index, req.sub, in.axis(), in.client(), in.id(), req.id);
-  if (!rt_.submit_parameter(*axis, req)) {
-    deferred_params_.push_back({*axis, req, std::move(pending), now});
+  if (!rt_.submit_parameter(axis.value_or(0), req)) {
+    deferred_params_.push_back({axis.value_or(0), req, std::move(pending), now});
     return;
   }
   pending_params_.emplace(req.id, std::move(pending));

@@ -128,13 +128,14 @@ bool Gateway::submit_setpoint(std::size_t axis_id, const core::Setpoint& sp) {
 }
 
 bool Gateway::submit_parameter(std::size_t axis_id, const core::ParamRequest& req) {
-  if (axis_id >= refs_.size()) return false;
+  const bool to_io = req.record.valid && req.record.io != core::kNoIo;
+  if (to_io ? req.record.io >= io_.size() : axis_id >= refs_.size()) return false;
   std::lock_guard lock(submit_mutex_);
   if (shutting_down_.load()) {
     GlobalParamReply r;
     r.axis_id = axis_id;
     r.reply.id = req.id;
-    r.reply.axis = refs_[axis_id].axis;
+    r.reply.axis = to_io ? core::kNoAxis : refs_[axis_id].axis;
     r.reply.ok = false;
     r.reply.error.assign("gateway is shutting down: no parameter access while axes are being disabled");
     local_param_replies_.push_back(r);
@@ -142,6 +143,12 @@ bool Gateway::submit_parameter(std::size_t axis_id, const core::ParamRequest& re
     return true;
   }
   core::ParamRequest r = req;
+  if (to_io) {
+    BusSlot& b = buses_[io_[req.record.io].bus_index];
+    r.axis = core::kNoAxis;
+    r.record.io = static_cast<std::uint16_t>(req.record.io - b.first_io);
+    return b.runner->push_parameter(r);
+  }
   r.axis = refs_[axis_id].axis;
   return buses_[refs_[axis_id].bus].runner->push_parameter(r);
 }
@@ -215,7 +222,7 @@ void Gateway::drain(Outbox& out) {
     }
     GlobalParamReply p;
     while (b.runner->pop_parameter_reply(p.reply)) {
-      p.axis_id = b.first_axis + p.reply.axis;
+      p.axis_id = p.reply.axis == core::kNoAxis ? SIZE_MAX : b.first_axis + p.reply.axis;  // an IO device's record
       out.param_replies.push_back(p);
     }
     GlobalIoReply io;

@@ -68,7 +68,7 @@ struct GlobalEvent {
   core::Event event;
 };
 struct GlobalParamReply {
-  std::size_t axis_id = 0;
+  std::size_t axis_id = 0;  // SIZE_MAX: a record of an IO device (no axis)
   core::ParamReply reply;
 };
 struct GlobalIoReply {
@@ -97,6 +97,7 @@ struct ParameterLookup {
   core::ParamType type = core::ParamType::Unknown;
   std::string type_source;  // "the EDS", "CiA 301", ... (for messages)
   std::string error;        // why not ok, in words
+  core::RecordAddress record{};  // valid: a PROFINET record instead of an object
 };
 
 class Runtime {
@@ -109,6 +110,8 @@ class Runtime {
   // same command id. Return false when the axis' queue is full (the caller rejects the command).
   virtual bool submit_command(std::size_t axis_id, const core::Command& cmd) = 0;
   virtual bool submit_setpoint(std::size_t axis_id, const core::Setpoint& sp) = 0;
+  // A record request (req.record valid) with record.io set goes to that I/O slave's device (its
+  // global id here) instead, and `axis_id` is not used.
   virtual bool submit_parameter(std::size_t axis_id, const core::ParamRequest& req) = 0;
   // The object `name` stands for on this axis, or the object index:sub when `name` is empty, with
   // its type (control plane only; may allocate).

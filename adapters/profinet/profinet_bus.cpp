@@ -44,6 +44,12 @@ Uuid make_uuid(std::uint64_t seed, std::uint32_t a, std::uint32_t b) noexcept {
   return u;
 }
 
+// A value of a fixed-size type is little-endian in a ParamRequest/ParamReply and big-endian in a
+// record [IEC 61158-6-10: the fields of records are big-endian]: reversed on the way.
+bool reversed_in_record(core::ParamType t, std::size_t size) noexcept {
+  return (core::param_type_is_integer(t) || core::param_type_is_real(t)) && core::param_type_size(t) == size;
+}
+
 bool ar_exists(CmClientState s) noexcept {
   return s == CmClientState::Parameterising || s == CmClientState::PrmEnd || s == CmClientState::WaitApplicationReady ||
          s == CmClientState::DataExchange;
@@ -177,7 +183,8 @@ void ProfinetBus::Device::on_record_reply(const CmRecordReply& reply) noexcept {
     const Im0View v = reply.outcome == CmRecordOutcome::Done ? decode_im0(reply.data) : Im0View{WireError::Truncated, {}};
     if (v.error == WireError::None) {
       const Im0& m = v.im0;
-      identity.format("%.*s serial %.*s hw %u sw %c%u.%u.%u", static_cast<int>(m.order_id.size()), m.order_id.data(),
+      // The form core/device_identity.hpp reads back for clients (drivegatectl list).
+      identity.format("I&M0 order %.*s serial %.*s hw %u sw %c%u.%u.%u", static_cast<int>(m.order_id.size()), m.order_id.data(),
                       static_cast<int>(m.serial_number.size()), m.serial_number.data(), m.hardware_revision,
                       m.software_prefix, m.software_functional, m.software_bugfix, m.software_internal);
     } else {
@@ -185,6 +192,10 @@ void ProfinetBus::Device::on_record_reply(const CmRecordReply& reply) noexcept {
       identity.format("I&M0 not read: %.*s", static_cast<int>(why.size()), why.data());
     }
     if (phase == Phase::Running) bus->set_detail(*this, "in data exchange (AR %u); %s", static_cast<unsigned>(ars), identity.c_str());
+    return;
+  }
+  if (client_record != 0 && reply.id == client_record) {
+    bus->client_record_done(*this, &reply, {});
     return;
   }
   for (const std::size_t a : axes)
@@ -552,6 +563,7 @@ void ProfinetBus::lose(Device& d, std::string_view why, core::TimePoint now) noe
   const bool was_running = d.phase == Phase::Running;
   stop_cyclic(d);
   for (const std::size_t a : d.axes) axes_[a]->channel->ar_ended();
+  if (d.client_record != 0) client_record_done(d, nullptr, "the AR ended before the record's reply came");
   if (d.io) io_[*d.io].outputs.fill(0);
   // Release the AR where the device may still hold it (a silent device's Release just times out).
   if (d.cm && d.cm->state() != CmClientState::Failed && d.cm->state() != CmClientState::Released) d.cm->release(now, out_);
@@ -608,6 +620,108 @@ void ProfinetBus::step(Device& d, core::TimePoint now) noexcept {
       if (link_seen_ == link::LinkState::Up && now - d.since >= d.backoff) start_find(d, now);
       break;
   }
+}
+
+// --- client records ----------------------------------------------------------------------------------
+
+core::Admission ProfinetBus::record(const core::ParamRequest& req, core::TimePoint /*now*/) noexcept {
+  const core::RecordAddress& a = req.record;
+  core::Admission no;
+  no.accepted = false;
+  Device* dp = nullptr;
+  if (a.io != core::kNoIo && a.io < io_.size())
+    dp = devices_[io_[a.io].device].get();
+  else if (a.io == core::kNoIo && req.axis < axes_.size())
+    dp = devices_[axes_[req.axis]->device].get();
+  if (dp == nullptr) return core::Admission::reject("no such axis or IO device on this bus");
+  Device& d = *dp;
+  for (const std::size_t x : d.axes)
+    if (a.index == record_index::kAkdParameterAccess && axes_[x]->channel->carries(a.slot, a.subslot)) {
+      no.reason.format("record 47 of slot %u subslot %u is the PROFIdrive parameter channel of the device's axis, run "
+                       "by the gateway: give a PNU (p930) instead",
+                       unsigned{a.slot}, unsigned{a.subslot});
+      return no;
+    }
+  if (req.write && (req.size == 0 || req.size > CmClient::kMaxRecordData)) {
+    no.reason.format("a record write carries 1 to %zu bytes here (one RPC datagram), not %u", CmClient::kMaxRecordData,
+                     unsigned{req.size});
+    return no;
+  }
+  if (!d.cm || d.cm->state() != CmClientState::DataExchange) {
+    no.reason.format("station \"%s\" is not in data exchange: no record access now (%s)", d.station.name.c_str(),
+                     d.detail.c_str());
+    return no;
+  }
+  if (d.client_record != 0 || records_in_flight_ + record_count_ >= record_replies_.size()) {
+    no.reason.assign("the record requests of this bus are all in flight: try again later");
+    no.busy = true;
+    return no;
+  }
+  std::uint32_t api = a.api;
+  if (!a.api_given) {
+    // The API the configuration puts the submodule in (the AKD's telegram: 3A00h), else API 0.
+    const std::size_t i = d.layout->index(a.slot, a.subslot);
+    api = i < d.layout->submodules().size() ? d.layout->submodules()[i].api : kDefaultApi;
+  }
+  core::ParamReply& r = d.client_reply;
+  r = core::ParamReply{};
+  r.id = req.id;
+  r.axis = req.axis;
+  r.type = req.type == core::ParamType::Unknown ? core::ParamType::OctetString : req.type;
+  if (req.write) {
+    const auto bytes = req.bytes();
+    if (reversed_in_record(req.type, bytes.size()))
+      std::reverse_copy(bytes.begin(), bytes.end(), record_scratch_.begin());
+    else
+      std::copy(bytes.begin(), bytes.end(), record_scratch_.begin());
+    r.size = req.size;
+    std::copy(bytes.begin(), bytes.end(), r.data.begin());
+    d.client_record = d.cm->submit_write(api, a.slot, a.subslot, a.index,
+                                         std::span<const std::uint8_t>(record_scratch_).first(bytes.size()));
+  } else {
+    d.client_record = d.cm->submit_read(api, a.slot, a.subslot, a.index, std::min(CmClient::kMaxRecordData, r.data.size()));
+  }
+  if (d.client_record == 0) return core::Admission::reject("the IO controller's record queue of the station is full");
+  ++records_in_flight_;
+  return core::Admission::accept();
+}
+
+void ProfinetBus::client_record_done(Device& d, const CmRecordReply* reply, std::string_view why) noexcept {
+  d.client_record = 0;
+  if (records_in_flight_ > 0) --records_in_flight_;
+  core::ParamReply& r = d.client_reply;
+  if (reply != nullptr && reply->outcome == CmRecordOutcome::Done) {
+    r.ok = true;
+    if (!reply->write) {
+      const std::size_t n = std::min(reply->data.size(), r.data.size());
+      if (reversed_in_record(r.type, n))
+        std::reverse_copy(reply->data.begin(), reply->data.begin() + static_cast<std::ptrdiff_t>(n), r.data.begin());
+      else
+        std::copy_n(reply->data.begin(), n, r.data.begin());
+      r.size = static_cast<std::uint16_t>(n);
+    }
+  } else {
+    r.ok = false;
+    r.size = 0;
+    if (reply != nullptr) {
+      const PnioStatus& s = reply->status;
+      r.error_code = std::uint32_t{s.code} << 24 | std::uint32_t{s.decode} << 16 | std::uint32_t{s.code1} << 8 |
+                     std::uint32_t{s.code2};
+      why = reply->text;
+    }
+    r.error.format("station \"%s\": %.*s", d.station.name.c_str(), static_cast<int>(why.size()), why.data());
+  }
+  // record() took it only with room in the ring.
+  record_replies_[(record_head_ + record_count_) % record_replies_.size()] = r;
+  ++record_count_;
+}
+
+bool ProfinetBus::next_record_reply(core::ParamReply& out) noexcept {
+  if (record_count_ == 0) return false;
+  out = record_replies_[record_head_];
+  record_head_ = (record_head_ + 1) % record_replies_.size();
+  --record_count_;
+  return true;
 }
 
 // --- the cyclic path ---------------------------------------------------------------------------------

@@ -29,7 +29,7 @@
 //   station "akd-x" (00:1b:1b:00:0a:01 at 192.168.0.10): searching (DCP identify)
 //   <StationFinder's report>                                  found, missing, duplicate, IP set
 //   station "akd-x" (...): connecting (AR 3)
-//   station "akd-x" (...): in data exchange (AR 3); AKD-P00306-NBPN-0000 serial ... hw 1 sw V1.2.3
+//   station "akd-x" (...): in data exchange (AR 3); I&M0 order AKD-P00306-NBPN-0000 serial ... hw 1 sw V1.2.3
 //                                           (I&M0 of the DAP, read once data exchange started)
 //   station "akd-x" (...): lost: input frame 0xC001 silent for 48 ms (...)
 //   station "akd-x" (...): <CmClient's reason> (connect refused, module diff, ...)
@@ -88,6 +88,8 @@ class ProfinetBus final : public core::Bus {
   static constexpr core::Duration kRetryFirst = std::chrono::seconds(1);
   static constexpr core::Duration kRetryMax = std::chrono::seconds(16);
   static constexpr std::size_t kMaxEvents = 32;
+  // Record requests of clients in flight or answered and not yet taken, over all devices.
+  static constexpr std::size_t kMaxClientRecords = 4;
 
   // Throws core::BusError when a device profile has no module idents or a device's AR does not
   // lay out.
@@ -110,6 +112,11 @@ class ProfinetBus final : public core::Bus {
   core::IoInfo io_info(std::size_t k) const noexcept override;
   void io_read(std::size_t k, core::IoSnapshot& out) noexcept override;
   core::IoWriteStatus io_write(std::size_t k, std::size_t offset, std::span<const std::uint8_t> bytes) noexcept override;
+  // Records of any API/slot/subslot/index of an axis' device or an IO device, one at a time per
+  // device over its CmClient; the PROFIdrive parameter channel (record 47 of an axis' telegram
+  // submodule) stays the master's.
+  core::Admission record(const core::ParamRequest& req, core::TimePoint now) noexcept override;
+  bool next_record_reply(core::ParamReply& out) noexcept override;
 
   // Diagnostics (bus thread, or while the bus is not cycling).
   [[nodiscard]] std::size_t device_count() const noexcept { return devices_.size(); }
@@ -148,6 +155,10 @@ class ProfinetBus final : public core::Bus {
     void step() noexcept;
     // The AR ended: an exchange in flight fails.
     void ar_ended() noexcept;
+    // Record 47 of this submodule is this channel's.
+    [[nodiscard]] bool carries(std::uint16_t slot, std::uint16_t subslot) const noexcept {
+      return slot == slot_ && subslot == subslot_;
+    }
 
    private:
     enum class State : std::uint8_t { Idle, Writing, ReadDue, Reading, Done, Failed };
@@ -230,6 +241,8 @@ class ProfinetBus final : public core::Bus {
     bool fresh = false;             // a new input frame was taken this cycle
     CmRecordId im0_read = 0;        // the I&M0 read of the DAP after the start of data exchange
     core::FixedString<160> identity{};  // from I&M0: order ID, serial, revisions ("" before)
+    CmRecordId client_record = 0;   // a client's record request in flight (record())
+    core::ParamReply client_reply{};  // its reply as far as known at submit (id, axis, type, a write's bytes)
     bool lose_pending = false;      // control lost: lose it at the next step
     core::FixedString<200> lose_reason{};
     core::FixedString<400> detail{};
@@ -255,6 +268,8 @@ class ProfinetBus final : public core::Bus {
   void send_frame(std::span<const std::uint8_t> frame) noexcept;
   void handle_link(core::TimePoint now) noexcept;
   void push_event(const core::Event& e) noexcept;
+  // The client record of `d` ends: with the CmClient's reply, or failed for `why` (reply null).
+  void client_record_done(Device& d, const CmRecordReply* reply, std::string_view why) noexcept;
 
   std::string name_;
   config::ProfinetBusOptions options_;
@@ -272,6 +287,10 @@ class ProfinetBus final : public core::Bus {
   std::array<std::uint8_t, link::kMaxFrameBytes> tx_{};
 
   core::EventRing<kMaxEvents> events_;
+  std::array<core::ParamReply, kMaxClientRecords> record_replies_{};  // a ring
+  std::size_t record_head_ = 0, record_count_ = 0;
+  std::size_t records_in_flight_ = 0;
+  std::array<std::uint8_t, core::kMaxParamBytes> record_scratch_{};  // a write's bytes in record order
 
   std::atomic<std::uint64_t> sent_{0};
   std::atomic<std::uint64_t> received_{0};

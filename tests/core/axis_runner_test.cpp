@@ -462,6 +462,34 @@ TEST(BusRunner, RoutesCommandsAndRepliesAndNeverAllocatesInTheCycle) {
   EXPECT_TRUE(saw_link);
 }
 
+// A record request (PROFINET's rec:...) goes to the bus, not to the axis' controller; a bus
+// without records refuses it in words, and one for an axis the bus lacks is the bus' to judge too.
+TEST(BusRunner, RecordsGoToTheBusWhichRefusesThemWithoutRecords) {
+  FakeBus bus;
+  std::vector<AxisSpec> specs{drivegate::test::linear_axis_spec(), drivegate::test::linear_axis_spec()};
+  specs[1].name = "y";
+  BusRunner runner(bus, specs);
+  ParamRequest q;
+  q.id = 31;
+  q.axis = 0;
+  q.record.valid = true;
+  q.record.index = 0xAFF0;
+  ASSERT_TRUE(runner.push_parameter(q));
+  q.id = 32;
+  q.axis = kNoAxis;
+  q.record.io = 3;
+  ASSERT_TRUE(runner.push_parameter(q));
+  runner.cycle(TimePoint{1s});
+  ParamReply r;
+  for (const CommandId id : {31U, 32U}) {
+    ASSERT_TRUE(runner.pop_parameter_reply(r));
+    EXPECT_EQ(r.id, id);
+    EXPECT_FALSE(r.ok);
+    EXPECT_EQ(r.error.view(), "this bus has no records (rec:SLOT:SUBSLOT:INDEX is PROFINET's record access)");
+  }
+  EXPECT_FALSE(runner.pop_parameter_reply(r));
+}
+
 TEST(AxisRunnerDefaultMode, SelectedOnceTheDriveReportsAndAgainAfterALinkLoss) {
   AxisSpec spec = drivegate::test::linear_axis_spec();
   spec.default_mode = Mode::ProfilePosition;

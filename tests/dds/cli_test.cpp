@@ -277,6 +277,65 @@ TEST(DrivegatectlWithoutLinks, ListAndStatusDoNotWaitForLinksNobodyPublishes) {
   EXPECT_LT(std::chrono::steady_clock::now() - status_start, std::chrono::seconds(6)) << r.output;
 }
 
+// A PROFINET axis: list shows its device's I&M0 from the link detail (a second line; --json an
+// object), the CANopen axis nothing more. Records go by rec:SLOT:SUBSLOT:INDEX as bytes or typed;
+// bad syntax stops drivegatectl before it sends anything, and a CANopen axis refuses a record.
+TEST(DrivegatectlProfinet, ListShowsI_M0AndParamTakesRecords) {
+  FakeRuntime rt("gw1", {"x", "pn"});
+  rt.put_on_bus(1, "pn0", "profinet");
+  rt.set_link(1, core::LinkState::Operational,
+              "station \"akd-x\" (02:1b:1b:00:0a:01 at 192.168.0.10): in data exchange (AR 1); I&M0 order "
+              "6ES7 155-6AU01 serial SIM 0001 hw 3 sw V1.2.3",
+              FakeRuntime::kStampNs);
+  rt.add_io("valves", 2, 2);  // on an EtherCAT bus
+  daemon::DdsBridge bridge(rt, bridge_options());
+  bridge.start();
+  CtlRun r = ctl("list");
+  EXPECT_EQ(r.status, 0) << r.output;
+  const auto x_line = r.output.find("  x  bus=can0");
+  ASSERT_NE(x_line, std::string::npos) << r.output;
+  EXPECT_EQ(r.output.compare(r.output.find('\n', x_line), 14, "\n  pn  bus=pn0"), 0) << "x has no second line: " << r.output;
+  EXPECT_NE(r.output.find("\n      order 6ES7 155-6AU01  serial SIM 0001  hw 3  sw V1.2.3\n"), std::string::npos)
+      << r.output;
+  r = ctl("--json list");
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find(R"("bus_type":"profinet","address":36,"identity":{"order_id":"6ES7 155-6AU01",)"
+                          R"("serial_number":"SIM 0001","hardware_revision":"3","software_revision":"V1.2.3"},)"),
+            std::string::npos)
+      << r.output;
+  EXPECT_EQ(r.output.find(R"("bus_type":"canopen","address":35,"identity")"), std::string::npos) << r.output;
+
+  rt.set_object(1, 0xAFF0, 0, core::ParamType::OctetString, "00 20 00 38 01 00");
+  r = ctl("param get pn rec:0:1:0xAFF0");
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("pn rec:0:1:0xAFF0 = 00 20 00 38 01 00 (OCTET_STRING)"), std::string::npos) << r.output;
+  r = ctl("param set pn rec:1:1:0x1000@0x3A00 0x0102 --type u16");
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(rt.object(1, 0x1000, 0), (std::vector<std::uint8_t>{0x02, 0x01}));  // little-endian: the bus swaps
+  r = ctl("param get pn rec:0:1");
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("record address 'rec:0:1': a slot, a subslot and an index are needed; write "
+                          "rec:SLOT:SUBSLOT:INDEX[@API]"),
+            std::string::npos)
+      << r.output;
+  r = ctl("param get pn rec:0:1:0x10000");
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("the index '0x10000' is no number of 0..0xFFFF"), std::string::npos) << r.output;
+  r = ctl("param get x rec:0:1:0xAFF0");
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_NE(r.output.find("axis 'x' is on canopen bus 'can0': 'rec:0:1:0xAFF0' is a PROFINET record address"),
+            std::string::npos)
+      << r.output;
+  EXPECT_EQ(rt.object(0, 0xAFF0, 0), std::vector<std::uint8_t>{});
+  // An IO device is a record's target by its name too (found through its io_state); this one is
+  // no PROFINET device.
+  r = ctl("param get valves rec:0:1:0xAFF0");
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_NE(r.output.find("IO device 'valves' is on ethercat bus 'ec0': 'rec:0:1:0xAFF0' is a PROFINET record address"),
+            std::string::npos)
+      << r.output;
+}
+
 TEST(DrivegateDemo, RunsTheWholeSequenceAndLeavesAxesDisabled) {
   FakeRuntime rt("demo", {"x", "y", "spindle", "turntable"});
   daemon::DdsBridge bridge(rt, bridge_options());
@@ -337,6 +396,11 @@ TEST(DrivegatectlUsage, BadUsageExitsWithTwo) {
   EXPECT_EQ(ctl("move x").status, 2);
   EXPECT_EQ(ctl("move x 1 --bogus 3").status, 2);
   EXPECT_EQ(ctl("frobnicate").status, 2);
+  // A bad record address stops drivegatectl before discovery (no gateway runs here).
+  const CtlRun bad = ctl("param get x rec:0:1:0xAFF0@api");
+  EXPECT_EQ(bad.status, 2) << bad.output;
+  EXPECT_NE(bad.output.find("record address 'rec:0:1:0xAFF0@api': the API 'api' is no 32-bit number"), std::string::npos)
+      << bad.output;
   const CtlRun help = ctl("move --help");
   EXPECT_EQ(help.status, 0);
   EXPECT_NE(help.output.find("--relative"), std::string::npos);

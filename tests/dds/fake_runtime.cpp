@@ -190,6 +190,11 @@ void FakeRuntime::set_link(std::size_t axis_id, core::LinkState link, std::strin
   s.link_since_ns = since_ns;
 }
 
+void FakeRuntime::put_on_bus(std::size_t axis_id, std::string bus, std::string bus_type) {
+  axes_.at(axis_id).bus = std::move(bus);
+  axes_.at(axis_id).bus_type = std::move(bus_type);
+}
+
 void FakeRuntime::add_bus(daemon::BusStatus status) { extra_buses_.push_back(std::move(status)); }
 
 daemon::BusStatus FakeRuntime::bus_status(std::size_t bus) const {

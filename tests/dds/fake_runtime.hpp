@@ -39,6 +39,8 @@ class FakeRuntime final : public daemon::Runtime {
   // A lost slave: inputs stale, writes refused with slave_lost (as the EtherCAT bus does).
   void set_io_lost(std::size_t io_id, bool lost);
   [[nodiscard]] std::vector<std::uint8_t> io_outputs(std::size_t io_id) const;
+  // The axis on another bus than can0 (canopen), e.g. "pn0" of type "profinet" (before start()).
+  void put_on_bus(std::size_t axis_id, std::string bus, std::string bus_type);
   // A bus after the default can0 (canopen, no clock figures), reported as given (before start()).
   void add_bus(daemon::BusStatus status);
   void set_busy(bool busy);

@@ -9,6 +9,7 @@
 #include <array>
 #include <cmath>
 
+#include "core/device_identity.hpp"
 #include "tests/profinet_bus/bus_harness.hpp"
 #include "tests/support/alloc_counter.hpp"
 #include "tests/support/param_request.hpp"
@@ -46,9 +47,16 @@ TEST(ProfinetBus, FindsNamesConnectsAndExchangesData) {
       << h.details();
   // I&M0 of the DAP, read once data exchange started, in the detail.
   ASSERT_TRUE(h.run_until([&] { return !h.bus->identity(0).empty(); }, 1s));
-  EXPECT_EQ(h.bus->identity(0), "AKD-P00306-NBPN-0000 serial SIM0000001 hw 0 sw V0.0.0") << h.details();
-  EXPECT_NE(h.bus->device_detail(0).find("in data exchange (AR 1); AKD-P00306-NBPN-0000"), std::string_view::npos);
-  EXPECT_EQ(h.bus->identity(2).substr(0, 4), "IO-1");
+  EXPECT_EQ(h.bus->identity(0), "I&M0 order AKD-P00306-NBPN-0000 serial SIM0000001 hw 0 sw V0.0.0") << h.details();
+  EXPECT_NE(h.bus->device_detail(0).find("in data exchange (AR 1); I&M0 order AKD-P00306-NBPN-0000"), std::string_view::npos);
+  EXPECT_EQ(h.bus->identity(2).substr(0, 15), "I&M0 order IO-1");
+  // Clients read it back from the axis' link detail (drivegatectl list).
+  const auto id = core::identity_in_link_detail(h.bus->link_detail(h.axis("x")));
+  ASSERT_TRUE(id) << h.details();
+  EXPECT_EQ(id->order_id, "AKD-P00306-NBPN-0000");
+  EXPECT_EQ(id->serial_number, "SIM0000001");
+  EXPECT_EQ(id->hardware_revision, "0");
+  EXPECT_EQ(id->software_revision, "V0.0.0");
   EXPECT_EQ(h.sim->akd_x->telegram(), 1);
   EXPECT_EQ(h.sim->akd_y->telegram(), 9);
   // The drives come up disabled: S1 (switching on inhibited).

@@ -8,7 +8,7 @@
 // The gateway finds the stations by name, gives them their addresses, connects them and runs the
 // PROFIdrive axes; the client enables one and runs it in speed mode; a power loss from the
 // simulator's console is a lost link and a reconnect with the axis disabled, the other drive
-// untouched. Skipped without root.
+// untouched; records and I&M0 over the parameter topic and the link detail. Skipped without root.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -16,6 +16,8 @@
 #include <memory>
 #include <sstream>
 
+#include "core/device_identity.hpp"
+#include "core/param_value.hpp"
 #include "tests/canopen_e2e/sim_process.hpp"
 #include "tests/daemon/daemon_process.hpp"
 #include "tests/support/e2e_client.hpp"
@@ -165,6 +167,45 @@ TEST_F(ProfinetE2e, PowerLossIsALostLinkAndTheDriveComesBackDisabled) {
                         20s))
       << diagnostics();
   EXPECT_EQ(state("y").link, "operational");
+}
+
+// Records over the DDS parameter topic: I&M0 of a drive's DAP as bytes, I&M1 written and read
+// back, I&M0 of the IO device by its name, an unknown slot refused in the device's words; and the
+// drive's I&M0 read at connect in the axis' link detail, as `drivegatectl list` reads it.
+TEST_F(ProfinetE2e, RecordsGoOverTheParameterTopic) {
+  const auto param = [&](const std::string& target, const std::string& address, bool write = false,
+                         const std::string& value = {}) {
+    client::ParamRequest q;
+    q.axis = target;
+    q.name = address;
+    q.write = write;
+    q.value = value;
+    return client_->param(q, 5s);
+  };
+  auto r = param("x", "rec:0:1:0xAFF0");
+  ASSERT_TRUE(r.ok) << r.error << diagnostics();
+  EXPECT_EQ(r.type, core::ParamType::OctetString);
+  ASSERT_EQ(r.data.size(), 60U);
+  EXPECT_EQ(std::string(r.data.begin() + 8, r.data.begin() + 28), "AKD-P00306-NBPN-0000");
+  const std::string tags = "00 21 00 38 01 00 " + core::hex_bytes(std::vector<std::uint8_t>(54, 'T'));
+  r = param("y", "rec:0:1:0xAFF1", true, tags);
+  ASSERT_TRUE(r.ok) << r.error << diagnostics();
+  r = param("y", "rec:0:1:0xAFF1");
+  ASSERT_TRUE(r.ok) << r.error << diagnostics();
+  EXPECT_EQ(core::hex_bytes(r.data), tags);
+  r = param("valves", "rec:0:1:0xAFF0");
+  ASSERT_TRUE(r.ok) << r.error << diagnostics();
+  EXPECT_EQ(r.data.size(), 60U);
+  r = param("x", "rec:7:1:0xAFF0");
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.error.find("invalid slot"), std::string::npos) << r.error;
+  EXPECT_EQ(r.error_code, 0xDE80B200U);
+
+  ASSERT_TRUE(client_->wait_until([&] {
+    const auto l = client_->link("x");
+    return l && core::identity_in_link_detail(l->detail).has_value();
+  }, 5s)) << diagnostics();
+  EXPECT_EQ(core::identity_in_link_detail(client_->link("x")->detail)->order_id, "AKD-P00306-NBPN-0000");
 }
 
 }  // namespace

@@ -222,5 +222,32 @@ TEST(PnIm0, Malformed) {
   EXPECT_EQ(encode_im0(m, buf), 0U);
 }
 
+// I&M1: type 0021h, length 56, version 1.0, IM_Tag_Function 32 and IM_Tag_Location 22 octets,
+// blank padded [IEC 61158-6-10 I&M1].
+const Bytes kIm1 = cat({hex("00 21 | 00 38 | 01 00"), test::ascii("conveyor 3", 32), test::ascii("hall B", 22)});
+
+TEST(PnIm1, BytesBothWays) {
+  EXPECT_EQ(encoded([&](auto o) { return encode_im1({"conveyor 3", "hall B"}, o); }), kIm1);
+  const Im1View v = decode_im1(kIm1);
+  ASSERT_EQ(v.error, WireError::None);
+  EXPECT_EQ(v.im1.tag_function, "conveyor 3");
+  EXPECT_EQ(v.im1.tag_location, "hall B");
+  EXPECT_EQ(encoded([&](auto o) { return encode_im1({}, o); }),
+            cat({hex("00 21 | 00 38 | 01 00"), Bytes(54, ' ')}));
+}
+
+TEST(PnIm1, Malformed) {
+  for (std::size_t n = 0; n < kIm1.size(); ++n) EXPECT_NE(decode_im1(std::span(kIm1).first(n)).error, WireError::None);
+  Bytes b = kIm1;
+  b.push_back(0);  // a byte after the block
+  EXPECT_EQ(decode_im1(b).error, WireError::BlockLengthMismatch);
+  b = kIm1;
+  b[1] = 0x20;  // I&M0
+  EXPECT_EQ(decode_im1(b).error, WireError::WrongBlockType);
+  std::array<std::uint8_t, 64> buf{};
+  EXPECT_EQ(encode_im1({std::string(33, 'x'), {}}, buf), 0U);
+  EXPECT_EQ(encode_im1({{}, std::string(23, 'x')}, buf), 0U);
+}
+
 }  // namespace
 }  // namespace drivegate::profinet

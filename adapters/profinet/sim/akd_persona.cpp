@@ -21,6 +21,7 @@ AkdPersona::AkdPersona(const AkdPersonaConfig& config) : config_(config), telegr
   dap_subs_[0] = {1, akd::kDapSubmodule};
   slots_[0] = {0, 0, akd::kDapModule, dap_subs_};
   plug(telegram_);
+  (void)encode_im1({}, im1_);
 }
 
 void AkdPersona::plug(std::uint16_t telegram) noexcept {
@@ -51,6 +52,12 @@ void AkdPersona::fit(std::uint32_t api, std::uint16_t slot, std::uint32_t module
 
 PnioStatus AkdPersona::write_record(const RecordReqHeader& h, std::span<const std::uint8_t> data) noexcept {
   if (h.index == record_index::kIm0) return pniorw_status(true, pniorw_error::kAccessDenied);
+  if (h.index == record_index::kIm1) {
+    if (data.size() != im1_.size()) return pniorw_status(true, pniorw_error::kWriteLengthError);
+    if (decode_im1(data).error != WireError::None) return pniorw_status(true, pniorw_error::kInvalidRange);
+    std::copy(data.begin(), data.end(), im1_.begin());
+    return {};
+  }
   if (h.index != record_index::kAkdParameterAccess || h.slot != akd::kTelegramSlot) {
     return pniorw_status(true, pniorw_error::kInvalidIndex);
   }
@@ -70,8 +77,14 @@ PnioStatus AkdPersona::read_record(const RecordReqHeader& h, std::span<std::uint
     im.order_id = config_.order_id;
     im.serial_number = config_.serial_number;
     im.profile_id = static_cast<std::uint16_t>(akd::kProfidriveApi);
+    im.im_supported = 0x0002;  // I&M1
     length = encode_im0(im, into);
     return length == 0 ? pniorw_status(false, pniorw_error::kInvalidRange) : PnioStatus{};
+  }
+  if (h.index == record_index::kIm1) {
+    length = std::min(into.size(), im1_.size());
+    std::copy_n(im1_.begin(), length, into.begin());
+    return {};
   }
   if (h.index != record_index::kAkdParameterAccess || h.slot != akd::kTelegramSlot) {
     return pniorw_status(false, pniorw_error::kInvalidIndex);

@@ -15,6 +15,9 @@
 //              read the response; a read with nothing waiting or a second write before the read
 //              is PNIORW "state conflict", a request over 240 bytes "write length error").
 //   I&M0       index AFF0h on every subslot (profile ID 3A00h).
+//   I&M1       index AFF1h on every subslot [sim]: the device's one pair of tags, written and read
+//              back (a write that is no I&M1 block is refused: PNIORW write length error or
+//              invalid range); it survives a power cycle.
 //   cycle      the drive model steps each cycle with the received setpoint image and its actual
 //              image is the telegram's input data. The outputs' worth goes to
 //              DriveModel::set_outputs: STOP / bad IOPS is ControllerStop (F702 with FBUS.PARAM02
@@ -94,6 +97,7 @@ class AkdPersona final : public PnPersona {
   std::array<CmModelSubmodule, 1> telegram_subs_{};
   std::array<CmModelSlot, 2> slots_{};
   std::array<std::uint8_t, 2 * profidrive::kMaxTelegramWords> scratch_{};  // actual image without an AR
+  std::array<std::uint8_t, kIm1Size> im1_{};  // the I&M1 record as last written
 };
 
 }  // namespace drivegate::profinet

@@ -10,6 +10,7 @@ std::string_view block_type_name(std::uint16_t type) noexcept {
     case block_type::kWriteReqHeader: return "IODWriteReqHeader";
     case block_type::kReadReqHeader: return "IODReadReqHeader";
     case block_type::kIm0: return "I&M0";
+    case block_type::kIm1: return "I&M1";
     case block_type::kArBlockReq: return "ARBlockReq";
     case block_type::kIocrBlockReq: return "IOCRBlockReq";
     case block_type::kAlarmCrBlockReq: return "AlarmCRBlockReq";

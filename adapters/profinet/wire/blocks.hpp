@@ -29,6 +29,7 @@ namespace block_type {
 inline constexpr std::uint16_t kWriteReqHeader = 0x0008;
 inline constexpr std::uint16_t kReadReqHeader = 0x0009;
 inline constexpr std::uint16_t kIm0 = 0x0020;
+inline constexpr std::uint16_t kIm1 = 0x0021;
 inline constexpr std::uint16_t kArBlockReq = 0x0101;
 inline constexpr std::uint16_t kIocrBlockReq = 0x0102;
 inline constexpr std::uint16_t kAlarmCrBlockReq = 0x0103;

@@ -215,4 +215,29 @@ Im0View decode_im0(std::span<const std::uint8_t> in) noexcept {
   return v;
 }
 
+std::size_t encode_im1(const Im1& m, std::span<std::uint8_t> out) noexcept {
+  if (m.tag_function.size() > 32 || m.tag_location.size() > 22) return 0;
+  Writer w(out, ByteOrder::Big);
+  const std::size_t start = begin_block(w, block_type::kIm1);
+  put_padded(w, m.tag_function, 32);
+  put_padded(w, m.tag_location, 22);
+  end_block(w, start);
+  return w.size_or_zero();
+}
+
+Im1View decode_im1(std::span<const std::uint8_t> in) noexcept {
+  Im1View v;
+  const BlockBody bb = open_block(in, block_type::kIm1, kIm1Size - kBlockHeaderSize);
+  if (bb.error != WireError::None) {
+    v.error = bb.error;
+    return v;
+  }
+  Reader r(bb.body, ByteOrder::Big);
+  v.im1.tag_function = trimmed(r.bytes(32));
+  v.im1.tag_location = trimmed(r.bytes(22));
+  v.error = finish_block(r);
+  if (v.error == WireError::None && bb.size != in.size()) v.error = WireError::BlockLengthMismatch;  // bytes after the block
+  return v;
+}
+
 }  // namespace drivegate::profinet

@@ -30,6 +30,7 @@ inline constexpr std::size_t kRecordHeaderSize = 64;
 // Record indices a controller uses [IEC 61158-6-10 Table "Index"; PROFIdrive].
 namespace record_index {
 inline constexpr std::uint16_t kIm0 = 0xAFF0;
+inline constexpr std::uint16_t kIm1 = 0xAFF1;
 inline constexpr std::uint16_t kAkdParameterAccess = 47;  // digest §5.1
 inline constexpr std::uint16_t kProfidriveLocal = 0xB02E;
 inline constexpr std::uint16_t kProfidriveGlobal = 0xB02F;
@@ -121,5 +122,24 @@ struct Im0View {
   std::size_t size = 0;
 };
 Im0View decode_im0(std::span<const std::uint8_t> in) noexcept;
+
+// ---- I&M1 [IEC 61158-6-10 "I&M1", PROFINET I&M guideline]: the plant's tags, written by users ---
+//   BlockHeader 0021h v1.0 | IM_Tag_Function 32 octets | IM_Tag_Location 22 octets (visible
+//   strings, blank padded)                           = 60 bytes
+
+inline constexpr std::size_t kIm1Size = 60;
+
+struct Im1 {
+  std::string_view tag_function{};  // trailing blanks removed (a view into the record)
+  std::string_view tag_location{};
+  bool operator==(const Im1&) const = default;
+};
+// Blank-pads both tags; 0 when either is too long.
+std::size_t encode_im1(const Im1& m, std::span<std::uint8_t> out) noexcept;
+struct Im1View {
+  WireError error = WireError::None;
+  Im1 im1{};
+};
+Im1View decode_im1(std::span<const std::uint8_t> in) noexcept;
 
 }  // namespace drivegate::profinet
