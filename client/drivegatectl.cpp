@@ -63,6 +63,7 @@ constexpr CommandHelp kCommands[] = {
      "  vendor parameter such as A83. The type comes from the axis' EDS, the device profile or CiA\n"
      "  301/402; --type names it otherwise: u8 u16 u24 u32 u40 u48 u56 u64, i8 .. i64, r32 r64, bool,\n"
      "  string, unicode, octets, domain (VALUE: decimal or 0x hex, a real, text, hex bytes \"01 02 0a\")\n"
+     "  PROFIdrive: OBJECT is a PNU: p930, p930[1] (subindex 1), r947[0]\n"
      "  PROFINET: OBJECT rec:SLOT:SUBSLOT:INDEX[@API] (decimal or 0x hex) reads or writes a record of the\n"
      "  axis' device (IODReadReq/IODWriteReq), e.g. rec:0:1:0xAFF0 for I&M0; its bytes unless --type\n"
      "  names a value (big-endian in the record); @API defaults to the configured submodule's",

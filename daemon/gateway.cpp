@@ -361,7 +361,8 @@ std::vector<std::string> Gateway::scheduling_notes() const {
 
 // The axis' bus type resolves names and knows types from its own files (canopen: EDS, device
 // profile; ethercat: ESI); a name they do not know is asked of the bus (the device's own
-// dictionary, ethercat); else the standards give the type. Without names: INDEX:SUB.
+// dictionary, ethercat); else the standards give the type. Without names: INDEX:SUB. A PROFIdrive
+// axis takes PNUs (config/profinet/parameters.hpp).
 ParameterLookup Gateway::lookup_parameter(std::size_t axis_id, std::string_view name, std::uint16_t index,
                                           std::uint8_t sub) const {
   ParameterLookup out;
@@ -401,7 +402,10 @@ ParameterLookup Gateway::lookup_parameter(std::size_t axis_id, std::string_view 
   if (p.type != core::ParamType::Unknown) {
     out.type = p.type;
     out.type_source = std::move(p.type_source);
-  } else if (const auto t = cia402::standard_param_type(*p.id); t != core::ParamType::Unknown) {
+  } else if (const auto t = bus.type_info && !bus.type_info->cia402_device ? core::ParamType::Unknown
+                                                                           : cia402::standard_param_type(*p.id);
+             t != core::ParamType::Unknown) {
+    // Only a CiA 402 drive's objects have the standards' types (a PROFIdrive PNU is no object index).
     out.type = t;
     out.type_source = out.index < 0x2000 ? "CiA 301" : "CiA 402";
   }

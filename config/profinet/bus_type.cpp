@@ -4,6 +4,7 @@
 #include "config/profinet/bus_options.hpp"
 #include "config/profinet/describe.hpp"
 #include "config/profinet/device_section.hpp"
+#include "config/profinet/parameters.hpp"
 
 namespace drivegate::config {
 
@@ -41,6 +42,7 @@ BusTypeInfo profinet_bus_type(const ProfinetWireRules& rules) {
   t.check_bus = {check_profinet_stations};
   t.describe_bus = {[rules](const BusPlan& bus, DescribeRows& rows) { describe_profinet_bus(rules, bus, rows); }};
   t.describe_axis = describe_profinet_axis;
+  t.find_parameter = find_profidrive_parameter;
   t.resource = resource;
   return t;
 }

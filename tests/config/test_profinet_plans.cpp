@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <tuple>
+
 #include "config/describe.hpp"
 #include "config/profinet/plan.hpp"
 #include "core/bus.hpp"
@@ -307,6 +309,40 @@ TEST(ProfinetPlans, AxesNeedADeviceWithAProfidriveSection) {
                   "bus needs (profiles/devices/README.md \"PROFIdrive\")");
   EXPECT_REPORTED(errors_of(with_axis_x("{ name: x, bus: pn0, address: 1, device: kollmorgen-akd-profinet }")),
                   "axes[0].profinet: missing");
+}
+
+}  // namespace
+}  // namespace drivegate::config
+
+namespace drivegate::config {
+namespace {
+
+// `param get AXIS p930`: a PROFIdrive axis takes PNUs with an optional subindex; INDEX:SUB (a
+// CANopen object) and anything else is refused in words, never taken as a PNU.
+TEST(ProfinetPlans, ParametersAreNamedByPnu) {
+  const Plan p = load_plan_from_string(kValid, "t.yaml", test::test_options());
+  const BusPlan& b = p.buses[0];
+  ASSERT_TRUE(b.type_info && b.type_info->find_parameter);
+  const auto find = [&](std::string_view name) { return b.type_info->find_parameter(b.axes[0], name, {0x6041, 0}); };
+  for (const auto& [name, pnu, sub] : {std::tuple{"p930", 930, 0}, std::tuple{"p930[1]", 930, 1},
+                                        std::tuple{"P964.2", 964, 2}, std::tuple{"r947[7]", 947, 7},
+                                        std::tuple{"p65535", 65535, 0}}) {
+    const ParameterRef r = find(name);
+    ASSERT_TRUE(r.id.has_value()) << name << ": " << r.error;
+    EXPECT_EQ(r.id->index, pnu) << name;
+    EXPECT_EQ(r.id->sub, sub) << name;
+    EXPECT_EQ(r.type, core::ParamType::Unknown) << name;  // the drive's reply says its format
+  }
+  for (const char* bad : {"p", "p0", "p65536", "p930[", "p930[]", "p930.", "p93a", "x930", "p930[1", "p-1", "6041h:00"}) {
+    const ParameterRef r = find(bad);
+    EXPECT_FALSE(r.id.has_value()) << bad;
+    EXPECT_NE(r.error.find("takes parameters by PNU: p930"), std::string::npos) << bad << ": " << r.error;
+    EXPECT_FALSE(r.name_unknown) << bad;
+  }
+  EXPECT_NE(find("p930[256]").error.find("subindex 256 is beyond 255"), std::string::npos);
+  const ParameterRef by_index = b.type_info->find_parameter(b.axes[0], "", {0x6041, 0});
+  EXPECT_FALSE(by_index.id.has_value());
+  EXPECT_NE(by_index.error.find("PROFIdrive axis 'x' takes parameters by PNU"), std::string::npos) << by_index.error;
 }
 
 }  // namespace

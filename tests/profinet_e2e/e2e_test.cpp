@@ -182,7 +182,16 @@ TEST_F(ProfinetE2e, RecordsGoOverTheParameterTopic) {
     q.value = value;
     return client_->param(q, 5s);
   };
-  auto r = param("x", "rec:0:1:0xAFF0");
+  // A PNU through the PROFIdrive parameter channel (record 47): PNU 964 subindex 0, the
+  // manufacturer ID of the device identification, and a CANopen address refused in words.
+  auto r = param("x", "p964[0]");
+  ASSERT_TRUE(r.ok) << r.error << diagnostics();
+  EXPECT_EQ(r.data.size(), 2U);  // a word (format 0x42)
+  r = param("x", "6041h:00");
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.error.find("takes parameters by PNU"), std::string::npos) << r.error;
+
+  r = param("x", "rec:0:1:0xAFF0");
   ASSERT_TRUE(r.ok) << r.error << diagnostics();
   EXPECT_EQ(r.type, core::ParamType::OctetString);
   ASSERT_EQ(r.data.size(), 60U);
