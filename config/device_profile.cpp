@@ -29,6 +29,7 @@ const std::vector<std::string>& known_quirks() {
                                             // hold a valid mode (0 is reserved), even before enabling
       "no_transmission_type_255",           // SD6 quirk 3: PDO transmission type 255 is reserved
       "mode_objects_16bit",                 // ESR/Dunker quirk 1: 6060h/6061h are INTEGER16
+      "pp_bit6_absolute",                   // ESR/Dunker quirk 14 [EXT]: pp controlword bit 6 = 1 is absolute
   };
   return kQuirks;
 }

@@ -114,7 +114,9 @@ CanopenBus::CanopenBus(const config::BusPlan& plan, std::unique_ptr<Transport> t
       throw core::BusError("bus '" + name_ + "' axis '" + a.spec.name + "': PDO maps exceed the process image");
     seed_mode_object(a, n->pdos.image());
     n->io = std::make_unique<NodeAccess>(n->id, n->channel, n->pdos, sdo_, emcy_, std::move(owned));
-    n->master = std::make_unique<cia402::Cia402Master>(*n->io, cia402::settings_from(a.spec));
+    cia402::MasterSettings settings = cia402::settings_from(a.spec);
+    settings.pp_bit6_absolute = a.device.quirk("pp_bit6_absolute");
+    n->master = std::make_unique<cia402::Cia402Master>(*n->io, settings);
     n->master->set_fault_table(tables_[i].faults);
     by_id_[n->id] = n.get();
     nodes_.push_back(std::move(n));

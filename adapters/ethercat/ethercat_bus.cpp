@@ -215,7 +215,9 @@ EthercatBus::EthercatBus(const config::BusPlan& plan, std::unique_ptr<Link> link
   for (std::size_t i = 0; i < axes_.size(); ++i) {
     Axis& x = axes_[i];
     x.io->set_faults(x.faults);
-    x.master = std::make_unique<cia402::Cia402Master>(*x.io, cia402::settings_from(plan.axes[i].spec));
+    cia402::MasterSettings settings = cia402::settings_from(plan.axes[i].spec);
+    settings.pp_bit6_absolute = plan.axes[i].device.quirk("pp_bit6_absolute");
+    x.master = std::make_unique<cia402::Cia402Master>(*x.io, settings);
     x.master->set_fault_table(x.faults);
   }
 }

@@ -61,7 +61,9 @@ void Cia402Master::enter_stage(core::TimePoint now) noexcept {
       add_nonzero(obj::kProfileVelocity, c.profile_velocity);
       add_nonzero(obj::kProfileAcceleration, c.profile_acceleration);
       add_nonzero(obj::kProfileDeceleration, c.profile_deceleration);
-      pp_bits_ = static_cast<std::uint16_t>((c.immediate ? cw::kChangeImmediately : 0U) | (c.relative ? cw::kRelative : 0U));
+      // Bit 6 is "relative" in CiA 402 and "absolute" on a drive with quirk pp_bit6_absolute.
+      pp_bits_ = static_cast<std::uint16_t>((c.immediate ? cw::kChangeImmediately : 0U) |
+                                            (c.relative != settings_.pp_bit6_absolute ? cw::kRelative : 0U));
       break;
     case CommandKind::Velocity:
       if (motion_.mode == Mode::Velocity) {

@@ -37,6 +37,9 @@ struct MasterSettings {
   // vl has no target-reached bit on NORD [NORD digest §5.2]: done when |6044h - 6042h| <= this
   // (only when 6044h is mapped; otherwise done once 6042h was written).
   std::int32_t vl_velocity_window = 5;
+  // Profile position: controlword bit 6 set means an absolute move, not a relative one (device
+  // quirk pp_bit6_absolute: ESR/Dunker, dunker-ethercat-coe.md §14 item 14 [EXT]).
+  bool pp_bit6_absolute = false;
 };
 
 inline MasterSettings settings_from(const core::AxisSpec& spec) {

@@ -57,6 +57,26 @@ TEST(ProfilePosition, RelativeAndImmediateBits) {
   EXPECT_EQ(h.cycle(kSwEnabled), 0x007F);  // bit 4 + bit 5 immediate + bit 6 relative
 }
 
+// ESR/Dunker (quirk pp_bit6_absolute, dunker-ethercat-coe.md §14 item 14): bit 6 set is an
+// absolute move there, so an absolute move sets it and a relative one clears it.
+TEST(ProfilePosition, Bit6IsAbsoluteOnADriveWithThatQuirk) {
+  MasterSettings s;
+  s.pp_bit6_absolute = true;
+  Harness h(s);
+  h.enable();
+  ASSERT_TRUE(h.submit(move(7, 500)).accepted);
+  EXPECT_EQ(h.cycle(kSwEnabled), 0x005F);  // bit 4 + bit 6 absolute
+  h.cycle(kSwEnabledAck);
+  h.cycle(kSwEnabledReached);
+  h.cycle(kSwEnabledReached);
+  h.cycle(kSwEnabledReached);
+  ASSERT_TRUE(h.sink.done(7));
+  auto c = move(8, -500);
+  c.relative = true;
+  ASSERT_TRUE(h.submit(c).accepted);
+  EXPECT_EQ(h.cycle(kSwEnabledReached), 0x001F);  // bit 4, bit 6 clear: relative
+}
+
 TEST(ProfilePosition, AcyclicRampsMustAllBeDoneBeforeBit4Rises) {
   Harness h;
   h.io.unmap(obj::kProfileVelocity.id);  // e.g. default AKD RPDO2 without 6081h, and 6083h/6084h never mapped

@@ -79,6 +79,24 @@ TEST(EthercatBusModes, EsrEnablesAndFollowsIpSetpoints) {
   expect_completed(h, h.push("esr", CommandKind::Disable), 3s, "disable");
 }
 
+// pp on the ESR: an absolute move sets controlword bit 6 there (quirk pp_bit6_absolute,
+// dunker-ethercat-coe.md §14 item 14), so the same absolute target twice ends where it was asked to,
+// not twice as far.
+TEST(EthercatBusModes, EsrAbsoluteMovesLandOnTheirTarget) {
+  EcatHarness h;
+  up(h);
+  if (HasFatalFailure()) return;
+  expect_completed(h, h.push("esr", CommandKind::Enable), 3s, "enable");
+  expect_completed(h, h.set_mode("esr", Mode::ProfilePosition), 3s, "pp");
+  const double start = h.snap("esr").position;
+  const double target = start + 0.5;
+  for (int i = 0; i < 2; ++i) {
+    expect_completed(h, h.push("esr", CommandKind::Move, target, 5), 5s, "move");
+    EXPECT_NEAR(h.snap("esr").position, target, 0.01) << "move " << i << " from " << start;
+  }
+  expect_completed(h, h.push("esr", CommandKind::Disable), 3s, "disable");
+}
+
 // csp on the generic drive (on SYNC0: the bus runs distributed clocks for it by default).
 TEST(EthercatBusModes, GenericFollowsCspSetpoints) {
   EcatHarness h;
