@@ -166,6 +166,51 @@ TEST(EthercatBusRecovery, PoweredOffSlaveIsLostAndComesBack) {
   expect_completed(h, h.push("gen", CommandKind::Enable), 3s, "enable after the restart");
 }
 
+// What bench_ethercat_daemon_cpu's phase (b) meets when its simulator stalls (bench/README.md):
+// the whole line stops answering for longer than lost_cycles while a drive moves in profile
+// position. Every slave is lost and configured from scratch; the axes come back disabled, so a move
+// is refused ("axis is not enabled") until an enable; enabled again, the drive moves. The profile
+// reaches the restarted slaves' statusword, controlword, mode and target through the image
+// references it resolved once, before the loss (ObjectAccess::resolve). (The generic drive moves:
+// the simulated ESR takes controlword bit 6 as "absolute" in pp, dunker-ethercat-coe.md
+// errata 14, which its device profile does not follow.)
+TEST(EthercatBusRecovery, StalledLineLosesTheMovingAxesWhichMoveAgainOnceEnabled) {
+  EcatHarness h;
+  up(h);
+  if (HasFatalFailure()) return;
+  expect_completed(h, h.push("esr", CommandKind::Enable), 3s, "enable esr");
+  expect_completed(h, h.push("gen", CommandKind::Enable), 3s, "enable gen");
+  expect_completed(h, h.push("gen", CommandKind::Move, 2.0, 5.0), 20s, "move gen");
+  const auto moving = h.push("gen", CommandKind::Move, 0.0, 5.0);
+  h.run_until([] { return false; }, 50ms);
+  ASSERT_EQ(h.gen.app->drive().state(), AxisState::OperationEnabled);
+
+  h.line->drop_next(30);  // about 30 cycles without an answer: lost_cycles is 3
+  ASSERT_TRUE(h.run_until([&] { return h.bus->link_state(h.axis("esr")) == LinkState::Lost &&
+                                       h.bus->link_state(h.axis("gen")) == LinkState::Lost; }, 100ms))
+      << h.details();
+  EXPECT_EQ(h.wait_final(moving, 100ms), ReplyStatus::Failed);
+  EXPECT_EQ(h.reason(moving), "link to drive lost");
+  ASSERT_TRUE(h.run_until([&] { return h.all_up(); }, 5s)) << h.details() << h.events_text();
+  EXPECT_GE(h.bus->restarts(0), 1U);
+  EXPECT_GE(h.bus->restarts(2), 1U);
+  for (const char* name : {"esr", "gen"}) {
+    EXPECT_EQ(h.snap(name).state, AxisState::SwitchOnDisabled) << name;
+    const auto refused = h.push(name, CommandKind::Move, 1.0, 5.0);
+    EXPECT_EQ(h.wait_final(refused, 100ms), ReplyStatus::Rejected) << name;
+    EXPECT_EQ(h.reason(refused), "axis is not enabled: send enable first") << name;
+  }
+
+  // Disabled, the drive coasts to a stop; then enabled and moved as before the loss.
+  ASSERT_TRUE(h.run_until([&] { return h.gen.app->drive().read_object({0x606C, 0}).value == 0; }, 20s));
+  expect_completed(h, h.push("esr", CommandKind::Enable), 3s, "enable esr after the restart");
+  expect_completed(h, h.push("gen", CommandKind::Enable), 3s, "enable gen after the restart");
+  expect_completed(h, h.push("gen", CommandKind::Move, 1.0, 5.0), 20s, "move gen after the restart");
+  EXPECT_NEAR(h.snap("gen").position, 1.0, 0.01);
+  EXPECT_NEAR(static_cast<double>(h.gen.app->drive().read_object({0x6064, 0}).value), 4096.0, 41.0);  // counts
+  EXPECT_EQ(h.snap("esr").state, AxisState::OperationEnabled);
+}
+
 // A slave of another identity at a drive's position is refused, naming both identities.
 TEST(EthercatBus, IdentityMismatchIsRefusedWithBothIdentities) {
   EcatHarness h(kLine, false);
@@ -188,3 +233,4 @@ TEST(EthercatBus, IdentityMismatchIsRefusedWithBothIdentities) {
 
 }  // namespace
 }  // namespace drivegate::ethercat::test
+
