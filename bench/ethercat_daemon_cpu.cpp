@@ -31,6 +31,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -169,6 +170,34 @@ int fail(const std::string& what) {
   return 1;
 }
 
+// Why axes stopped being enabled, from the daemon's log (level info logs every event; events come
+// on changes only): the lines of each kind that takes an axis out of operation enabled, counted,
+// with the first of each. A moment without an answer from the whole line (the simulator stalled
+// for more than lost_cycles) shows as every axis' link going lost at once.
+void print_what_disabled_axes(const std::string& log) {
+  struct Kind {
+    const char* label;
+    const char* needle;
+  };
+  constexpr std::array<Kind, 5> kKinds{{{"link lost", " -> lost"},
+                                        {"drive fault", ": fault 0x"},
+                                        {"control lost", ": control_lost: "},
+                                        {"command timeout", ": command_timeout: "},
+                                        {"cycle schedule missed", "stopped keeping its schedule"}}};
+  std::array<int, kKinds.size()> count{};
+  std::array<std::string, kKinds.size()> first;
+  std::istringstream in(log);
+  for (std::string line; std::getline(in, line);) {
+    for (std::size_t k = 0; k < kKinds.size(); ++k) {
+      if (line.find(kKinds[k].needle) == std::string::npos) continue;
+      if (count[k]++ == 0) first[k] = line;
+    }
+  }
+  std::printf("  in the daemon's log, what takes axes out of operation enabled:\n");
+  for (std::size_t k = 0; k < kKinds.size(); ++k) {
+    std::printf("    %-22s %4d%s%s\n", kKinds[k].label, count[k], count[k] > 0 ? "   first: " : "", first[k].c_str());
+  }
+}
 
 // The raw transport's rig: namespaces A (daemon, client) and B (drivegate-sim), a veth pair per
 // bus between them, and drivegate-sim serving every bus' line on its end B.
@@ -265,7 +294,7 @@ int run(int argc, char** argv) {
       test::write_config_text("bench-ethercat-daemon-cpu", config_text(dds, axes, rig ? rig->interfaces : std::vector<std::string>{}));
   if (rig) rig->start_sim(config);
   test::NotifySocket notify;
-  test::DaemonProcess daemon(config, notify.path(), "warn");
+  test::DaemonProcess daemon(config, notify.path(), "info");  // events: print_what_disabled_axes()
   if (!notify.wait_for("READY=1", 30s)) return fail("drivegated did not start:\n" + daemon.log());
 
   client::Client c0(client::options_for(dds.domain, dds.ns, "bench-0"));
@@ -360,7 +389,10 @@ int run(int argc, char** argv) {
   stop = true;
   mover.join();
   std::printf("  moves sent %d, refused %d\n", moves.load(), errors.load());
-  if (errors > 0) return fail("some moves were refused, the first: " + first_refusal);
+  if (errors > 0) {
+    print_what_disabled_axes(daemon.log());
+    return fail("some moves were refused, the first: " + first_refusal);
+  }
   daemon.terminate(SIGTERM, 20s);
   for (const char* suffix : {"", ".log"}) std::filesystem::remove(config + suffix);
   return 0;
