@@ -58,6 +58,8 @@ constexpr std::size_t kMaxReplyBacklog = 2048;
 // A client with this many requests still unanswered gets "busy" for more: its replies then always
 // fit the reply topics' history per client (idl/dds_node.cpp), read or not.
 constexpr int kClientLimit = 256;
+// A reply that waited this long for room in its client's reply history is warned about.
+constexpr auto kReplyStall = 5s;
 // A summary of the traffic instead of a log line per command.
 constexpr auto kSummaryPeriod = 10s;
 
@@ -409,10 +411,11 @@ void DdsBridge::Impl::start() {
   o.security = opt_.security;
   node_ = std::make_unique<msg::DdsNode>(o);
   state_w_ = &node_->writer(msg::TopicId::AxisState);
-  reply_w_ = &node_->writer(msg::TopicId::CommandReply, this, dds::StatusMask::publication_matched());
+  // Reply writers never block the bridge: a client's full history refuses at once and the reply waits here.
+  reply_w_ = &node_->writer(msg::TopicId::CommandReply, this, dds::StatusMask::publication_matched(), 0ms);
   event_w_ = &node_->writer(msg::TopicId::AxisEvent);
   bus_w_ = &node_->writer(msg::TopicId::BusStatus);
-  param_w_ = &node_->writer(msg::TopicId::ParamReply, this, dds::StatusMask::publication_matched());
+  param_w_ = &node_->writer(msg::TopicId::ParamReply, this, dds::StatusMask::publication_matched(), 0ms);
   info_w_ = &node_->writer(msg::TopicId::GatewayInfo);
   try {
     link_w_ = &node_->writer(msg::TopicId::AxisLink);
@@ -424,7 +427,7 @@ void DdsBridge::Impl::start() {
   }
   try {
     io_state_w_ = &node_->writer(msg::TopicId::IoState);
-    io_reply_w_ = &node_->writer(msg::TopicId::IoWriteReply, this, dds::StatusMask::publication_matched());
+    io_reply_w_ = &node_->writer(msg::TopicId::IoWriteReply, this, dds::StatusMask::publication_matched(), 0ms);
     io_write_r_ = &node_->reader(msg::TopicId::IoWrite, this, dds::StatusMask::data_available());
   } catch (const std::runtime_error& e) {
     // Permissions made before the I/O topics existed: the gateway runs, without them.
@@ -954,7 +957,17 @@ void DdsBridge::Impl::write_replies(Clock::time_point now) {
         ++it;
         continue;
       }
-      if (!writer->write(&it->sample)) spdlog::error("dds: a reply to '{}' could not be written", it->sample.client());
+      if (!writer->write(&it->sample)) {
+        // The client's history is full of replies not yet acknowledged by every reader that gets
+        // them (idl/dds_node.cpp): this one and the client's later ones wait, in order.
+        count([](Stats& s) { ++s.replies_held; });
+        if (now - it->since >= kReplyStall && warn_limit_.allow(now))
+          spdlog::warn("dds: replies to client '{}' have waited {} s for its readers' acknowledgements",
+                       it->sample.client(), std::chrono::duration_cast<std::chrono::seconds>(now - it->since).count());
+        blocked.insert(it->prefix);
+        ++it;
+        continue;
+      }
       count([&](Stats& s) {
         ++s.replies_written;
         if (!matched) ++s.replies_unmatched;

@@ -72,6 +72,7 @@ class DdsBridge {
     std::uint64_t params_routed = 0;
     std::uint64_t replies_written = 0;
     std::uint64_t replies_unmatched = 0;  // written after the hold time without a matched reader of the client
+    std::uint64_t replies_held = 0;       // write attempts refused by a client's full reply history (retried)
     std::uint64_t states_published = 0;
     std::uint64_t io_writes_routed = 0;
     std::uint64_t io_states_published = 0;

@@ -34,6 +34,7 @@ namespace {
 // and volatile, keyed by client with a deep history per client: one client that stops reading
 // cannot hold up the replies to every other (which a shared keep-all history would), and the
 // gateway keeps each client's unanswered requests well below that depth (daemon/dds_bridge.cpp).
+// The gateway's reply writers keep all, up to that depth per client (see DdsNode::writer).
 // A reply written before the gateway's writer knew a client's reader would be lost to volatile
 // durability, so the gateway holds a client's replies until its reader is matched. State and
 // set-points are best effort, newest only; events transient-local so a late joiner sees recent
@@ -266,6 +267,21 @@ dds::DataWriter& DdsNode::writer(TopicId t, dds::DataWriterListener* listener, d
                                  std::chrono::milliseconds max_blocking) {
   dds::DataWriterQos qos = dds::DATAWRITER_QOS_DEFAULT;
   apply(qos_of(t), qos);
+  // A reply writer keeps all, up to the topic's depth per client, and is transient local: a reply
+  // is then never dropped before every reader that gets it has acknowledged it. Keep-last (and
+  // Fast DDS's volatile keep-all, which drops the oldest when full) lost replies on a loaded
+  // machine: a reader whose receive buffer overflowed asked again for a reply already overwritten.
+  // A client's full instance refuses the write after `max_blocking` and the gateway holds the
+  // reply (daemon/dds_bridge.cpp). Readers keep the table's QoS (volatile, keep-last): a volatile
+  // reader gets nothing written before it matched, and a reader acknowledges whatever it receives,
+  // so a client that does not take its replies cannot hold up the writer. No limit on instances:
+  // a client name that was never seen before is never refused.
+  if (t == TopicId::CommandReply || t == TopicId::ParamReply || t == TopicId::IoWriteReply) {
+    qos.history().kind = dds::KEEP_ALL_HISTORY_QOS;
+    qos.durability().kind = dds::TRANSIENT_LOCAL_DURABILITY_QOS;
+    qos.resource_limits().max_instances = 0;  // unlimited
+    qos.resource_limits().max_samples = 0;    // unlimited; max_samples_per_instance stays the depth
+  }
   const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(max_blocking).count();
   qos.reliability().max_blocking_time = eprosima::fastrtps::Duration_t(
       static_cast<std::int32_t>(ns / 1'000'000'000), static_cast<std::uint32_t>(ns % 1'000'000'000));
