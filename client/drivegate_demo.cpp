@@ -32,8 +32,9 @@ constexpr const char* kUsage =
     "                      [--x AXIS] [--y AXIS] [--spindle AXIS] [--turntable AXIS]\n"
     "                      [--spindle-speed V] [--jog-seconds S] [--plain]\n"
     "Enables the demo axes, homes the turntable, moves x and y, moves the CANopen drives akd, nord\n"
-    "and sd6 and the EtherCAT drives esr and servo out and back, streams a stroke to esr (ip) and\n"
-    "servo (csp), jogs the spindle, then stops and disables everything. Axis names default\n"
+    "and sd6, the EtherCAT drives esr and servo and the PROFINET drive feed out and back, streams a\n"
+    "stroke to esr (ip) and servo (csp), jogs the spindle and the PROFINET drive akdpn, then stops\n"
+    "and disables everything. Axis names default\n"
     "to those of demo.yaml (x, y, spindle, turntable); axes that no gateway offers are skipped.\n"
     "--plain prints step lines without the live table.\n";
 
@@ -284,11 +285,14 @@ int run(int argc, char** argv) {
       std::cerr << "drivegate-demo: skipping axis '" << a << "': " << client.route(a, gateway).error << "\n";
     }
   }
-  // The CANopen and EtherCAT drives of the demo config, each moved out and back (in its own unit).
+  // The CANopen, EtherCAT and PROFINET drives of the demo config, each moved out and back (in its
+  // own unit); the PROFINET AKD in speed mode is jogged.
   const std::vector<std::pair<std::string, double>> fieldbus_moves{
-      {"akd", 20}, {"nord", 3}, {"sd6", 2}, {"esr", 5}, {"servo", 30}};
+      {"akd", 20}, {"nord", 3}, {"sd6", 2}, {"esr", 5}, {"servo", 30}, {"feed", 3}};
   for (const auto& [a, distance] : fieldbus_moves)
     if (offered(a)) axes.push_back(a);
+  const std::string speed_drive = "akdpn";
+  if (offered(speed_drive)) axes.push_back(speed_drive);
   if (axes.empty()) {
     std::cerr << "drivegate-demo: none of the demo axes is available\n";
     return 1;
@@ -321,6 +325,7 @@ int run(int argc, char** argv) {
   if (ok && has("esr")) ok = demo.stream({{"esr", 3}}, "ip", 2.0);
   if (ok && has("servo")) ok = demo.stream({{"servo", 20}}, "csp", 2.0);
   if (ok && has(spindle)) ok = demo.jog(spindle, speed, jog_seconds);
+  if (ok && has(speed_drive)) ok = demo.jog(speed_drive, speed, jog_seconds);
   if (interrupted()) demo.log("interrupted: disabling all axes");
   demo.shut_down(axes);
   demo.stop_display();
