@@ -31,8 +31,8 @@ constexpr const char* kUsage =
     "usage: drivegate-demo [--domain N] [--namespace NS] [--gateway G] [--identity DIR] [--timeout S]\n"
     "                      [--x AXIS] [--y AXIS] [--spindle AXIS] [--turntable AXIS]\n"
     "                      [--spindle-speed V] [--jog-seconds S] [--plain]\n"
-    "Enables the demo axes, homes the turntable, moves x and y, moves the CANopen drives akd, nord\n"
-    "and sd6, the EtherCAT drives esr and servo and the PROFINET drive feed out and back, streams a\n"
+    "Enables the demo axes, homes the turntable and the PROFINET drive feed, moves x and y, moves the\n"
+    "CANopen drives akd, nord and sd6 and the EtherCAT drives esr and servo out and back, streams a\n"
     "stroke to esr (ip) and servo (csp), jogs the spindle and the PROFINET drive akdpn, then stops\n"
     "and disables everything. Axis names default\n"
     "to those of demo.yaml (x, y, spindle, turntable); axes that no gateway offers are skipped.\n"
@@ -285,14 +285,15 @@ int run(int argc, char** argv) {
       std::cerr << "drivegate-demo: skipping axis '" << a << "': " << client.route(a, gateway).error << "\n";
     }
   }
-  // The CANopen, EtherCAT and PROFINET drives of the demo config, each moved out and back (in its
-  // own unit); the PROFINET AKD in speed mode is jogged.
+  // The CANopen and EtherCAT drives of the demo config, each moved out and back (in its own unit);
+  // the PROFINET AKDs: feed is homed, akdpn (speed mode) jogged.
   const std::vector<std::pair<std::string, double>> fieldbus_moves{
-      {"akd", 20}, {"nord", 3}, {"sd6", 2}, {"esr", 5}, {"servo", 30}, {"feed", 3}};
+      {"akd", 20}, {"nord", 3}, {"sd6", 2}, {"esr", 5}, {"servo", 30}};
   for (const auto& [a, distance] : fieldbus_moves)
     if (offered(a)) axes.push_back(a);
+  for (const char* a : {"feed", "akdpn"})
+    if (offered(a)) axes.push_back(a);
   const std::string speed_drive = "akdpn";
-  if (offered(speed_drive)) axes.push_back(speed_drive);
   if (axes.empty()) {
     std::cerr << "drivegate-demo: none of the demo axes is available\n";
     return 1;
@@ -306,6 +307,7 @@ int run(int argc, char** argv) {
   for (const auto& a : axes) enables.push_back(command(a, "enable"));
   ok = demo.together("enable", enables);
   if (ok && has(turntable)) ok = demo.step("home " + turntable, command(turntable, "home"));
+  if (ok && has("feed")) ok = demo.step("home feed", command("feed", "home"));
   const std::vector<std::pair<double, double>> path{{50, 20}, {100, 60}, {20, 80}, {0, 0}};
   for (const auto& [px, py] : path) {
     if (!ok) break;
