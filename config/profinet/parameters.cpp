@@ -28,22 +28,24 @@ ParameterRef find_profidrive_parameter(const AxisPlan& axis, std::string_view na
     out.error = how;
     return out;
   }
+  // p930, p930[1] or p930.1 ("r" likewise): the PNU, and the subindex when one is given.
   std::string_view pnu_text = name.substr(1);
   std::string_view sub_text;
-  if (const auto open = pnu_text.find('['); open != std::string_view::npos) {
-    if (pnu_text.back() != ']') pnu_text = {};
-    sub_text = pnu_text.empty() ? std::string_view{} : pnu_text.substr(open + 1, pnu_text.size() - open - 2);
-    pnu_text = pnu_text.substr(0, open);
-    if (sub_text.empty()) pnu_text = {};
-  } else if (const auto dot = pnu_text.find('.'); dot != std::string_view::npos) {
-    sub_text = pnu_text.substr(dot + 1);
-    pnu_text = pnu_text.substr(0, dot);
-    if (sub_text.empty()) pnu_text = {};
+  bool well_formed = name.front() == 'p' || name.front() == 'P' || name.front() == 'r' || name.front() == 'R';
+  if (const auto at = pnu_text.find_first_of("[."); at != std::string_view::npos) {
+    const bool bracket = pnu_text[at] == '[';
+    sub_text = pnu_text.substr(at + 1);
+    if (bracket) {
+      well_formed = well_formed && sub_text.size() > 1 && sub_text.back() == ']';
+      sub_text.remove_suffix(sub_text.empty() ? 0 : 1);
+    }
+    pnu_text = pnu_text.substr(0, at);
+    well_formed = well_formed && !sub_text.empty();
   }
   std::uint32_t pnu = 0;
   std::uint32_t sub = 0;
-  if ((name.front() != 'p' && name.front() != 'P' && name.front() != 'r' && name.front() != 'R') ||
-      !decimal(pnu_text, 65535, pnu) || pnu == 0 || (!sub_text.empty() && !decimal(sub_text, 0xFFFF, sub))) {
+  if (!well_formed || !decimal(pnu_text, 65535, pnu) || pnu == 0 ||
+      (!sub_text.empty() && !decimal(sub_text, 0xFFFF, sub))) {
     out.error = "'" + std::string(name) + "' is not a parameter: " + how;
     return out;
   }
