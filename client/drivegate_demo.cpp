@@ -293,7 +293,6 @@ int run(int argc, char** argv) {
     if (offered(a)) axes.push_back(a);
   for (const char* a : {"feed", "akdpn"})
     if (offered(a)) axes.push_back(a);
-  const std::string speed_drive = "akdpn";
   if (axes.empty()) {
     std::cerr << "drivegate-demo: none of the demo axes is available\n";
     return 1;
@@ -327,7 +326,7 @@ int run(int argc, char** argv) {
   if (ok && has("esr")) ok = demo.stream({{"esr", 3}}, "ip", 2.0);
   if (ok && has("servo")) ok = demo.stream({{"servo", 20}}, "csp", 2.0);
   if (ok && has(spindle)) ok = demo.jog(spindle, speed, jog_seconds);
-  if (ok && has(speed_drive)) ok = demo.jog(speed_drive, speed, jog_seconds);
+  if (ok && has("akdpn")) ok = demo.jog("akdpn", speed, jog_seconds);
   if (interrupted()) demo.log("interrupted: disabling all axes");
   demo.shut_down(axes);
   demo.stop_display();
