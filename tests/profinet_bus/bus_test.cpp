@@ -1,9 +1,10 @@
 // The PROFINET bus on simulated devices: stations found by name and given their IP, ARs to data
-// exchange, an AKD enabled and run in speed mode through its telegram, a PNU read over record 47,
-// the IO device's bytes both ways, losses (power, AR abort) that reconnect only the device that
-// was lost with a new AR and its axis disabled, a missing station and a wrong module named, the
-// ARs released on close, no allocation per cycle in data exchange, a drive fault read from the
-// fault buffer over record 47 and acknowledged, and alarms as events.
+// exchange, an AKD enabled and run in speed mode through its telegram, another moved in MDI and
+// disabled, a PNU read over record 47, the IO device's bytes both ways, losses (power, AR abort)
+// that reconnect only the device that was lost with a new AR and its axis disabled, a missing
+// station and a wrong module named, the ARs released on close, no allocation per cycle in data
+// exchange, a drive fault read from the fault buffer over record 47 and acknowledged, and alarms as
+// events.
 #include <gtest/gtest.h>
 
 #include <array>
@@ -84,6 +85,34 @@ TEST(ProfinetBus, EnablesAnAkdAndRunsItInSpeedMode) {
   EXPECT_EQ(h.snap("y").state, core::AxisState::SwitchOnDisabled);
   const auto off = h.push("x", core::CommandKind::Disable);
   ASSERT_EQ(h.wait_final(off, 5s), core::ReplyStatus::Completed) << h.reason(off);
+}
+
+// Telegram 9 at the AKD's 16 ms update: homed, moved out and back in MDI, each move landing on
+// its target, then disabled: OFF1 from standstill and on to S1.
+TEST(ProfinetBus, MdiMovesLandOnTheirTargetsAndTheDriveDisables) {
+  PnHarness h;
+  ASSERT_TRUE(h.run_until([&] { return h.all_up(); }, 5s)) << h.details();
+  ASSERT_EQ(h.wait_final(h.push("y", core::CommandKind::Enable), 3s), core::ReplyStatus::Completed);
+  const auto home = h.push("y", core::CommandKind::Home);
+  ASSERT_EQ(h.wait_final(home, 10s), core::ReplyStatus::Completed) << h.reason(home);
+  for (const double target : {3.0, 0.0}) {
+    core::Command c;
+    c.id = h.next_id++;
+    c.axis = h.axis("y");
+    c.kind = core::CommandKind::Move;
+    c.position = target;  // rev
+    c.velocity = 2.0;
+    c.acceleration = 20.0;
+    c.deceleration = 20.0;
+    ASSERT_TRUE(h.runner->push_command(c));
+    ASSERT_EQ(h.wait_final(c.id, 10s), core::ReplyStatus::Completed)
+        << h.reason(c.id) << ": at " << h.snap("y").position << " rev, " << h.snap("y").velocity << " rev/s";
+    EXPECT_NEAR(h.snap("y").position, target, 1e-3);
+  }
+  const auto off = h.push("y", core::CommandKind::Disable);
+  ASSERT_EQ(h.wait_final(off, 5s), core::ReplyStatus::Completed) << h.reason(off) << h.events_text();
+  EXPECT_EQ(h.snap("y").state, core::AxisState::SwitchOnDisabled);
+  EXPECT_EQ(h.sim->akd_y->drive().state(), profidrive::sim::State::S1SwitchingOnInhibited);
 }
 
 TEST(ProfinetBus, ReadsAPnuOverRecord47) {

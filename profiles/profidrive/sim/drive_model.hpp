@@ -217,7 +217,9 @@ class DriveModel {
   void start_task(std::uint16_t c) noexcept;
   void run_homing(std::uint16_t c, double dt) noexcept;
   void ramp_demand(double target_velocity, double acc, double dec, double dt) noexcept;
-  void motor_update(double dt) noexcept;
+  // Bounds the motor's integration steps per update (a 1 s update on a 2 ms loop).
+  static constexpr int kMaxMotorSteps = 2048;
+  void motor_update(double dt, double demand_from) noexcept;
   void check_following_error() noexcept;
   [[nodiscard]] double cpr() const noexcept;  // counts per rev (PNU 1002)
   [[nodiscard]] double acc_full_scale() const noexcept;
