@@ -24,6 +24,9 @@ DriveState decode_state(std::uint16_t zsw1, std::uint16_t last_stw1) noexcept {
   if (!has(zsw1, zsw1::kNoCoastStop)) return {AxisState::SwitchOnDisabled, true};
   if (!has(zsw1, zsw1::kNoQuickStop)) return {AxisState::QuickStopActive, true};
   if (on && ready) {
+    // S4 pattern with OFF3 sent (0x0402: bits 0 and 2 low), the drive not yet showing bit 5 low:
+    // the quick stop is under way, not an OFF1 ramp.
+    if (enabled && !has(last_stw1, stw1::kNoQuickStop)) return {AxisState::QuickStopActive, true};
     // S3/S4 pattern with OFF1 sent: S5 ramping down to S2 (or S3 -> S2 under way).
     if (!has(last_stw1, stw1::kOn)) return {AxisState::ReadyToSwitchOn, true};
     return {enabled ? AxisState::OperationEnabled : AxisState::SwitchedOn, false};

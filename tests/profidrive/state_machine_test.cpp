@@ -65,6 +65,9 @@ TEST(ProfidriveState, S5AfterOff3IsQuickStop) {
   EXPECT_EQ(decode_state(kS3 & ~zsw1::kNoQuickStop, stw1_word::kQuickStop),
             (DriveState{AxisState::QuickStopActive, true}));
   EXPECT_EQ(decode_state(0x0250, stw1_word::kQuickStop), (DriveState{AxisState::SwitchOnDisabled, false}));
+  // OFF3 just sent, the drive still in S4: quick stop under way, not the OFF1 ramp (bit 0 is low
+  // too in 0x0402).
+  EXPECT_EQ(decode_state(kS4, stw1_word::kQuickStop), (DriveState{AxisState::QuickStopActive, true}));
 }
 
 TEST(ProfidriveState, CoastStopAndFault) {
