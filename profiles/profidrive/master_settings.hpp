@@ -33,6 +33,9 @@ struct MasterSettings {
   // (target reached, homed, drive stopped): completion ignores them. Counted in fresh telegrams, not
   // cycles, so a drive that updates slower than the bus cycle gets the same grace.
   std::uint32_t settle_telegrams = 3;
+  // Native velocity units per XIST_A count per second, for the velocity derived from XIST_A where
+  // the telegram carries no NIST_A (default: 65536 counts per rev, 2^31 = 200 rev/s).
+  double velocity_per_count = 2147483648.0 / 200.0 / 65536.0;
 };
 
 inline MasterSettings settings_from(const core::AxisSpec& spec) {
@@ -40,6 +43,7 @@ inline MasterSettings settings_from(const core::AxisSpec& spec) {
   s.step_timeout = spec.enable_step_timeout;
   s.follow_timeout = std::min(spec.enable_step_timeout, s.follow_timeout);
   s.homing_timeout = spec.homing.timeout;
+  s.velocity_per_count = spec.units.velocity_factor() / spec.units.position_factor();
   return s;
 }
 

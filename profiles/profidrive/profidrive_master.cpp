@@ -31,7 +31,12 @@ TelegramCapabilities capabilities_of(const TelegramLayout& layout) noexcept {
 
 ProfidriveMaster::ProfidriveMaster(TelegramPort& port, ParamChannel& channel, const TelegramLayout& layout,
                                    const MasterSettings& settings) noexcept
-    : port_(port), channel_(channel), layout_(layout), caps_(capabilities_of(layout)), settings_(settings) {
+    : port_(port),
+      channel_(channel),
+      layout_(layout),
+      caps_(capabilities_of(layout)),
+      settings_(settings),
+      derived_velocity_(settings.velocity_per_count) {
   mode_ = initial_mode();
 }
 
@@ -343,6 +348,8 @@ void ProfidriveMaster::drop_drive(std::string_view reason, core::ControllerSink&
   // client commands it (DESIGN.md §4 safety rules).
   actual_valid_ = false;
   actual_ = Actuals{};
+  derived_velocity_.reset();
+  velocity_ = 0;
   state_ = DriveState{};
   warning_ = false;
   control_requested_ = true;

@@ -30,6 +30,7 @@
 #include "profiles/profidrive/fault_buffer.hpp"
 #include "profiles/profidrive/master_settings.hpp"
 #include "profiles/profidrive/param_access.hpp"
+#include "profiles/profidrive/position_velocity.hpp"
 #include "profiles/profidrive/param_channel.hpp"
 #include "profiles/profidrive/state_machine.hpp"
 #include "profiles/profidrive/telegram.hpp"
@@ -173,6 +174,8 @@ class ProfidriveMaster final : public core::AxisController {
   Actuals actual_{};
   core::TimePoint fresh_at_{};
   std::uint64_t telegrams_ = 0;  // fresh actual telegrams decoded
+  PositionVelocity derived_velocity_;  // from XIST_A, where the telegram carries no NIST_A
+  std::int32_t velocity_ = 0;          // native units, from NIST_A or derived
   DriveState state_{};
   bool warning_ = false;
   bool control_requested_ = true;  // ZSW1 bit 9 as last seen

@@ -65,6 +65,8 @@ bool ProfidriveMaster::read_inputs(core::TimePoint now, core::ControllerSink& si
     if (decode_actuals(layout_, image, a) == TelegramError::None) {
       actual_ = a;
       fresh_at_ = now;
+      if (layout_.carries(Signal::NistA)) velocity_ = native_from_nist(actual_.nist_a);
+      else if (caps_.position_actual) velocity_ = derived_velocity_.add(actual_.xist_a, now);
       ++telegrams_;
       if (!actual_valid_) step_since_ = now;
       actual_valid_ = true;
@@ -294,7 +296,7 @@ void ProfidriveMaster::fill_feedback() noexcept {
   fb_.statusword = actual_.zsw1;
   fb_.controlword = stw1_;
   if (caps_.position_actual) fb_.position = actual_.xist_a;
-  if (layout_.carries(Signal::NistA)) fb_.velocity = native_from_nist(actual_.nist_a);
+  fb_.velocity = velocity_;
   if (layout_.carries(Signal::ItistGlatt)) fb_.torque = actual_.itist_glatt;
   const Zsw1Flags f = decode_flags(actual_.zsw1);
   fb_.warning = f.warning;

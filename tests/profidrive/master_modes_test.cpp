@@ -276,6 +276,9 @@ TEST(ProfidriveMasterJog, VelocityOnAnMdiTelegramIsRealTimeJog) {
   EXPECT_TRUE(h.sink.done(2));
   h.run(10);
   EXPECT_LT(h.drive.position, 0);
+  // Telegram 9 carries no NIST_A: the velocity is XIST_A's slope, 10 counts per 1 ms telegram at
+  // 65536 counts per rev (MasterSettings' default) in the native unit.
+  EXPECT_NEAR(h.master.feedback().velocity, -10 * 1000 * h.settings.velocity_per_count, 1.0);
   ASSERT_TRUE(h.submit(velocity(3, 0)).accepted);  // 0 is a stop
   h.cycle();
   EXPECT_EQ(h.drive.sent().stw1, 0x040F);
@@ -284,6 +287,7 @@ TEST(ProfidriveMasterJog, VelocityOnAnMdiTelegramIsRealTimeJog) {
   const std::int32_t at = h.drive.position;
   h.run(10);
   EXPECT_EQ(h.drive.position, at);
+  EXPECT_EQ(h.master.feedback().velocity, 0);
 }
 
 TEST(ProfidriveMaster, CapabilitiesFollowTheTelegram) {

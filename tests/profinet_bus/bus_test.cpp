@@ -87,31 +87,49 @@ TEST(ProfinetBus, EnablesAnAkdAndRunsItInSpeedMode) {
   ASSERT_EQ(h.wait_final(off, 5s), core::ReplyStatus::Completed) << h.reason(off);
 }
 
+core::Command motion(PnHarness& h, const std::string& name, core::CommandKind kind, double position, double velocity) {
+  core::Command c;
+  c.id = h.next_id++;
+  c.axis = h.axis(name);
+  c.kind = kind;
+  c.position = position;  // rev
+  c.velocity = velocity;  // rev/s
+  c.acceleration = 20.0;
+  c.deceleration = 20.0;
+  EXPECT_TRUE(h.runner->push_command(c));
+  return c;
+}
+
 // Telegram 9 at the AKD's 16 ms update: homed, moved out and back in MDI, each move landing on
-// its target, then disabled: OFF1 from standstill and on to S1.
-TEST(ProfinetBus, MdiMovesLandOnTheirTargetsAndTheDriveDisables) {
+// its target; jogged (real-time jog), its speed shown although telegram 9 carries no NIST_A (the
+// slope of XIST_A); then disabled: OFF1 from standstill and on to S1.
+TEST(ProfinetBus, MdiMovesLandOnTheirTargetsAJogShowsItsSpeedAndTheDriveDisables) {
   PnHarness h;
   ASSERT_TRUE(h.run_until([&] { return h.all_up(); }, 5s)) << h.details();
   ASSERT_EQ(h.wait_final(h.push("y", core::CommandKind::Enable), 3s), core::ReplyStatus::Completed);
   const auto home = h.push("y", core::CommandKind::Home);
   ASSERT_EQ(h.wait_final(home, 10s), core::ReplyStatus::Completed) << h.reason(home);
   for (const double target : {3.0, 0.0}) {
-    core::Command c;
-    c.id = h.next_id++;
-    c.axis = h.axis("y");
-    c.kind = core::CommandKind::Move;
-    c.position = target;  // rev
-    c.velocity = 2.0;
-    c.acceleration = 20.0;
-    c.deceleration = 20.0;
-    ASSERT_TRUE(h.runner->push_command(c));
-    ASSERT_EQ(h.wait_final(c.id, 10s), core::ReplyStatus::Completed)
-        << h.reason(c.id) << ": at " << h.snap("y").position << " rev, " << h.snap("y").velocity << " rev/s";
+    const auto mv = motion(h, "y", core::CommandKind::Move, target, 2.0).id;
+    ASSERT_EQ(h.wait_final(mv, 10s), core::ReplyStatus::Completed)
+        << h.reason(mv) << ": at " << h.snap("y").position << " rev, " << h.snap("y").velocity << " rev/s";
     EXPECT_NEAR(h.snap("y").position, target, 1e-3);
   }
+  const auto jog = motion(h, "y", core::CommandKind::Velocity, 0, -1.5);
+  core::Setpoint alive;  // a jog lasts while its set-point is kept alive (the command timeout)
+  alive.axis = jog.axis;
+  alive.velocity = jog.velocity;
+  bool jogging = false;
+  for (int i = 0; i < 100 && !jogging; ++i) {
+    ASSERT_TRUE(h.runner->push_setpoint(alive));
+    jogging = h.run_until([&] { return std::fabs(h.snap("y").velocity + 1.5) < 0.01; }, 50ms);
+  }
+  ASSERT_TRUE(jogging) << h.snap("y").velocity << " rev/s; the drive at " << h.sim->akd_y->drive().velocity_rps();
+  EXPECT_LT(h.snap("y").position, 0.0);
   const auto off = h.push("y", core::CommandKind::Disable);
   ASSERT_EQ(h.wait_final(off, 5s), core::ReplyStatus::Completed) << h.reason(off) << h.events_text();
   EXPECT_EQ(h.snap("y").state, core::AxisState::SwitchOnDisabled);
+  EXPECT_NEAR(h.snap("y").velocity, 0.0, 0.05);
   EXPECT_EQ(h.sim->akd_y->drive().state(), profidrive::sim::State::S1SwitchingOnInhibited);
 }
 

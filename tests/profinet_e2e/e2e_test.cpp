@@ -1,6 +1,7 @@
 // The PROFINET adapter end to end with the real binaries (the set-up: e2e_fixture.hpp). The gateway
 // finds the stations by name, gives them their addresses, connects them and runs the PROFIdrive
-// axes; the client enables one and runs it in speed mode; a power loss from the simulator's console
+// axes; the client enables one and runs it in speed mode, and homes, moves in MDI, runs a
+// traversing block and jogs the other; a power loss from the simulator's console
 // is a lost link and a reconnect with the axis disabled, the other drive untouched; records and
 // I&M0 over the parameter topic and the link detail.
 #include <gtest/gtest.h>
@@ -29,6 +30,78 @@ TEST_F(ProfinetE2e, AnAkdIsEnabledAndRunsInSpeedMode) {
   EXPECT_EQ(state("y").state, "switch_on_disabled");
   const auto off = send("x", "disable");
   EXPECT_EQ(off.outcome, client::Outcome::Completed) << off.reason << diagnostics();
+}
+
+// Application class 3 on the AKD with telegram 352 at its 16 ms update: homed (STW1 bit 11), moved
+// in MDI out and back, a traversing block stored through the MT.* PNUs and run (program mode),
+// jogged (real-time jog, STW1 bit 12) and stopped, then disabled to S1.
+TEST_F(ProfinetE2e, AnAkdIsHomedMovedInMdiRunsABlockAndJogs) {
+  const auto en = send("y", "enable");
+  ASSERT_EQ(en.outcome, client::Outcome::Completed) << en.reason << diagnostics();
+  const auto home = send("y", "home");
+  ASSERT_EQ(home.outcome, client::Outcome::Completed) << home.reason << diagnostics();
+  const auto at = [&](double target) {
+    return wait_axis("y", [target](const client::AxisState& s) { return std::fabs(s.position - target) < 1e-3; }, 5s);
+  };
+  for (const double target : {3.0, 0.0}) {
+    auto mv = request("y", "move");
+    mv.position = target;  // rev
+    mv.velocity = 2.0;
+    mv.acceleration = 20.0;
+    mv.deceleration = 20.0;
+    const auto r = send(mv);
+    ASSERT_EQ(r.outcome, client::Outcome::Completed) << target << ": " << r.reason << diagnostics();
+    EXPECT_TRUE(at(target)) << target << diagnostics();
+  }
+
+  // Task 1: absolute to 2 rev at 375 rpm, 8 steps of PNU 1008 (6100 rpm/s) both ways [§16.1].
+  const auto write = [&](const std::string& pnu, const std::string& type, const std::string& value) {
+    client::ParamRequest q;
+    q.axis = "y";
+    q.name = pnu;
+    q.write = true;
+    q.type = type;
+    q.value = value;
+    const auto r = client_->param(q, 5s);
+    EXPECT_TRUE(r.ok) << pnu << ": " << r.error;
+  };
+  write("p2274", "u8", "1");            // MT.NUM
+  write("p2275", "i32", "131072");      // MT.P, counts
+  write("p2283", "u32", "0x08000000");  // MT.V_32, 2^32 = 12000 rpm
+  write("p2263", "u32", "8");           // MT.ACC
+  write("p2268", "u32", "8");           // MT.DEC
+  write("p2266", "u32", "1");           // MT.CNTL: absolute
+  write("p2277", "u8", "0");            // MT.SET
+  auto block = request("y", "run_block");
+  block.block = 1;
+  const auto b = send(block);
+  ASSERT_EQ(b.outcome, client::Outcome::Completed) << b.reason << diagnostics();
+  EXPECT_TRUE(at(2.0)) << diagnostics();
+
+  auto jog = request("y", "velocity");
+  jog.velocity = -1.5;  // rev/s
+  jog.acceleration = 20.0;
+  jog.deceleration = 20.0;
+  const auto j = start(jog);
+  ASSERT_NE(j.outcome, client::Outcome::Failed) << j.reason << diagnostics();
+  // A jog lasts while its set-point is kept alive (the axis' command timeout, 500 ms), as
+  // drivegate-demo does.
+  bool jogging = false;
+  for (int i = 0; i < 100 && !jogging; ++i) {
+    ASSERT_EQ(client_->stream_setpoint("y", {}, 0, jog.velocity, 0), "");
+    jogging = wait_axis("y", [](const client::AxisState& s) { return std::fabs(s.velocity + 1.5) < 0.05; }, 50ms);
+  }
+  EXPECT_TRUE(jogging) << diagnostics();
+  const auto stop = send("y", "stop");
+  ASSERT_EQ(stop.outcome, client::Outcome::Completed) << stop.reason << diagnostics();
+  EXPECT_LT(state("y").position, 2.0);
+  EXPECT_EQ(state("y").state, "operation_enabled");
+
+  const auto off = send("y", "disable");
+  ASSERT_EQ(off.outcome, client::Outcome::Completed) << off.reason << diagnostics();
+  // The state topic follows the reply within a status period.
+  EXPECT_TRUE(wait_axis("y", [](const client::AxisState& s) { return s.state == "switch_on_disabled"; }, 1s))
+      << diagnostics();
 }
 
 TEST_F(ProfinetE2e, PowerLossIsALostLinkAndTheDriveComesBackDisabled) {
