@@ -286,13 +286,12 @@ int run(int argc, char** argv) {
     }
   }
   // The CANopen and EtherCAT drives of the demo config, each moved out and back (in its own unit);
-  // the PROFINET AKDs: feed is homed, akdpn (speed mode) jogged.
+  // the PROFINET AKDs: feed is homed and moved like them (MDI), akdpn (speed mode) jogged.
   const std::vector<std::pair<std::string, double>> fieldbus_moves{
-      {"akd", 20}, {"nord", 3}, {"sd6", 2}, {"esr", 5}, {"servo", 30}};
+      {"akd", 20}, {"nord", 3}, {"sd6", 2}, {"esr", 5}, {"servo", 30}, {"feed", 3}};
   for (const auto& [a, distance] : fieldbus_moves)
     if (offered(a)) axes.push_back(a);
-  for (const char* a : {"feed", "akdpn"})
-    if (offered(a)) axes.push_back(a);
+  if (offered("akdpn")) axes.push_back("akdpn");
   if (axes.empty()) {
     std::cerr << "drivegate-demo: none of the demo axes is available\n";
     return 1;

@@ -5,6 +5,7 @@
 #include "config/sim/plan.hpp"
 #include "config/describe.hpp"
 #include "config/loader.hpp"
+#include "config/profinet/plan.hpp"
 #include "tests/config/test_support.hpp"
 
 namespace drivegate::config {
@@ -145,7 +146,7 @@ TEST(LoadValid, FixedDeviceUnitsAndDefaults) {
 TEST(LoadValid, DemoConfigLoads) {
   const Plan plan = load_plan(DRIVEGATE_DEMO_CONFIG);
   EXPECT_TRUE(plan.warnings.empty());
-  ASSERT_EQ(plan.buses.size(), 3U);
+  ASSERT_EQ(plan.buses.size(), 4U);
   const BusPlan& bus = plan.buses[0];
   EXPECT_EQ(bus.type, "sim");
   EXPECT_EQ(bus.cycle_time, core::Duration{1ms});
@@ -189,6 +190,14 @@ TEST(LoadValid, DemoConfigLoads) {
   EXPECT_EQ(ec.axes[0].device.name, "esr-triodrive");
   EXPECT_EQ(ec.axes[1].device.name, "generic-cia402");
   EXPECT_EQ(ec.axes[1].address, 3);
+
+  // The PROFINET network: two AKDs and an IO device, simulated in-process.
+  const BusPlan& pn = plan.buses[3];
+  EXPECT_EQ(pn.type, "profinet");
+  EXPECT_TRUE(pn.section<ProfinetBusOptions>().simulated);
+  EXPECT_EQ(pn.section<ProfinetBusOptions>().io.size(), 1U);
+  ASSERT_EQ(pn.axes.size(), 2U);
+  EXPECT_EQ(pn.axes[0].device.name, "kollmorgen-akd-profinet");
 }
 
 TEST(LoadValid, DescribePlanShowsTheImportantNumbers) {
