@@ -76,12 +76,14 @@ bool BusRunner::cycle(TimePoint now) noexcept {
     if (!io_replies_.push(r)) dropped_.fetch_add(1, std::memory_order_relaxed);
   }
 
+  const bool publish = now >= next_publish_;
+  if (publish) next_publish_ = now + publish_period_;
   for (std::size_t i = 0; i < axes_.size(); ++i) {
     axes_[i].update(now, *this);
-    snapshots_[i].store(axes_[i].snapshot());
+    if (publish) snapshots_[i].store(axes_[i].snapshot());
   }
   ++cycles_;
-  for (std::size_t k = 0; k < io_count_; ++k) {
+  for (std::size_t k = 0; k < io_count_ && publish; ++k) {
     bus_.io_read(k, io_scratch_);
     io_scratch_.stamp_ns = to_ns(now);
     io_scratch_.cycle = cycles_;

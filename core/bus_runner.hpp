@@ -45,6 +45,11 @@ class BusRunner final : private RunnerOutput {
   // Outbound items lost because the control plane did not drain in time.
   [[nodiscard]] std::uint64_t dropped_outputs() const noexcept { return dropped_.load(std::memory_order_relaxed); }
 
+  // The snapshots are stored for readers at most this often (0, the default: every cycle). A
+  // snapshot of every axis every cycle is a good part of a large bus' cycle; the daemon's readers
+  // sample them at the DDS status rate. Set before the cycle thread starts.
+  void set_publish_period(Duration period) noexcept { publish_period_ = period; }
+
   // --- Cycle thread ---
   // Returns true when it queued replies, events or parameter replies for the control plane.
   bool cycle(TimePoint now) noexcept;
@@ -76,6 +81,8 @@ class BusRunner final : private RunnerOutput {
   std::unique_ptr<Seqlock<IoSnapshot>[]> io_snapshots_;
   IoSnapshot io_scratch_{};  // filled by the bus each cycle (kept here: it is large for the stack)
   std::uint64_t cycles_ = 0;
+  Duration publish_period_ = Duration::zero();
+  TimePoint next_publish_{};
 
   SpscQueue<Command, 64> commands_;
   SpscQueue<Setpoint, 256> setpoints_;

@@ -54,6 +54,10 @@ Gateway::Gateway(const config::Plan& plan) : name_(plan.gateway.name) {
     }
     slot.bus = make_bus(bp);
     slot.runner = std::make_unique<core::BusRunner>(*slot.bus, slot.specs);
+    // The bridge samples the snapshots at the status rate: stored four times per status period,
+    // a published state is at most a quarter period older than its sample.
+    slot.runner->set_publish_period(std::chrono::duration_cast<core::Duration>(
+        std::chrono::duration<double>(0.25 / plan.gateway.status_rate_hz)));
     slot.first_io = io_.size();
     for (std::size_t k = 0; k < slot.bus->io_count(); ++k) {
       const core::IoInfo i = slot.bus->io_info(k);

@@ -631,3 +631,27 @@ TEST(BusRunner, BusEventsKeepTheirAxis) {
   EXPECT_EQ(emcy[0].stamp_ns, to_ns(TimePoint{1s + 1ms}));
   EXPECT_EQ(emcy[1].axis, kNoAxis);  // no such axis: about the bus
 }
+
+// With a publish period the snapshots are stored at most that often (the daemon's readers sample
+// them at the DDS status rate), and the first cycle's always.
+TEST(BusRunner, SnapshotsAreStoredOncePerPublishPeriod) {
+  FakeBus bus;
+  for (auto& c : bus.ctl) c.fb.valid = true;
+  std::vector<AxisSpec> specs{drivegate::test::linear_axis_spec(), drivegate::test::linear_axis_spec()};
+  specs[1].name = "y";
+  BusRunner runner(bus, specs);
+  runner.set_publish_period(5ms);
+  TimePoint t{1s};
+  runner.cycle(t);
+  EXPECT_EQ(runner.snapshot(1).cycle, 1u);
+  for (int i = 0; i < 4; ++i) {
+    t += 1ms;
+    runner.cycle(t);
+    EXPECT_EQ(runner.snapshot(0).cycle, 1u);
+  }
+  bus.ctl[1].fb.position = 1000;
+  t += 1ms;
+  runner.cycle(t);
+  EXPECT_EQ(runner.snapshot(0).cycle, 6u);
+  EXPECT_EQ(runner.snapshot(1).position, drivegate::test::linear_axis_spec().units.position_to_user(1000));
+}
