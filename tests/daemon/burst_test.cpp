@@ -21,6 +21,7 @@
 #include <fastdds/dds/core/status/SubscriptionMatchedStatus.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/DataReaderListener.hpp>
 
 #include "client/client.hpp"
 #include "drivegate.h"
@@ -40,14 +41,17 @@ constexpr int kCommandsPerClient = 2500;  // 10,000 in all
 constexpr int kParamsPerClient = 2500;    // 10,000 in all
 
 // One client on the raw topics: writes as fast as the writer takes samples (keep-all: write()
-// waits while the gateway's history is full) and counts every reply addressed to it.
-class RawClient {
+// waits while the gateway's history is full) and counts every reply addressed to it. It has no
+// window of its own, so its replies are taken as they arrive (a listener on the readers): with the
+// table's keep-last readers a client that lets more than 1024 of its replies pile up loses the
+// oldest (README "DDS topics"), which a test thread starved on a loaded machine did.
+class RawClient final : private fdds::DataReaderListener {
  public:
   RawClient(const test::DdsIsolation& iso, std::string name) : name_(std::move(name)), node_(options(iso, name_)) {
     cmd_w_ = &node_.writer(msg::TopicId::AxisCommand);
     param_w_ = &node_.writer(msg::TopicId::ParamRequest);
-    reply_r_ = &node_.reader(msg::TopicId::CommandReply);
-    param_r_ = &node_.reader(msg::TopicId::ParamReply);
+    reply_r_ = &node_.reader(msg::TopicId::CommandReply, this, fdds::StatusMask::data_available());
+    param_r_ = &node_.reader(msg::TopicId::ParamReply, this, fdds::StatusMask::data_available());
   }
 
   bool wait_matched(std::chrono::milliseconds timeout) {
@@ -90,8 +94,10 @@ class RawClient {
     }
   }
 
-  // Takes what arrived; true once every command and request has its final reply.
-  bool collect() {
+  // Takes what arrived (the readers' listener: the only caller, so that no other thread takes
+  // from the readers while holding mutex_ as the listener may be called holding a reader's lock).
+  void collect() {
+    const std::lock_guard lock(mutex_);
     msg::CommandReply r;
     fdds::SampleInfo info;
     while (reply_r_->take_next_sample(&r, &info) == ReturnCode_t::RETCODE_OK) {
@@ -111,11 +117,11 @@ class RawClient {
       if (!p.ok() && p.error().rfind("busy", 0) == 0) ++param_busy_;
       else if (!p.ok()) ++param_errors_;
     }
-    return finals_.size() == kCommandsPerClient && param_finals_.size() == kParamsPerClient;
   }
 
   // Exactly one final reply per command and per request, and nothing for ids never sent.
   void expect_exactly_one_each() const {
+    const std::lock_guard lock(mutex_);
     EXPECT_EQ(finals_.size(), static_cast<std::size_t>(kCommandsPerClient)) << name_;
     EXPECT_EQ(param_finals_.size(), static_cast<std::size_t>(kParamsPerClient)) << name_;
     for (const auto& [id, n] : finals_) {
@@ -127,6 +133,7 @@ class RawClient {
   }
 
   void print_missing() const {
+    const std::lock_guard lock(mutex_);
     int shown = 0;
     for (std::uint64_t id = 1; id <= kCommandsPerClient && shown < 10; ++id)
       if (!finals_.count(id)) {
@@ -145,10 +152,18 @@ class RawClient {
   std::uint64_t param_errors_ = 0;  // errors other than "busy"
   std::uint64_t param_busy_ = 0;
   std::uint64_t write_waits_ = 0;
-  std::size_t finals() const { return finals_.size(); }
-  std::size_t param_finals() const { return param_finals_.size(); }
+  std::size_t finals() const {
+    const std::lock_guard lock(mutex_);
+    return finals_.size();
+  }
+  std::size_t param_finals() const {
+    const std::lock_guard lock(mutex_);
+    return param_finals_.size();
+  }
 
  private:
+  void on_data_available(fdds::DataReader* /*reader*/) override { collect(); }
+
   static msg::DdsOptions options(const test::DdsIsolation& iso, const std::string& name) {
     msg::DdsOptions o;
     o.domain = iso.domain;
@@ -162,6 +177,7 @@ class RawClient {
   fdds::DataWriter* param_w_ = nullptr;
   fdds::DataReader* reply_r_ = nullptr;
   fdds::DataReader* param_r_ = nullptr;
+  mutable std::mutex mutex_;  // the readers' listener thread and the test's thread
   std::map<std::uint64_t, int> accepted_;
   std::map<std::uint64_t, int> finals_;
   std::map<std::uint64_t, int> param_finals_;
@@ -197,15 +213,8 @@ TEST(Burst, TenThousandCommandsAndParameterRequestsFromSeveralClientsGetOneReply
 
   const auto start = Clock::now();
   std::vector<std::thread> writers;
-  std::atomic<bool> done{false};
   for (auto& c : clients)
     writers.emplace_back([&c] { c->send_all("burst"); });
-  // Replies are taken while the writers write: a client that reads nothing would hold the gateway.
-  std::vector<std::thread> readers;
-  for (auto& c : clients)
-    readers.emplace_back([&c, &done] {
-      while (!done && !c->collect()) std::this_thread::sleep_for(2ms);
-    });
   for (auto& t : writers) t.join();
   const auto written = Clock::now();
   const auto deadline = written + 120s;
@@ -215,14 +224,11 @@ TEST(Burst, TenThousandCommandsAndParameterRequestsFromSeveralClientsGetOneReply
     for (auto& c : clients) all = all && c->finals() == kCommandsPerClient && c->param_finals() == kParamsPerClient;
     if (!all) std::this_thread::sleep_for(20ms);
   }
-  done = true;
-  for (auto& t : readers) t.join();
   const auto finished = Clock::now();
 
   std::map<std::string, int> statuses;
   std::uint64_t busy = 0, waits = 0, param_errors = 0, param_busy = 0;
   for (auto& c : clients) {
-    c->collect();
     c->expect_exactly_one_each();
     for (const auto& [s, n] : c->by_status_) statuses[s] += n;
     busy += c->busy_;
