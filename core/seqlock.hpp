@@ -1,6 +1,6 @@
 #pragma once
 // Single-writer seqlock for snapshots (DESIGN.md §3): the cycle thread writes an axis or bus
-// snapshot every cycle without waiting; readers on the control plane retry until they get a
+// snapshot (every cycle, or once per BusRunner publish period) without waiting; readers on the control plane retry until they get a
 // consistent copy. T must be trivially copyable; the payload is copied word by word through
 // relaxed atomics so that the concurrent copy is not a data race in the C++ memory model.
 #include <array>
