@@ -68,9 +68,8 @@ void CycleThread::stop() {
 
 bool CycleThread::healthy(core::TimePoint now) const noexcept {
   if (!running()) return false;
-  const std::int64_t last = std::max(timing_.load().last_cycle_ns, started_at_ns_.load(std::memory_order_acquire));
   const std::int64_t allowed = std::max<std::int64_t>(10 * schedule_.period.count(), 100'000'000);
-  return core::to_ns(now) - last <= allowed;
+  return core::to_ns(now) - last_start_ns_.load(std::memory_order_acquire) <= allowed;
 }
 
 std::string CycleThread::scheduling_note() const { return note_; }
@@ -100,7 +99,7 @@ void CycleThread::run() noexcept {
   std::int64_t next = start_ns + period;
   std::int64_t window_start = 0;
   std::uint64_t window_cycles = 0;
-  started_at_ns_.store(start_ns, std::memory_order_release);
+  last_start_ns_.store(start_ns, std::memory_order_release);
   running_.store(true, std::memory_order_release);
   started_.store(true, std::memory_order_release);
   started_.notify_all();
@@ -131,6 +130,7 @@ void CycleThread::run() noexcept {
       snap.cycles = cycle + 1;
       snap.last_cycle_ns = wake;
       timing_.store(snap);
+      last_start_ns_.store(wake, std::memory_order_release);
 
       body_(core::TimePoint{core::Duration{wake}}, cycle);
 

@@ -90,7 +90,10 @@ class CycleThread {
   std::atomic<bool> stop_requested_{false};
   std::atomic<bool> running_{false};
   std::atomic<bool> body_failed_{false};
-  std::atomic<std::int64_t> started_at_ns_{0};
+  // The thread's start, then each cycle's: healthy() reads this one word, never timing_, whose
+  // seqlock would keep a reader waiting for as long as the thread stays stopped inside a store
+  // (preempted, or frozen by a debugger): the supervisor must not hang on the thread it watches.
+  std::atomic<std::int64_t> last_start_ns_{0};
   core::LatencyHistogram window_;    // cycle thread only
   core::LatencyHistogram lifetime_;  // cycle thread only while running
   core::Seqlock<TimingSnapshot> timing_;

@@ -98,12 +98,32 @@ std::size_t NotifySocket::count(const std::string& what) {
 }
 
 bool NotifySocket::wait_for(const std::string& what, std::chrono::milliseconds timeout) {
+  return wait_count(what, 1, timeout);
+}
+
+bool NotifySocket::wait_count(const std::string& what, std::size_t n, std::chrono::milliseconds timeout) {
   std::unique_lock lock(mutex_);
   return arrived_.wait_for(lock, timeout, [&] {
-    for (const auto& m : received_)
-      if (m.find(what) != std::string::npos) return true;
-    return false;
+    std::size_t seen = 0;
+    for (const auto& m : received_) seen += m.find(what) != std::string::npos ? 1U : 0U;
+    return seen >= n;
   });
+}
+
+bool NotifySocket::drain(std::chrono::milliseconds timeout) {
+  std::string marker;
+  {
+    std::lock_guard lock(mutex_);
+    marker = "X_TEST_DRAIN=" + std::to_string(++markers_);
+  }
+  const int fd = socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+  sockaddr_un addr{};
+  addr.sun_family = AF_UNIX;
+  std::strncpy(addr.sun_path, path_.c_str(), sizeof(addr.sun_path) - 1);
+  const bool sent = fd >= 0 && sendto(fd, marker.data(), marker.size(), 0, reinterpret_cast<sockaddr*>(&addr),
+                                      sizeof addr) == static_cast<ssize_t>(marker.size());
+  if (fd >= 0) close(fd);
+  return sent && wait_for(marker, timeout);
 }
 
 DaemonProcess::DaemonProcess(const std::string& config, const std::string& notify_socket, const std::string& log_level,

@@ -41,8 +41,13 @@ class NotifySocket {
   [[nodiscard]] const std::string& path() const { return path_; }
   // Waits until a datagram containing `what` (e.g. "READY=1") has arrived.
   bool wait_for(const std::string& what, std::chrono::milliseconds timeout);
+  // Waits until `n` datagrams containing `what` have arrived.
+  bool wait_count(const std::string& what, std::size_t n, std::chrono::milliseconds timeout);
   // How many datagrams containing `what` have arrived so far.
   std::size_t count(const std::string& what);
+  // Waits until every datagram sent to the socket before this call has been read (a marker sent
+  // now comes back after them: the socket queues in order), so that count() includes them.
+  bool drain(std::chrono::milliseconds timeout);
 
  private:
   void read_loop();
@@ -52,6 +57,7 @@ class NotifySocket {
   std::condition_variable arrived_;
   std::vector<std::string> received_;
   bool stop_ = false;
+  std::size_t markers_ = 0;
   std::thread reader_;
 };
 

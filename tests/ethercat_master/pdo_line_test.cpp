@@ -188,5 +188,41 @@ TEST(PdoLine, PerSlaveDatagramsTellWhichSlaveIsMissing) {
   EXPECT_EQ(cx.counters().al_checks, 0U);
 }
 
+// An AL status check whose answer comes a cycle late (a loaded machine, a slow line) is not
+// taken for its slave's status: until it is back, each slave's record is the check before it,
+// cycle and status together. A record with the new cycle and the old check's SAFE-OP made the
+// bus take a slave that had just gone to OP for one that left it.
+TEST(PdoLine, AnAlCheckInFlightLeavesTheLastAnsweredOne) {
+  Bring b;
+  b.configure();
+  if (HasFatalFailure()) return;
+  CyclicExchange cx(b.img);
+  b.go(AlState::SafeOp, cx);
+  if (HasFatalFailure()) return;
+  b.cycles(cx, 3);  // every slave checked in SAFE-OP
+  for (std::size_t k = 0; k < 3; ++k) {
+    EXPECT_TRUE(cx.al_check(k).answered) << k;
+    EXPECT_EQ(cx.al_check(k).status().state(), AlState::SafeOp) << k;
+  }
+  b.go(AlState::Op, cx);
+  if (HasFatalFailure()) return;
+
+  // This cycle's frame is queued, not yet back.
+  ASSERT_TRUE(cx.queue(b.t.tx));
+  const std::uint64_t in_flight = cx.counters().cycles;
+  for (std::size_t k = 0; k < 3; ++k) EXPECT_LT(cx.al_check(k).cycle, in_flight) << k;
+
+  b.t.cycle();  // the frame passes the line and comes back
+  std::size_t checked = 0;
+  for (std::size_t k = 0; k < 3; ++k) {
+    const SlaveAlCheck& c = cx.al_check(k);
+    if (c.cycle != in_flight) continue;
+    ++checked;
+    EXPECT_TRUE(c.answered) << k;
+    EXPECT_EQ(c.status().state(), AlState::Op) << k;
+  }
+  EXPECT_EQ(checked, 1U);  // one slave per cycle, round robin
+}
+
 }  // namespace
 }  // namespace drivegate::ethercat

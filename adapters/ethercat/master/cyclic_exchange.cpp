@@ -58,7 +58,7 @@ bool CyclicExchange::queue(Transactions& tx) noexcept {
     if (tx.queue(this, make_tag(cycle_, kAlItem | static_cast<std::uint32_t>(k)), Command::FPRD,
                  physical_address(image_.slave(k).station, reg::kAlStatus), 2)) {
       ++slot.expected;
-      al_[k].cycle = cycle_;
+      al_queued_[k] = cycle_;
     } else {
       ++counters_.refused;
       all = false;
@@ -112,8 +112,9 @@ void CyclicExchange::on_result(std::uint32_t tag, const DatagramAnswer& answer) 
   const bool back = answer.outcome == DatagramOutcome::Answered;
   if ((item & kAlItem) != 0) {
     const std::size_t k = item & ~kAlItem;
-    if (k < kMax && al_[k].cycle == slot->cycle) {
+    if (k < kMax && al_queued_[k] == slot->cycle) {
       ++counters_.al_checks;
+      al_[k].cycle = slot->cycle;
       al_[k].answered = back && answer.wkc == 1 && answer.data.size() >= 2;
       al_[k].raw = al_[k].answered ? static_cast<std::uint16_t>(answer.data[0] | (answer.data[1] << 8)) : 0;
       if (!al_[k].healthy()) ++counters_.al_missing;

@@ -57,9 +57,12 @@ struct CyclicCounters {
 enum class SlaveAnswer : std::uint8_t { Unknown, Answered, Missing };
 std::string_view to_string(SlaveAnswer a) noexcept;
 
-// The last AL status check of one slave.
+// The last AL status check of one slave that came back (or was lost). A check still in flight
+// leaves the one before it here: the cycle and the status always belong to the same check (a
+// cycle of the new one with the status of the old one took a slave just gone to OP for one that
+// left it, when its answer came a cycle late).
 struct SlaveAlCheck {
-  std::uint64_t cycle = 0;     // cycle it was queued in (0: never)
+  std::uint64_t cycle = 0;     // cycle it was queued in (0: none came back yet)
   bool answered = false;       // WKC 1
   std::uint16_t raw = 0;       // 0130h as read
   [[nodiscard]] AlStatus status() const noexcept { return decode_al_status(raw); }
@@ -120,6 +123,7 @@ class CyclicExchange final : public DatagramOwner {
   std::array<std::uint64_t, kMax> slave_good_cycle_{};  // PerSlave: last cycle a datagram of it was right
   std::array<std::uint64_t, kMax> slave_bad_cycle_{};   // PerSlave: last cycle a datagram of it was wrong or lost
   std::array<SlaveAlCheck, kMax> al_{};
+  std::array<std::uint64_t, kMax> al_queued_{};  // cycle of each slave's check in flight
   std::array<CycleSlot, kRing> ring_{};
   std::uint64_t cycle_ = 0;
   std::uint64_t last_completed_ = 0;
