@@ -4,6 +4,7 @@
 #include <array>
 #include <cstdio>
 #include <optional>
+#include <span>
 #include <sstream>
 
 #include "adapters/profinet/sim/generic_io_persona.hpp"
@@ -249,8 +250,8 @@ std::string PnConsole::alarm(const Target& t, const std::string& id, const std::
 }
 
 std::string PnConsole::io(const Target& t, const std::string& id, const std::vector<std::string>& args) {
-  GenericIoPersona* io = t.station->io;
-  if (io == nullptr) return "error: " + id + " (" + t.station->persona + ") is not a generic IO device";
+  GenericIoPersona* dev = t.station->io;
+  if (dev == nullptr) return "error: " + id + " (" + t.station->persona + ") is not a generic IO device";
   if (args.size() < 2) return "error: io takes STATION SLOT[:SUBSLOT] [BYTE...]";
   std::optional<std::uint16_t> slot;
   std::optional<std::uint16_t> subslot;
@@ -264,7 +265,7 @@ std::string PnConsole::io(const Target& t, const std::string& id, const std::vec
   const std::uint16_t ss = p.submodule->subslot;
   const std::string where = std::to_string(s) + ":" + std::to_string(ss);
   if (args.size() > 2) {
-    const std::size_t inputs = io->input(api, s, ss).size();
+    const std::size_t inputs = dev->input(api, s, ss).size();
     if (inputs == 0) return "error: io: " + id + " " + where + " has no inputs to set";
     if (args.size() - 2 != inputs) {
       return "error: io: " + id + " " + where + " takes " + std::to_string(inputs) + " input bytes, not " +
@@ -276,10 +277,10 @@ std::string PnConsole::io(const Target& t, const std::string& id, const std::vec
       if (!v) return "error: io: \"" + args[i] + "\" is not a byte (0..255 or 0x00..0xFF)";
       values.push_back(static_cast<std::uint8_t>(*v));
     }
-    (void)io->set_input(api, s, ss, values);  // the length is checked above
+    (void)dev->set_input(api, s, ss, values);  // the length is checked above
   }
-  return std::string(args.size() > 2 ? "ok " : "") + "io " + id + " " + where + " out=" + hex_word(io->output(api, s, ss)) +
-         " out-state=" + std::string(to_string(io->outputs(api, s, ss))) + " in=" + hex_word(io->input(api, s, ss));
+  return std::string(args.size() > 2 ? "ok " : "") + "io " + id + " " + where + " out=" + hex_word(dev->output(api, s, ss)) +
+         " out-state=" + std::string(to_string(dev->outputs(api, s, ss))) + " in=" + hex_word(dev->input(api, s, ss));
 }
 
 std::string PnConsole::status_items() const {
