@@ -99,10 +99,12 @@ TEST_F(ProfinetE2e, IoDeviceBytesGoBothWays) {
   EXPECT_EQ(v->inputs, (std::vector<std::uint8_t>{0x00, 0x00}));
   EXPECT_EQ(v->outputs, (std::vector<std::uint8_t>{0x00, 0x00}));
   std::string last;
+  // Until slot 2's answer at the simulator is `answer`.
+  const auto outputs_become = [&](const std::string& answer) {
+    return wait_sim("io io-block 2", [&](const std::string& a) { return a == answer; }, 5s, last);
+  };
   // The outputs are valid from the first frames in data exchange on (the controller's IOPS good).
-  ASSERT_TRUE(wait_sim("io io-block 2", [](const std::string& a) { return a == "io pn0:io-block 2:1 out=0000 out-state=valid in=-"; },
-                       5s, last))
-      << last << diagnostics();
+  ASSERT_TRUE(outputs_become("io pn0:io-block 2:1 out=0000 out-state=valid in=-")) << last << diagnostics();
   EXPECT_EQ(sim("io io-block 1"), "io pn0:io-block 1:1 out=- out-state=valid in=0000");
 
   client::IoWriteRequest w;
@@ -111,9 +113,7 @@ TEST_F(ProfinetE2e, IoDeviceBytesGoBothWays) {
   w.data = {0xC3};
   const auto r = client_->io_write(w, 10s);
   ASSERT_TRUE(r.ok) << r.status << ": " << r.error << diagnostics();
-  ASSERT_TRUE(wait_sim("io io-block 2", [](const std::string& a) { return a == "io pn0:io-block 2:1 out=00C3 out-state=valid in=-"; },
-                       5s, last))
-      << last << diagnostics();
+  ASSERT_TRUE(outputs_become("io pn0:io-block 2:1 out=00C3 out-state=valid in=-")) << last << diagnostics();
   EXPECT_TRUE(client_->wait_until([&] {
     const auto s = valves();
     return s && s->outputs == std::vector<std::uint8_t>{0x00, 0xC3};
@@ -129,9 +129,7 @@ TEST_F(ProfinetE2e, IoDeviceBytesGoBothWays) {
   w.offset = 0;
   w.data = {0x11, 0x22};
   ASSERT_TRUE(client_->io_write(w, 10s).ok) << diagnostics();
-  EXPECT_TRUE(wait_sim("io io-block 2", [](const std::string& a) { return a == "io pn0:io-block 2:1 out=1122 out-state=valid in=-"; },
-                       5s, last))
-      << last;
+  EXPECT_TRUE(outputs_become("io pn0:io-block 2:1 out=1122 out-state=valid in=-")) << last;
   w.data = {0x01, 0x02, 0x03};
   const auto refused = client_->io_write(w, 10s);
   EXPECT_FALSE(refused.ok);
