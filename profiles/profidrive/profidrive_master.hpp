@@ -173,6 +173,9 @@ class ProfidriveMaster final : public core::AxisController {
   Actuals actual_{};
   core::TimePoint fresh_at_{};
   std::uint64_t telegrams_ = 0;  // fresh actual telegrams decoded
+  // A fault reset keeps STW1 bit 7 low until telegrams_ reaches this (the drive saw it low), then
+  // high until the drive leaves its fault.
+  std::uint64_t acknowledge_from_ = 0;
   DriveState state_{};
   bool warning_ = false;
   bool control_requested_ = true;  // ZSW1 bit 9 as last seen
