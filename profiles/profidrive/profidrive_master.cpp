@@ -223,6 +223,9 @@ Admission ProfidriveMaster::submit(const core::DriveCommand& cmd, core::TimePoin
       }
       device_slot_.abort(cmd, sink);
       start_device(DeviceGoal::FaultReset, cmd, now);
+      // Bit 7 already high: low first, for long enough that an output frame carried it and the
+      // drive took it (three more actual telegrams: two whole update times after this word).
+      acknowledge_from_ = (stw1_ & stw1::kFaultAcknowledge) != 0 ? telegrams_ + 3 : telegrams_;
       return Admission::accept();
 
     case CommandKind::Halt:

@@ -176,6 +176,9 @@ class ProfidriveMaster final : public core::AxisController {
   std::uint64_t telegrams_ = 0;  // fresh actual telegrams decoded
   PositionVelocity derived_velocity_;  // from XIST_A, where the telegram carries no NIST_A
   std::int32_t velocity_ = 0;          // native units, from NIST_A or derived
+  // A fault reset keeps STW1 bit 7 low until telegrams_ reaches this (the drive saw it low), then
+  // high until the drive leaves its fault.
+  std::uint64_t acknowledge_from_ = 0;
   DriveState state_{};
   bool warning_ = false;
   bool control_requested_ = true;  // ZSW1 bit 9 as last seen

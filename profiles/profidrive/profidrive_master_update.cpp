@@ -192,7 +192,7 @@ void ProfidriveMaster::run_device(core::TimePoint now, core::ControllerSink& sin
       break;
     case DeviceGoal::FaultReset:
       // A 0->1 edge on bit 7 with bits 0..3 low; the AKD lands in S1 [§8.1, §18.2, §25.17].
-      device_stw1_ = fault_reset_stw1(stw1_);
+      device_stw1_ = fault_reset_stw1(telegrams_ >= acknowledge_from_);
       done = !in_fault(state_.state) && state_.state != AxisState::Unknown;
       step = "fault acknowledge (STW1 bit 7 edge) to S1";
       hold_stw1_ = stw1_word::kQuickStop;

@@ -55,11 +55,12 @@ struct EnableStep {
 // the drive gets there).
 EnableStep enable_step(DriveState current, std::uint16_t last_stw1, std::uint16_t mode_bits = 0) noexcept;
 
-// A fault reset on its own (no enable): 0x0400 while the last word still has bit 7, then 0x0480,
-// the 0->1 edge with bits 0..3 low, so the drive lands in S1 and stays there [§8.1, §18.2].
-constexpr std::uint16_t fault_reset_stw1(std::uint16_t last_stw1) noexcept {
-  return (last_stw1 & stw1::kFaultAcknowledge) != 0 ? stw1_word::kIdle
-                                                     : static_cast<std::uint16_t>(stw1_word::kIdle | stw1::kFaultAcknowledge);
+// A fault reset on its own (no enable): 0x0400 while bit 7 must be seen low first (the last word
+// had it), then 0x0480, the 0->1 edge with bits 0..3 low, so the drive lands in S1 and stays there
+// [§8.1, §18.2]. Each level is held for telegrams, not toggled per cycle: the drive takes STW1 once
+// per update time, which spans several controller cycles.
+constexpr std::uint16_t fault_reset_stw1(bool acknowledge) noexcept {
+  return acknowledge ? static_cast<std::uint16_t>(stw1_word::kIdle | stw1::kFaultAcknowledge) : stw1_word::kIdle;
 }
 
 }  // namespace drivegate::profidrive

@@ -92,13 +92,13 @@ std::string SimProcess::command(const std::string& line, std::chrono::millisecon
   return next_line(timeout).value_or("");
 }
 
-bool SimProcess::wait_status(const std::function<bool(const std::string&)>& done, std::chrono::milliseconds timeout,
-                             std::string& last) {
+bool SimProcess::wait_answer(const std::string& line, const std::function<bool(const std::string&)>& done,
+                             std::chrono::milliseconds timeout, std::string& last) {
   for (const auto end = Clock::now() + timeout;;) {
-    last = command("status");
+    last = command(line, std::chrono::seconds(5));
     if (done(last)) return true;
     if (Clock::now() >= end) return false;
-    ::poll(nullptr, 0, 20);  // the pace of the status requests; each answer is the condition
+    ::poll(nullptr, 0, 20);  // the pace of the requests; each answer is the condition
   }
 }
 

@@ -36,10 +36,15 @@ class SimProcess {
   std::optional<std::string> wait_ready(std::chrono::milliseconds timeout);
   // Sends one command line and returns the simulator's answer ("" when none came in time).
   std::string command(const std::string& line, std::chrono::milliseconds timeout = std::chrono::seconds(2));
-  // Asks for `status` until `done(status line)` holds or the timeout passes; true when it held.
-  // The last answer is left in `last`.
+  // Sends `line` until `done(answer)` holds or the timeout passes (an answer may take 5 s); true
+  // when it held. The last answer is left in `last`.
+  bool wait_answer(const std::string& line, const std::function<bool(const std::string&)>& done,
+                   std::chrono::milliseconds timeout, std::string& last);
+  // wait_answer for `status`.
   bool wait_status(const std::function<bool(const std::string&)>& done, std::chrono::milliseconds timeout,
-                   std::string& last);
+                   std::string& last) {
+    return wait_answer("status", done, timeout, last);
+  }
   [[nodiscard]] std::string log() const;
   [[nodiscard]] pid_t pid() const { return pid_; }
 

@@ -4,7 +4,6 @@
 
 #include <filesystem>
 #include <sstream>
-#include <thread>
 
 namespace drivegate::test {
 
@@ -124,12 +123,7 @@ std::string EthercatE2e::sim(const std::string& command) { return sim_->command(
 
 bool EthercatE2e::wait_sim(const std::string& command, const std::function<bool(const std::string&)>& done,
                            std::chrono::milliseconds timeout, std::string& last) {
-  for (const auto end = std::chrono::steady_clock::now() + timeout;;) {
-    last = sim(command);
-    if (done(last)) return true;
-    if (std::chrono::steady_clock::now() >= end) return false;
-    std::this_thread::sleep_for(20ms);  // the pace of the console requests; each answer is the condition
-  }
+  return sim_->wait_answer(command, done, timeout, last);
 }
 
 std::string EthercatE2e::field(const std::string& answer, const std::string& key) {

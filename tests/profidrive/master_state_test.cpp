@@ -140,6 +140,29 @@ TEST(ProfidriveMaster, FaultFailsCommandsReadsTheBufferAndResetLandsInS1) {
   EXPECT_EQ(h.drive.state, State::S4);
 }
 
+// Over PROFINET the drive takes STW1 once per update time (16 controller cycles here), whatever
+// the cycle a fault reset starts in: bit 7 is held high until the drive leaves its fault, not
+// toggled every cycle (toggled, every frame of an even reduction ratio carried the same level, and
+// in half the phases the drive never saw the edge).
+TEST(ProfidriveMaster, FaultResetHoldsTheAcknowledgeForADriveThatTakesStw1OncePerUpdateTime) {
+  for (int phase = 0; phase < 16; ++phase) {
+    Harness h(1);
+    h.enable();
+    h.drive.raise_fault({501});
+    ASSERT_TRUE(h.run_until([&] { return h.sink.count(EventKind::Fault) == 1; }, 100));
+    ASSERT_TRUE(h.submit(command(2, CommandKind::FaultReset)).accepted);
+    for (int i = 0; i < 3000 && !h.finished(2); ++i) {
+      const bool takes = (i + phase) % 16 == 0;
+      if (takes) h.drive.step();
+      h.drive.fresh = takes;
+      h.master.update(h.now, h.sink);
+      h.now += 1ms;
+    }
+    EXPECT_TRUE(h.sink.done(2)) << "phase " << phase << ": " << h.sink.failure(2);
+    EXPECT_EQ(h.drive.state, State::S1) << "phase " << phase;
+  }
+}
+
 TEST(ProfidriveMaster, FaultResetTimesOutWhileTheCauseStays) {
   MasterSettings s;
   s.step_timeout = 40ms;

@@ -162,12 +162,11 @@ TEST(ProfidriveState, FaultAcknowledgeEdgeThenS1ThenOnAgain) {
 }
 
 TEST(ProfidriveState, FaultResetAloneStaysInS1) {
-  EXPECT_EQ(fault_reset_stw1(0x047F), 0x0480);
-  EXPECT_EQ(fault_reset_stw1(0x0480), 0x0400);  // no edge possible: drop bit 7 first
-  EXPECT_EQ(fault_reset_stw1(0x0400), 0x0480);
+  EXPECT_EQ(fault_reset_stw1(true), 0x0480);
+  EXPECT_EQ(fault_reset_stw1(false), 0x0400);  // bit 7 low first when the last word had it
   // Bits 0..3 low: after the acknowledge the drive stays in S1 (S1 -> S2 needs bits 1 and 2).
-  EXPECT_EQ(fault_reset_stw1(0x0400) & stw1::kStateMask, 0);
-  EXPECT_NE(fault_reset_stw1(0x0400) & stw1::kControlByPlc, 0);
+  EXPECT_EQ(fault_reset_stw1(true) & stw1::kStateMask, 0);
+  EXPECT_NE(fault_reset_stw1(true) & stw1::kControlByPlc, 0);
 }
 
 TEST(ProfidriveState, EnableWaitsForAStopToFinish) {

@@ -8,12 +8,15 @@
 //
 // Set-up waits until the gateway has found the stations by name, given them their addresses and
 // connected them: both axes operational and disabled, the IO device's data valid. Skipped without
-// root.
+// root. The tests: e2e_test.cpp (bring-up, motion, power loss, records), faults_test.cpp (a drive
+// fault, a killed gateway, the IO device's bytes).
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <sstream>
+#include <string>
 
 #include "tests/canopen_e2e/sim_process.hpp"
 #include "tests/daemon/daemon_process.hpp"
@@ -106,6 +109,32 @@ class ProfinetE2e : public E2eClientTest {
     }, kStartUp)) << diagnostics();
   }
 
+  // enable, with the final reply and the published state checked.
+  void enable(const std::string& axis) {
+    const auto r = send(axis, "enable");
+    ASSERT_EQ(r.outcome, client::Outcome::Completed) << axis << ": " << r.reason << diagnostics();
+    ASSERT_TRUE(wait_axis(axis, [](const client::AxisState& s) { return s.state == "operation_enabled"; }, 5s))
+        << axis << diagnostics();
+  }
+
+  // One simulator console command, its answer.
+  std::string sim(const std::string& command) { return sim_->command(command, 5s); }
+  // Sends `command` until `done(answer)` holds; the last answer in `last`.
+  bool wait_sim(const std::string& command, const std::function<bool(const std::string&)>& done,
+                std::chrono::milliseconds timeout, std::string& last) {
+    return sim_->wait_answer(command, done, timeout, last);
+  }
+  // The `key=` field of `station`'s item in a `status` answer (pn_console.hpp), "" when missing.
+  static std::string station_field(const std::string& status, const std::string& station, const std::string& key) {
+    const auto at = status.find(" pn0:" + station + " ");
+    if (at == std::string::npos) return {};
+    const std::string item = status.substr(at, status.find(';', at) - at);
+    const auto k = item.find(" " + key + "=");
+    if (k == std::string::npos) return {};
+    const auto from = k + key.size() + 2;
+    return item.substr(from, item.find(' ', from) - from);
+  }
+
   void TearDown() override {
     client_.reset();
     daemon_.reset();
@@ -126,9 +155,14 @@ class ProfinetE2e : public E2eClientTest {
     if (client_) {
       d << "\n--- axes:";
       for (const auto& s : client_->states())
-        d << "\n  " << s.axis << ": link " << s.link << ", " << s.state << ", mode " << s.mode << ", velocity " << s.velocity;
+        d << "\n  " << s.axis << ": link " << s.link << ", " << s.state << ", mode " << s.mode << ", velocity " << s.velocity
+          << ", fault " << s.fault_code << " " << s.fault_text;
+      if (const auto v = client_->io_state("valves")) d << "\n--- valves: valid " << v->valid;
     }
-    if (sim_) d << "\n--- simulator: " << sim_->command("status") << "\n" << tail(sim_->log(), 20);
+    if (sim_) {
+      d << "\n--- simulator: " << sim_->command("status") << "\n  " << sim_->command("io io-block 1") << "\n  "
+        << sim_->command("io io-block 2") << "\n" << tail(sim_->log(), 20);
+    }
     if (daemon_) d << "\n--- drivegated (end of log):\n" << tail(daemon_->log(), 60);
     return d.str();
   }

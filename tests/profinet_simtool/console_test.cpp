@@ -1,7 +1,7 @@
 // The PROFINET fault console (PnConsole) on the network of a config, against the controller's
 // engines in memory on virtual time (tests/profinet_sim/sim_bench.hpp): alarms reaching the
 // controller's AlarmChannel with their text, power loss and return, reboot, AR abort, frame loss,
-// a drive fault, `status`, and every refusal with its answer.
+// a drive fault, a generic device's IO bytes (`io`), `status`, and every refusal with its answer.
 #include <gtest/gtest.h>
 
 #include "adapters/profinet/sim/pn_console.hpp"
@@ -203,6 +203,55 @@ TEST_F(PnConsoleTest, RebootAbortLossAndDriveFault) {
   EXPECT_EQ(console_.matches("pn0:akd-x"), 1U);
   EXPECT_EQ(console_.matches("pn1:akd-x"), 0U);
   EXPECT_EQ(console_.matches("3"), 0U);
+}
+
+// `io`: the IO device's submodules as the controller's AR exchanges them, outputs seen and inputs
+// set from the console (never looped back), and every refusal.
+TEST_F(PnConsoleTest, IoShowsTheOutputsAndSetsTheInputsOfAGenericDevice) {
+  assign_addresses();
+  // Without an AR: nothing received yet, the inputs as at power-on.
+  EXPECT_EQ(cmd("io io-block 1"), "io pn0:io-block 1:1 out=- out-state=lost in=0000");
+  EXPECT_EQ(cmd("io pn0:io-block 2:1"), "io pn0:io-block 2:1 out=00 out-state=lost in=-");
+  EXPECT_EQ(cmd("io io-block 1:1 0x12 52"), "ok io pn0:io-block 1:1 out=- out-state=lost in=1234");
+
+  // The panel of pn_config(): the DAP, 2 input octets in slot 1, 1 output octet in slot 2.
+  constexpr MacAddress kIoBlock{0x02, 0x50, 0x4E, 0x00, 0x00, 0x03};
+  ArPlan plan({{0, 0, 0x100, 1, 1, IoKind::NoIo, 0, 0},
+               {0, 1, 0x210, 1, 0x11, IoKind::Input, 2, 0},
+               {0, 2, 0x220, 1, 0x12, IoKind::Output, 0, 1}},
+              0xC0A80014, kIoBlock, 1);
+  SimBench::Ar& ar = bench_.add_ar(plan);
+  bench_.start(ar);
+  ASSERT_TRUE(bench_.run_until([&] { return ar.cm->state() == CmClientState::DataExchange; }, 5s)) << ar.cm->reason();
+  plan.provider->data(plan.index(2))[0] = 0xC3;
+  bench_.run_for(100ms);
+  EXPECT_EQ(cmd("io io-block 2"), "io pn0:io-block 2:1 out=C3 out-state=valid in=-");
+  const auto in = plan.consumer->data(plan.index(1));
+  EXPECT_EQ(Bytes(in.begin(), in.end()), (Bytes{0x12, 0x34}));
+  EXPECT_EQ(cmd("io io-block 1 0xA5 0x5A"), "ok io pn0:io-block 1:1 out=- out-state=valid in=A55A");
+  bench_.run_for(100ms);
+  const auto in2 = plan.consumer->data(plan.index(1));
+  EXPECT_EQ(Bytes(in2.begin(), in2.end()), (Bytes{0xA5, 0x5A}));
+  EXPECT_EQ(cmd("io io-block 0"), "io pn0:io-block 0:1 out=- out-state=valid in=-");  // the DAP
+
+  // Refusals, the device's data unchanged.
+  EXPECT_EQ(cmd("io"), "error: io takes a STATION (" + std::string(PnConsole::kCommands) + ")");
+  EXPECT_EQ(cmd("io nosuch 1"), "error: no simulated PROFINET station nosuch");
+  EXPECT_EQ(cmd("io akd-x 1"), "error: pn0:akd-x (kollmorgen-akd-profinet) is not a generic IO device");
+  EXPECT_EQ(cmd("io io-block"), "error: io takes STATION SLOT[:SUBSLOT] [BYTE...]");
+  EXPECT_EQ(cmd("io io-block one"), "error: io: \"one\" is not SLOT or SLOT:SUBSLOT");
+  EXPECT_EQ(cmd("io io-block 1:"), "error: io: \"1:\" is not SLOT or SLOT:SUBSLOT");
+  EXPECT_EQ(cmd("io io-block 3"), "error: pn0:io-block has no submodule 3");
+  EXPECT_EQ(cmd("io io-block 1:2"), "error: pn0:io-block has no submodule 1:2");
+  EXPECT_EQ(cmd("io io-block 1 1"), "error: io: pn0:io-block 1:1 takes 2 input bytes, not 1");
+  EXPECT_EQ(cmd("io io-block 1 1 2 3"), "error: io: pn0:io-block 1:1 takes 2 input bytes, not 3");
+  EXPECT_EQ(cmd("io io-block 2 1"), "error: io: pn0:io-block 2:1 has no inputs to set");
+  EXPECT_EQ(cmd("io io-block 1 1 0x100"), "error: io: \"0x100\" is not a byte (0..255 or 0x00..0xFF)");
+  EXPECT_EQ(cmd("io io-block 1 1 -1"), "error: io: \"-1\" is not a byte (0..255 or 0x00..0xFF)");
+  EXPECT_EQ(cmd("io io-block 1 zz 1"), "error: io: \"zz\" is not a byte (0..255 or 0x00..0xFF)");
+  EXPECT_EQ(cmd("io io-block 1"), "io pn0:io-block 1:1 out=- out-state=valid in=A55A");
+  EXPECT_EQ(cmd("power-off io-block"), "ok power-off pn0:io-block");
+  EXPECT_EQ(cmd("io io-block 1"), "error: pn0:io-block is off (power-on io-block)");
 }
 
 }  // namespace

@@ -99,6 +99,9 @@ TEST_F(PnSimProcess, TheControllerFindsTheStationsByNameAndGivesThemTheirAddress
   EXPECT_EQ(item(sim_->command("status"), "akd-x"),
             "pn0:akd-x kollmorgen-akd-profinet name=akd-x mac=02:50:4e:00:00:01 ip=0.0.0.0 ar=NoAr cycles=0 watchdog=0 "
             "alarm-cr=0 rx-lost=0 tx-lost=0 alarms=-");
+  // io goes to the PROFINET console, also naming no station when no EtherCAT line is simulated.
+  EXPECT_EQ(sim_->command("io io-block 1"), "io pn0:io-block 1:1 out=- out-state=lost in=0000");
+  EXPECT_EQ(sim_->command("io nosuch 1"), "error: no simulated PROFINET station nosuch");
 
   const config::Plan plan = plan_of(pn_config(veth_->a()));
   DcpClient& dcp = controller_->dcp;

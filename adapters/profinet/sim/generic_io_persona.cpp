@@ -94,6 +94,11 @@ bool GenericIoPersona::set_input(std::uint32_t api, std::uint16_t slot, std::uin
   return true;
 }
 
+std::span<const std::uint8_t> GenericIoPersona::input(std::uint32_t api, std::uint16_t slot, std::uint16_t subslot) const noexcept {
+  const Data* d = find(api, slot, subslot);
+  return d == nullptr ? std::span<const std::uint8_t>{} : std::span<const std::uint8_t>(d->input);
+}
+
 std::span<const std::uint8_t> GenericIoPersona::output(std::uint32_t api, std::uint16_t slot, std::uint16_t subslot) const noexcept {
   const Data* d = find(api, slot, subslot);
   return d == nullptr ? std::span<const std::uint8_t>{} : std::span<const std::uint8_t>(d->output);

@@ -50,8 +50,10 @@ class GenericIoPersona final : public PnPersona {
   void power_cycle() noexcept override;
 
   // The input data a submodule sends from the next cycle on (false: no such submodule or another
-  // length); the last output data it received and what it was worth then.
+  // length), and what it sends now (empty: no such submodule); the last output data it received and
+  // what it was worth then.
   bool set_input(std::uint32_t api, std::uint16_t slot, std::uint16_t subslot, std::span<const std::uint8_t> data) noexcept;
+  [[nodiscard]] std::span<const std::uint8_t> input(std::uint32_t api, std::uint16_t slot, std::uint16_t subslot) const noexcept;
   [[nodiscard]] std::span<const std::uint8_t> output(std::uint32_t api, std::uint16_t slot, std::uint16_t subslot) const noexcept;
   [[nodiscard]] PnOutputs outputs(std::uint32_t api, std::uint16_t slot, std::uint16_t subslot) const noexcept;
 

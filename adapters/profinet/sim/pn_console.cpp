@@ -4,9 +4,12 @@
 #include <array>
 #include <cstdio>
 #include <optional>
+#include <span>
 #include <sstream>
 
+#include "adapters/profinet/sim/generic_io_persona.hpp"
 #include "config/scalars.hpp"
+#include "core/param_value.hpp"
 
 namespace drivegate::profinet {
 
@@ -32,6 +35,35 @@ std::string ip_text(std::uint32_t ip) {
 
 std::string name_of(const BuiltPnNetwork& n, const PnSimStation& s) { return n.bus() + ":" + s.name; }
 
+// SLOT or SLOT:SUBSLOT as the console takes it; false when `text` is neither.
+bool parse_place(std::string_view text, std::optional<std::uint16_t>& slot, std::optional<std::uint16_t>& subslot) {
+  const auto colon = text.find(':');
+  const auto s = number(text.substr(0, colon), 0, 0x7FFF);
+  const auto ss = colon == std::string_view::npos ? std::optional<std::uint32_t>{} : number(text.substr(colon + 1), 1, 0xFFFF);
+  if (!s || (colon != std::string_view::npos && !ss)) return false;
+  slot = static_cast<std::uint16_t>(*s);
+  if (ss) subslot = static_cast<std::uint16_t>(*ss);
+  return true;
+}
+
+// Bytes as one word of hex digits ("00C3"), "-" for none.
+std::string hex_word(std::span<const std::uint8_t> bytes) {
+  if (bytes.empty()) return "-";
+  std::string s = core::hex_bytes(bytes);
+  std::erase(s, ' ');
+  return s;
+}
+
+std::string_view to_string(PnOutputs o) noexcept {
+  switch (o) {
+    case PnOutputs::NotYet: return "not-yet";
+    case PnOutputs::Valid: return "valid";
+    case PnOutputs::Stop: return "stop";
+    case PnOutputs::Lost: return "lost";
+  }
+  return "unknown";
+}
+
 // The alarm kinds of the console [IEC 61158-6-10, AlarmType; process alarms go high, the others
 // low priority].
 struct AlarmKind {
@@ -52,13 +84,13 @@ constexpr std::array<AlarmKind, 6> kAlarmKinds{{
 // ChannelErrorType 0009h "error" [IEC 61158-6-10, ChannelErrorType].
 constexpr std::uint16_t kDefaultChannelError = 0x0009;
 
-// Where an alarm goes: the slot and subslot the console names (or the first one with IO data),
-// with the idents plugged there.
-struct AlarmPlace {
+// The submodule a command names: the slot and subslot given (a slot alone: its first submodule;
+// neither: the first one with IO data), with the idents plugged there.
+struct Place {
   const CmModelSlot* slot = nullptr;
   const CmModelSubmodule* submodule = nullptr;
 };
-AlarmPlace place(PnPersona& persona, std::optional<std::uint16_t> slot, std::optional<std::uint16_t> subslot) {
+Place place(PnPersona& persona, std::optional<std::uint16_t> slot, std::optional<std::uint16_t> subslot) {
   for (const CmModelSlot& s : persona.slots()) {
     if (slot && s.slot != *slot) continue;
     for (const CmModelSubmodule& m : s.submodules) {
@@ -74,7 +106,7 @@ AlarmPlace place(PnPersona& persona, std::optional<std::uint16_t> slot, std::opt
 
 bool PnConsole::handles(std::string_view verb) noexcept {
   for (const std::string_view v :
-       {"power-off", "power-on", "reboot", "abort-ar", "lose", "drive-fault", "alarm", "status"}) {
+       {"power-off", "power-on", "reboot", "abort-ar", "lose", "drive-fault", "alarm", "io", "status"}) {
     if (verb == v) return true;
   }
   return false;
@@ -129,6 +161,7 @@ std::string PnConsole::command(std::string_view line, core::TimePoint now) {
   const std::string id = name_of(*t.network, *t.station);
   const std::size_t want = verb == "lose" ? 3 : verb == "drive-fault" ? 2 : 1;
   if (verb == "alarm") return alarm(t, id, args);
+  if (verb == "io") return io(t, id, args);
   if (args.size() != want) {
     if (verb == "lose") return "error: lose takes STATION rx|tx N (N frames, 1..1000000)";
     if (verb == "drive-fault") return "error: drive-fault takes STATION NUMBER (an AKD fault number 1..65535)";
@@ -175,14 +208,8 @@ std::string PnConsole::alarm(const Target& t, const std::string& id, const std::
   if (kind == kAlarmKinds.end()) return std::string(kUsage);
   std::optional<std::uint16_t> slot;
   std::optional<std::uint16_t> subslot;
-  if (args.size() >= 3) {
-    const auto colon = args[2].find(':');
-    const auto s = number(args[2].substr(0, colon), 0, 0x7FFF);
-    const auto ss = colon == std::string::npos ? std::optional<std::uint32_t>{} : number(args[2].substr(colon + 1), 1, 0xFFFF);
-    if (!s || (colon != std::string::npos && !ss)) return "error: alarm: \"" + args[2] + "\" is not SLOT or SLOT:SUBSLOT";
-    slot = static_cast<std::uint16_t>(*s);
-    if (ss) subslot = static_cast<std::uint16_t>(*ss);
-  }
+  if (args.size() >= 3 && !parse_place(args[2], slot, subslot))
+    return "error: alarm: \"" + args[2] + "\" is not SLOT or SLOT:SUBSLOT";
   std::uint16_t error_type = kDefaultChannelError;
   if (args.size() == 4) {
     const auto e = number(args[3], 1, 0xFFFF);
@@ -191,7 +218,7 @@ std::string PnConsole::alarm(const Target& t, const std::string& id, const std::
   }
   PnDevice& d = *t.station->device;
   if (!d.powered()) return "error: " + id + " is off";
-  const AlarmPlace p = place(d.persona(), slot, subslot);
+  const Place p = place(d.persona(), slot, subslot);
   if (p.slot == nullptr) return "error: " + id + " has no submodule " + (args.size() >= 3 ? args[2] : "with IO data");
   AlarmNotification n;
   n.priority = kind->priority;
@@ -220,6 +247,40 @@ std::string PnConsole::alarm(const Target& t, const std::string& id, const std::
            " priority alarms wait for their AlarmAck already";
   }
   return "ok alarm " + id + " " + args[1] + " slot " + std::to_string(n.slot) + " subslot " + hex4(n.subslot);
+}
+
+std::string PnConsole::io(const Target& t, const std::string& id, const std::vector<std::string>& args) {
+  GenericIoPersona* dev = t.station->io;
+  if (dev == nullptr) return "error: " + id + " (" + t.station->persona + ") is not a generic IO device";
+  if (args.size() < 2) return "error: io takes STATION SLOT[:SUBSLOT] [BYTE...]";
+  std::optional<std::uint16_t> slot;
+  std::optional<std::uint16_t> subslot;
+  if (!parse_place(args[1], slot, subslot)) return "error: io: \"" + args[1] + "\" is not SLOT or SLOT:SUBSLOT";
+  PnDevice& d = *t.station->device;
+  if (!d.powered()) return "error: " + id + " is off (power-on " + args[0] + ")";
+  const Place p = place(d.persona(), slot, subslot);
+  if (p.slot == nullptr) return "error: " + id + " has no submodule " + args[1];
+  const std::uint32_t api = p.slot->api;
+  const std::uint16_t s = p.slot->slot;
+  const std::uint16_t ss = p.submodule->subslot;
+  const std::string where = std::to_string(s) + ":" + std::to_string(ss);
+  if (args.size() > 2) {
+    const std::size_t inputs = dev->input(api, s, ss).size();
+    if (inputs == 0) return "error: io: " + id + " " + where + " has no inputs to set";
+    if (args.size() - 2 != inputs) {
+      return "error: io: " + id + " " + where + " takes " + std::to_string(inputs) + " input bytes, not " +
+             std::to_string(args.size() - 2);
+    }
+    std::vector<std::uint8_t> values;
+    for (std::size_t i = 2; i < args.size(); ++i) {
+      const auto v = number(args[i], 0, 0xFF);
+      if (!v) return "error: io: \"" + args[i] + "\" is not a byte (0..255 or 0x00..0xFF)";
+      values.push_back(static_cast<std::uint8_t>(*v));
+    }
+    (void)dev->set_input(api, s, ss, values);  // the length is checked above
+  }
+  return std::string(args.size() > 2 ? "ok " : "") + "io " + id + " " + where + " out=" + hex_word(dev->output(api, s, ss)) +
+         " out-state=" + std::string(to_string(dev->outputs(api, s, ss))) + " in=" + hex_word(dev->input(api, s, ss));
 }
 
 std::string PnConsole::status_items() const {

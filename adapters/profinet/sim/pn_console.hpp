@@ -17,6 +17,14 @@
 //                            disappearing), pull, plug, return (return of submodule) (low
 //                            priority); the submodule defaults to the first one with IO data (the
 //                            AKD's telegram in slot 1), the idents are those plugged there
+//   io STATION SLOT[:SUBSLOT] [BYTE...]
+//                            a generic IO device's submodule (SUBSLOT: the slot's first):
+//                            "io pn0:io-block 2:1 out=11C3 out-state=valid in=-", the outputs the
+//                            controller wrote last and what they were worth (valid, stop: the
+//                            controller in STOP or the IOPS bad, not-yet, lost: no AR), and the
+//                            inputs it sends ("-": none); with bytes (as many as it has inputs) it
+//                            sets the inputs from the next cycle on ("ok io ..."). The device never
+//                            takes its inputs from its outputs.
 //   status                   per device: BUS:STATION persona name=... mac=... ip=... ar=...
 //                            cycles=N watchdog=N alarm-cr=N rx-lost=N tx-lost=N alarms=SENT/ACKED;
 //                            (" BUS:STATION persona off;" without power)
@@ -39,7 +47,8 @@ class PnConsole {
   static constexpr std::string_view kCommands =
       "power-off STATION, power-on STATION, reboot STATION, abort-ar STATION, lose STATION rx|tx N, "
       "drive-fault STATION NUMBER, alarm STATION process|diagnosis|diagnosis-gone|pull|plug|return "
-      "[SLOT[:SUBSLOT]] [ERROR], status (STATION: a NameOfStation or BUS:STATION)";
+      "[SLOT[:SUBSLOT]] [ERROR], io STATION SLOT[:SUBSLOT] [BYTE...], status (STATION: a NameOfStation or "
+      "BUS:STATION)";
 
   // The network must outlive the console; commands run on the thread that runs it.
   void add(BuiltPnNetwork& network) { networks_.push_back(&network); }
@@ -62,6 +71,7 @@ class PnConsole {
   // The station `text` names, or the error sentence in `error`.
   bool find(std::string_view text, Target& out, std::string& error) const;
   [[nodiscard]] std::string alarm(const Target& t, const std::string& id, const std::vector<std::string>& args) const;
+  [[nodiscard]] static std::string io(const Target& t, const std::string& id, const std::vector<std::string>& args);
 
   std::vector<BuiltPnNetwork*> networks_;
 };

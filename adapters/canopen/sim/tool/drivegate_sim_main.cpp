@@ -28,12 +28,14 @@
 //             corrupt N [BUS] | stick K STATE CODE | unstick K   (adapters/ethercat/sim/line_console.hpp)
 //   PROFINET: power-off STATION | power-on STATION | reboot STATION | abort-ar STATION |
 //             lose STATION rx|tx N | drive-fault STATION NUMBER |
-//             alarm STATION KIND [SLOT[:SUBSLOT]] [ERROR]   (adapters/profinet/sim/pn_console.hpp)
+//             alarm STATION KIND [SLOT[:SUBSLOT]] [ERROR] | io STATION SLOT[:SUBSLOT] [BYTE...]
+//             (adapters/profinet/sim/pn_console.hpp)
 //   all:      status
 // NODE is a node-ID, K a position on an EtherCAT line (1 = next to the gateway), STATION a
 // PROFINET NameOfStation, each BUS:NODE, BUS:K or BUS:STATION when more than one bus has it;
 // numbers are decimal or 0x hex. `corrupt` with one number (or a number and a bus name) is
-// EtherCAT's, with a node and a count CANopen's; power-off / power-on naming a station PROFINET's.
+// EtherCAT's, with a node and a count CANopen's; power-off / power-on and io naming a station
+// PROFINET's.
 #include <poll.h>
 #include <signal.h>
 #include <time.h>
@@ -323,19 +325,21 @@ class Simulator {
   }
 
   // The PROFINET console's answer when the command is one of its own (pn_console.hpp), nullopt
-  // otherwise: its own verbs, and power-off / power-on naming a simulated station.
+  // otherwise: its own verbs, power-off / power-on naming a simulated station, and io naming one
+  // (or naming none when no EtherCAT line is simulated: PROFINET's refusal says why).
   std::optional<std::string> profinet_command(const std::string& line) {
     std::istringstream in(line);
     std::string verb;
     std::string target;
     in >> verb >> target;
     if (!profinet::PnConsole::handles(verb) || verb == "status") return std::nullopt;
-    if (verb != "power-off" && verb != "power-on") {
+    if (verb != "power-off" && verb != "power-on" && verb != "io") {
       if (pn_console_.empty()) return "error: " + verb + " is a PROFINET command and no PROFINET network is simulated";
       return pn_console_.command(line, clock_.now());
     }
-    if (pn_console_.matches(target) == 0) return std::nullopt;
-    return pn_console_.command(line, clock_.now());
+    if (pn_console_.matches(target) > 0 || (verb == "io" && console_.empty() && !pn_console_.empty()))
+      return pn_console_.command(line, clock_.now());
+    return std::nullopt;
   }
 
   // The EtherCAT console's answer when the command is one of its own (line_console.hpp), nullopt
