@@ -29,8 +29,8 @@ class ProfinetE2e : public E2eClientTest {
  protected:
   static constexpr auto kStartUp = 40s;
 
-  // Both processes read it; each names its own veth end. data_hold_factor 30 (480 ms): a loaded
-  // two-core machine under the sanitizers may hold either process for tens of ms.
+  // Both processes read it; each names its own veth end. data_hold_factor 60 (960 ms): a loaded
+  // two-core machine under the sanitizers held a process for up to 957 ms (30 was too few).
   std::string config_text(const std::string& interface) const {
     std::ostringstream y;
     y << "gateway: { name: pn-e2e, dds: { domain: " << dds_.domain << ", namespace: " << dds_.ns
@@ -39,7 +39,7 @@ class ProfinetE2e : public E2eClientTest {
       << "  - name: pn0\n"
       << "    type: profinet\n"
       << "    cycle_time: 1ms\n"
-      << "    options: { interface: " << interface << ", reduction_ratio: 16, data_hold_factor: 30 }\n"
+      << "    options: { interface: " << interface << ", reduction_ratio: 16, data_hold_factor: 60 }\n"
       << "    devices:\n"
       << "      - { station: akd-x, ip: 192.168.0.10 }\n"
       << "      - { station: akd-y, ip: 192.168.0.11 }\n"
