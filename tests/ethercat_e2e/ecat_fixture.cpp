@@ -1,8 +1,5 @@
 #include "tests/ethercat_e2e/ecat_fixture.hpp"
 
-#include <unistd.h>
-
-#include <filesystem>
 #include <sstream>
 
 namespace drivegate::test {
@@ -31,65 +28,11 @@ std::string EthercatE2e::config_text(const std::string& interface) const {
 }
 
 void EthercatE2e::SetUp() {
-  if (const std::string& why = netns_unavailable(); !why.empty()) GTEST_SKIP() << why;
-  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  dds_ = unique_dds(info->name());
-  ns_gw_ = std::make_unique<NetNamespace>();
-  ns_sim_ = std::make_unique<NetNamespace>();
-  veth_ = std::make_unique<VethPair>(ns_gw_.get(), ns_sim_.get());
-  config_ = write_config_text(std::string("ecat-e2e-") + info->name(), config_text(veth_->a()));
-  sim_config_ = write_config_text(std::string("ecat-e2e-sim-") + info->name(), config_text(veth_->b()));
-  {
-    // Forked from this thread while it is in "sim": the simulator's raw socket opens there.
-    const NetnsScope in(*ns_sim_);
-    sim_ = std::make_unique<SimProcess>(sim_config_);
-  }
-  const auto ready = sim_->wait_ready(20s);
-  ASSERT_TRUE(ready) << sim_->log();
-  ASSERT_EQ(*ready, "drivegate-sim: 3 slaves on ethercat " + veth_->b() + " (bus ec0)");
-
-  in_gw_ = std::make_unique<NetnsScope>(*ns_gw_);
-  start_gateway();
-  if (HasFatalFailure()) return;
-  connect_client();
-}
-
-void EthercatE2e::TearDown() {
-  // The client first (its participant lives in "gw"), then the gateway before its drives, then
-  // the namespaces: this thread leaves "gw" before it is deleted.
-  client_.reset();
-  daemon_.reset();
-  notify_.reset();
-  sim_.reset();
-  in_gw_.reset();
-  veth_.reset();
-  ns_sim_.reset();
-  ns_gw_.reset();
-  if (config_.empty()) return;  // skipped
-  for (const auto& log : {config_ + ".log", sim_config_ + ".sim.log"}) expect_no_sanitizer_report(log);
-  // The files stay for a failed test, whose messages name them.
-  if (HasFailure()) return;
-  for (const auto& f : {config_, config_ + ".log", sim_config_, sim_config_ + ".sim.log"}) std::filesystem::remove(f);
-}
-
-void EthercatE2e::start_gateway() {
-  daemon_.reset();
-  notify_ = std::make_unique<NotifySocket>();
-  daemon_ = std::make_unique<DaemonProcess>(config_, notify_->path());
-  ASSERT_TRUE(notify_->wait_for("READY=1", kStartUp)) << daemon_->log();
-}
-
-void EthercatE2e::connect_client() {
-  auto options = client::options_for(dds_.domain, dds_.ns, "ecat-e2e-client");
-  options.interfaces = {"lo"};
-  open_client(options);
-}
-
-void EthercatE2e::enable(const std::string& axis) {
-  const auto r = send(axis, "enable");
-  ASSERT_EQ(r.outcome, client::Outcome::Completed) << axis << ": " << r.reason << diagnostics();
-  ASSERT_TRUE(wait_axis(axis, [](const client::AxisState& s) { return s.state == "operation_enabled"; }, 5s))
-      << axis << diagnostics();
+  make_network();
+  if (IsSkipped()) return;
+  write_configs("ecat-e2e", [this](const std::string& interface) { return config_text(interface); });
+  ASSERT_NO_FATAL_FAILURE(start_sim("drivegate-sim: 3 slaves on ethercat " + veth_->b() + " (bus ec0)"));
+  ASSERT_NO_FATAL_FAILURE(start_gateway_and_client("ecat-e2e-client"));
 }
 
 void EthercatE2e::set_mode(const std::string& axis, const std::string& mode) {
@@ -118,13 +61,6 @@ bool EthercatE2e::wait_all(const std::string& drive_state, std::chrono::millisec
 }
 
 std::optional<client::IoState> EthercatE2e::panel() const { return client_->io_state("panel"); }
-
-std::string EthercatE2e::sim(const std::string& command) { return sim_->command(command, 5s); }
-
-bool EthercatE2e::wait_sim(const std::string& command, const std::function<bool(const std::string&)>& done,
-                           std::chrono::milliseconds timeout, std::string& last) {
-  return sim_->wait_answer(command, done, timeout, last);
-}
 
 std::string EthercatE2e::field(const std::string& answer, const std::string& key) {
   const auto at = answer.find(" " + key + "=");

@@ -1,10 +1,8 @@
 #pragma once
-// The fixture of the PROFINET end-to-end tests:
-//
-//   namespace "sim": drivegate-sim serving two AKDs and an IO device on veth end b, which carries
-//                    the stations' addresses (the devices come up named, without an address)
-//   namespace "gw":  drivegated, the IO controller, on veth end a (192.168.0.1), and the test's
-//                    DDS client on that namespace's loopback
+// The fixture of the PROFINET end-to-end tests (the namespaces, processes and waits:
+// tests/support/veth_e2e.hpp): drivegate-sim serves two AKDs and an IO device on veth end b,
+// which carries the stations' addresses (the devices come up named, without an address);
+// drivegated, the IO controller, is on veth end a (192.168.0.1).
 //
 // Set-up waits until the gateway has found the stations by name, given them their addresses and
 // connected them: both axes operational and disabled, the IO device's data valid. Skipped without
@@ -12,23 +10,15 @@
 // fault, a killed gateway, the IO device's bytes).
 #include <gtest/gtest.h>
 
-#include <filesystem>
-#include <functional>
-#include <memory>
 #include <sstream>
 #include <string>
 
-#include "tests/canopen_e2e/sim_process.hpp"
-#include "tests/daemon/daemon_process.hpp"
-#include "tests/support/e2e_client.hpp"
-#include "tests/support/netns.hpp"
+#include "tests/support/veth_e2e.hpp"
 
 namespace drivegate::test {
 
-class ProfinetE2e : public E2eClientTest {
+class ProfinetE2e : public VethE2eTest {
  protected:
-  static constexpr auto kStartUp = 40s;
-
   // Both processes read it; each names its own veth end. data_hold_factor 60 (960 ms): a loaded
   // two-core machine under the sanitizers held a process for up to 957 ms (30 was too few).
   std::string config_text(const std::string& interface) const {
@@ -60,41 +50,16 @@ class ProfinetE2e : public E2eClientTest {
   }
 
   void SetUp() override {
-    if (const std::string& why = netns_unavailable(); !why.empty()) GTEST_SKIP() << why;
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dds_ = unique_dds(info->name());
-    ns_gw_ = std::make_unique<NetNamespace>();
-    ns_sim_ = std::make_unique<NetNamespace>();
-    veth_ = std::make_unique<VethPair>(ns_gw_.get(), ns_sim_.get());
+    make_network();
+  if (IsSkipped()) return;
     ASSERT_TRUE(ns_gw_->ip({"addr", "add", "192.168.0.1/24", "dev", veth_->a()}).ok());
     for (const char* a : {"192.168.0.10/24", "192.168.0.11/24", "192.168.0.20/24"})
       ASSERT_TRUE(ns_sim_->ip({"addr", "add", a, "dev", veth_->b()}).ok());
-    config_ = write_config_text(std::string("pn-e2e-") + info->name(), config_text(veth_->a()));
-    sim_config_ = write_config_text(std::string("pn-e2e-sim-") + info->name(), config_text(veth_->b()));
-    {
-      const NetnsScope in(*ns_sim_);
-      sim_ = std::make_unique<SimProcess>(sim_config_);
-    }
-    // One line per device (its MAC), then the ready line.
-    std::optional<std::string> ready;
-    for (int i = 0; i < 4 && (!ready || ready->find(" devices on profinet ") == std::string::npos); ++i)
-      ready = sim_->wait_ready(20s);
-    ASSERT_TRUE(ready) << sim_->log();
-    ASSERT_EQ(*ready, "drivegate-sim: 3 devices on profinet " + veth_->b() + " (bus pn0)");
-    in_gw_ = std::make_unique<NetnsScope>(*ns_gw_);
-    ASSERT_NO_FATAL_FAILURE(start_gateway());
-    auto options = client::options_for(dds_.domain, dds_.ns, "pn-e2e-client");
-    options.interfaces = {"lo"};
-    open_client(options);
+    write_configs("pn-e2e", [this](const std::string& interface) { return config_text(interface); });
+    // One line per device (its MAC), then this one.
+    ASSERT_NO_FATAL_FAILURE(start_sim("drivegate-sim: 3 devices on profinet " + veth_->b() + " (bus pn0)"));
+    ASSERT_NO_FATAL_FAILURE(start_gateway_and_client("pn-e2e-client"));
     ASSERT_NO_FATAL_FAILURE(wait_all_up());
-  }
-
-  // drivegated in namespace "gw" (the test thread is in it), up to READY=1.
-  void start_gateway() {
-    daemon_.reset();
-    notify_ = std::make_unique<NotifySocket>();
-    daemon_ = std::make_unique<DaemonProcess>(config_, notify_->path());
-    ASSERT_TRUE(notify_->wait_for("READY=1", kStartUp)) << daemon_->log();
   }
 
   // Both axes operational and disabled, the IO device's data valid.
@@ -109,21 +74,6 @@ class ProfinetE2e : public E2eClientTest {
     }, kStartUp)) << diagnostics();
   }
 
-  // enable, with the final reply and the published state checked.
-  void enable(const std::string& axis) {
-    const auto r = send(axis, "enable");
-    ASSERT_EQ(r.outcome, client::Outcome::Completed) << axis << ": " << r.reason << diagnostics();
-    ASSERT_TRUE(wait_axis(axis, [](const client::AxisState& s) { return s.state == "operation_enabled"; }, 5s))
-        << axis << diagnostics();
-  }
-
-  // One simulator console command, its answer.
-  std::string sim(const std::string& command) { return sim_->command(command, 5s); }
-  // Sends `command` until `done(answer)` holds; the last answer in `last`.
-  bool wait_sim(const std::string& command, const std::function<bool(const std::string&)>& done,
-                std::chrono::milliseconds timeout, std::string& last) {
-    return sim_->wait_answer(command, done, timeout, last);
-  }
   // The `key=` field of `station`'s item in a `status` answer (pn_console.hpp), "" when missing.
   static std::string station_field(const std::string& status, const std::string& station, const std::string& key) {
     const auto at = status.find(" pn0:" + station + " ");
@@ -135,22 +85,7 @@ class ProfinetE2e : public E2eClientTest {
     return item.substr(from, item.find(' ', from) - from);
   }
 
-  void TearDown() override {
-    client_.reset();
-    daemon_.reset();
-    notify_.reset();
-    sim_.reset();
-    in_gw_.reset();
-    veth_.reset();
-    ns_sim_.reset();
-    ns_gw_.reset();
-    if (config_.empty()) return;  // skipped
-    for (const auto& log : {config_ + ".log", sim_config_ + ".sim.log"}) expect_no_sanitizer_report(log);
-    if (HasFailure()) return;  // the files stay for a failed test, whose messages name them
-    for (const auto& f : {config_, config_ + ".log", sim_config_, sim_config_ + ".sim.log"}) std::filesystem::remove(f);
-  }
-
-  std::string diagnostics() {
+  std::string diagnostics() override {
     std::ostringstream d;
     if (client_) {
       d << "\n--- axes:";
@@ -166,17 +101,6 @@ class ProfinetE2e : public E2eClientTest {
     if (daemon_) d << "\n--- drivegated (end of log):\n" << tail(daemon_->log(), 60);
     return d.str();
   }
-
-  std::unique_ptr<NetNamespace> ns_gw_;
-  std::unique_ptr<NetNamespace> ns_sim_;
-  std::unique_ptr<VethPair> veth_;
-  std::unique_ptr<NetnsScope> in_gw_;
-  DdsIsolation dds_{};
-  std::string config_;
-  std::string sim_config_;
-  std::unique_ptr<SimProcess> sim_;
-  std::unique_ptr<NotifySocket> notify_;
-  std::unique_ptr<DaemonProcess> daemon_;
 };
 
 }  // namespace drivegate::test
