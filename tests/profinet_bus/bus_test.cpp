@@ -1,10 +1,10 @@
 // The PROFINET bus on simulated devices: stations found by name and given their IP, ARs to data
 // exchange, an AKD enabled and run in speed mode through its telegram, another moved in MDI and
-// disabled, a PNU read over record 47, the IO device's bytes both ways, losses (power, AR abort)
-// that reconnect only the device that was lost with a new AR and its axis disabled, a missing
-// station and a wrong module named, the ARs released on close, no allocation per cycle in data
-// exchange, a drive fault read from the fault buffer over record 47 and acknowledged, and alarms as
-// events.
+// disabled, a jog quick-stopped at the soft limits, a PNU read over record 47, the IO device's
+// bytes both ways, losses (power, AR abort) that reconnect only the device that was lost with a new
+// AR and its axis disabled, a missing station and a wrong module named, the ARs released on close,
+// no allocation per cycle in data exchange, a drive fault read from the fault buffer over record 47
+// and acknowledged, and alarms as events.
 #include <gtest/gtest.h>
 
 #include <array>
@@ -131,6 +131,30 @@ TEST(ProfinetBus, MdiMovesLandOnTheirTargetsAJogShowsItsSpeedAndTheDriveDisables
   EXPECT_EQ(h.snap("y").state, core::AxisState::SwitchOnDisabled);
   EXPECT_NEAR(h.snap("y").velocity, 0.0, 0.05);
   EXPECT_EQ(h.sim->akd_y->drive().state(), profidrive::sim::State::S1SwitchingOnInhibited);
+}
+
+// The soft limits hold for a jog too: telegram 9 carries no NIST_A, and the velocity the limit
+// watch judges "moving out" by is XIST_A's slope (it read 0, and a jog ran through the limit).
+TEST(ProfinetBus, AJogThatLeavesTheSoftLimitsIsQuickStopped) {
+  PnHarness h(replaced(kNetwork, "profinet: { station: akd-y, telegram: 9 } }",
+                       "profinet: { station: akd-y, telegram: 9 }, limits: { min_position: -0.5, max_position: 0.5 } }"));
+  ASSERT_TRUE(h.run_until([&] { return h.all_up(); }, 5s)) << h.details();
+  ASSERT_EQ(h.wait_final(h.push("y", core::CommandKind::Enable), 3s), core::ReplyStatus::Completed);
+  ASSERT_EQ(h.wait_final(h.push("y", core::CommandKind::Home), 10s), core::ReplyStatus::Completed);
+  const auto jog = motion(h, "y", core::CommandKind::Velocity, 0, -1.5);
+  core::Setpoint alive;
+  alive.axis = jog.axis;
+  alive.velocity = jog.velocity;
+  bool stopped = false;
+  for (int i = 0; i < 100 && !stopped; ++i) {
+    ASSERT_TRUE(h.runner->push_setpoint(alive));
+    stopped = h.run_until([&] { return h.snap("y").state != core::AxisState::OperationEnabled; }, 50ms);
+  }
+  ASSERT_TRUE(stopped) << h.snap("y").position << " rev" << h.events_text();
+  EXPECT_NE(h.events_text().find("outside the soft limits [-0.5, 0.5] rev and moving out: quick stop"), std::string::npos)
+      << h.events_text();
+  EXPECT_GT(h.snap("y").position, -1.0);  // caught within the quick stop's distance
+  EXPECT_EQ(h.wait_final(jog.id, 1s), core::ReplyStatus::Failed);
 }
 
 TEST(ProfinetBus, ReadsAPnuOverRecord47) {
