@@ -425,12 +425,14 @@ std::vector<DcpAction> profinet_scan_actions(const core::ScanRequest& request) {
       }
     } else if (option == "--set-ip") {
       a.kind = DcpAction::Kind::SetIp;
-      const auto [mac, suite] = mac_and_value(a.text, value, "MAC=A.B.C.D/MASK[/GATEWAY], e.g. 00:1b:1b:00:0a:04=192.168.0.14/24");
+      const auto [mac, suite] =
+          mac_and_value(a.text, value, "MAC=A.B.C.D/MASK[/GATEWAY], e.g. 00:1b:1b:00:0a:04=192.168.0.14/24");
       a.mac = mac;
       a.ip = action_suite(a.text, suite);
       for (const auto& b : out) {
         if (b.kind != DcpAction::Kind::SetIp) continue;
-        if (b.mac == a.mac) throw core::ScanUsageError(a.text + ": " + mac_words(a.mac) + " is given an IP suite twice");
+        if (b.mac == a.mac)
+          throw core::ScanUsageError(a.text + ": " + mac_words(a.mac) + " is given an IP suite twice");
         if (b.ip.address == a.ip.address)
           throw core::ScanUsageError(a.text + ": " + config::ipv4_text(ipv4_host(a.ip.address)) + " is given to " +
                                      mac_words(b.mac) + " too");
@@ -525,8 +527,11 @@ void run_actions(DcpSession& dcp, std::span<const DcpAction> actions, const core
   }
   found.resize(identified.stations);
   const DcpQualifier qualifier = request.permanent ? DcpQualifier::Permanent : DcpQualifier::Temporary;
-  const std::string kept = request.permanent ? "permanent (kept over a power loss)"
-                                             : "temporary (forgotten at a power loss";
+  // What the Set's BlockQualifier means for the device; `then`: what follows from temporary.
+  const auto kept = [&](std::string_view then) {
+    return request.permanent ? std::string("permanent (kept over a power loss)")
+                             : "temporary (forgotten at a power loss; " + std::string(then) + ")";
+  };
   for (const DcpAction& a : actions) {
     const auto fail = [&](const std::string& why) { r.action_failed = a.text + ": " + why; };
     std::vector<DcpStation*> targets;
@@ -559,16 +564,16 @@ void run_actions(DcpSession& dcp, std::span<const DcpAction> actions, const core
       s.has_name = true;
       s.name_length = static_cast<std::uint8_t>(std::min(a.name.size(), s.name_chars.size()));
       std::copy_n(a.name.begin(), s.name_length, s.name_chars.begin());
-      r.actions_done.push_back(mac_words(s.mac) + ": NameOfStation set to \"" + a.name + "\" (was " + was + "), " + kept +
-                               (request.permanent ? "" : "; the controller finds its stations by name: --permanent keeps it)"));
+      r.actions_done.push_back(mac_words(s.mac) + ": NameOfStation set to \"" + a.name + "\" (was " + was + "), " +
+                               kept("the controller finds its stations by name: --permanent keeps it"));
     } else if (a.kind == DcpAction::Kind::SetIp) {
       const std::string was = s.has_ip && ipv4_host(s.ip.address) != 0 ? suite_words(s) : "none";
       const DcpResult done = dcp.run(dcp.client().set_ip(s.mac, a.ip, qualifier));
       if (done.status != DcpRequestStatus::Done) return fail(set_failure(done));
       s.has_ip = true;
       s.ip = a.ip;
-      r.actions_done.push_back(station_words(s) + ": IP suite set to " + suite_words(s) + " (was " + was + "), " + kept +
-                               (request.permanent ? "" : "; the controller gives a station its configured address at start)"));
+      r.actions_done.push_back(station_words(s) + ": IP suite set to " + suite_words(s) + " (was " + was + "), " +
+                               kept("the controller gives a station its configured address at start"));
     } else {
       const DcpResult done = dcp.run(dcp.client().signal(s.mac));
       if (done.status != DcpRequestStatus::Done) return fail(set_failure(done));
