@@ -63,13 +63,17 @@ struct ParameterRef {
 // Looks for devices on a bus of this type (`drivegated --scan TYPE:WHERE`, daemon/scan.hpp): `plan`
 // reads WHERE into a bus plan (through the type's own option reader, so a scan and a file agree);
 // the caller then holds the bus (`resource`, as a gateway does) and calls `run`, which only reads
-// from the devices. Both throw core::ScanError or core::BusError with one line a person can act on.
+// from the devices (but for the write actions of a scanner that `writes`). Both throw
+// core::ScanError or core::BusError with one line a person can act on.
 class BusTypeRegistry;
 struct BusScanner {
   // `types`: the bus types of the caller (the daemon's registry), for the plan and the device profiles.
   std::function<BusPlan(const core::ScanRequest& request, const BusTypeRegistry& types)> plan;
   std::function<core::ScanResult(const BusPlan& bus, const core::ScanRequest& request, const BusTypeRegistry& types)>
       run;
+  // Takes ScanRequest::actions (its `plan` checks them, its `run` does them); a scanner that does
+  // not is not given any.
+  bool writes = false;
   [[nodiscard]] explicit operator bool() const noexcept { return plan && run; }
 };
 

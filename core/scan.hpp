@@ -20,6 +20,20 @@ class ScanError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
+// A scan argument that is wrong as written (a write action's MAC or value): found before anything
+// is sent; `drivegated` exits 2 with it, as for its other usage errors.
+class ScanUsageError : public ScanError {
+ public:
+  using ScanError::ScanError;
+};
+
+// A write action asked for on the scan's command line, run before the listing (PROFINET:
+// `--set-name MAC=NAME`, `--set-ip MAC=SUITE`, `--signal MAC|NAME`): the option and its value as
+// given. Only a scanner that writes (BusScanner::writes) takes them.
+struct ScanAction {
+  std::string option;  // "--set-name"
+  std::string value;   // "00:1b:1b:00:0a:04=drive-d"
+};
 
 struct ScanRequest {
   std::string bus_type;  // "canopen", "ethercat", "profinet"
@@ -32,6 +46,9 @@ struct ScanRequest {
   Duration listen = std::chrono::milliseconds(200);
   // Where device profiles are looked for, in order (as the daemon's LoadOptions::device_dirs).
   std::vector<std::filesystem::path> device_dirs;
+  // Run in this order before the listing; `permanent`: the values they set survive a power loss.
+  std::vector<ScanAction> actions;
+  bool permanent = false;
 };
 
 // Where a device sits on its bus: `number` is what an axis' `address` takes in the configuration
@@ -95,6 +112,10 @@ struct ScanResult {
   std::vector<FoundDevice> devices;  // by address
   std::vector<std::string> notes;    // bus-wide: other masters seen, malformed frames counted
   std::vector<std::string> warnings; // what must be fixed on the bus before a gateway runs it (conflicts)
+  // The write actions: one line per action done, in order; `action_failed` the one that failed
+  // (the rest were not run), "" when none did. The listing is of the bus after them.
+  std::vector<std::string> actions_done;
+  std::string action_failed;
   Duration elapsed{};
 };
 

@@ -42,6 +42,8 @@ constexpr std::chrono::milliseconds kSecondSignalGrace{2000};
 constexpr const char* kUsage = R"(usage: drivegated --config FILE [--log-level LEVEL]
        drivegated --check-config FILE
        drivegated --scan TYPE:WHERE [--scan-timeout D] [--device-dir DIR]... [--write-config FILE [--force]]
+       drivegated --scan profinet:IFACE [--set-name MAC=NAME]... [--set-ip MAC=A.B.C.D/MASK[/GATEWAY]]...
+                  [--permanent] [--signal MAC|NAME]... [--write-config FILE [--force]]
        drivegated --version | --help
 
 Runs the gateway described by FILE: brings up every bus and axis, runs one cycle thread per bus
@@ -54,7 +56,8 @@ SIGPIPE, SIGTSTP, SIGTTIN and SIGTTOU are ignored.
   --check-config FILE  validate FILE and print the compiled plan without touching any bus
   --log-level LEVEL    trace|debug|info|warn|error|critical|off (overrides gateway.log_level)
 
-  --scan TYPE:WHERE    list the devices on a bus and the device profile that fits each; only reads.
+  --scan TYPE:WHERE    list the devices on a bus and the device profile that fits each; only reads,
+                       but for the profinet actions below.
                        canopen:can0 (SocketCAN interface), or canopen:udp-multicast?group=G&port=P&interface=A
                        (quote it in a shell); options: interface, bitrate, group, port
                        ethercat:eth1 (the line on an Ethernet port); options: sdo_timeout, transition_timeout, objects
@@ -64,6 +67,16 @@ SIGPIPE, SIGTSTP, SIGTTIN and SIGTTOU are ignored.
   --device-dir DIR     also look for device profiles in DIR (before the built-in ones)
   --write-config FILE  write a configuration skeleton for what was found (--check-config accepts it)
   --force              replace FILE if it exists (otherwise it is kept and the command fails)
+
+  profinet only, run in the order given before the listing (which then shows their result); every
+  argument is checked before anything is sent, and the first action that fails ends them (exit 1):
+  --set-name MAC=NAME  give the device at MAC (00:1b:1b:00:0a:04) the NameOfStation NAME (DCP Set);
+                       refused unsent when another device answers with NAME
+  --set-ip MAC=SUITE   give it the IP suite A.B.C.D/MASK[/GATEWAY] (MASK dotted or a prefix length)
+  --permanent          the device keeps the name and IP suite over a power loss (a replaced drive
+                       needs that); without it they are temporary: forgotten at a power loss (the
+                       controller gives the configured address at start, but finds stations by name)
+  --signal MAC|NAME    flash the LED of the device at MAC or with the NameOfStation NAME
 )";
 
 struct Args {
@@ -121,9 +134,14 @@ std::optional<Args> parse_args(int argc, char** argv, int& exit_code) {
         }
         a.scan->answer_timeout = *d;
       }
-    } else if (arg == "--force") {
+    } else if (arg == "--set-name" || arg == "--set-ip" || arg == "--signal") {
+      auto v = value(arg == "--set-name" ? "MAC=NAME" : arg == "--set-ip" ? "MAC=A.B.C.D/MASK[/GATEWAY]" : "MAC or NAME");
+      if (!v) return std::nullopt;
       if (!a.scan) a.scan.emplace();
-      a.scan->force = true;
+      a.scan->actions.push_back({arg, *v});  // checked by the scanner before it sends anything
+    } else if (arg == "--force" || arg == "--permanent") {
+      if (!a.scan) a.scan.emplace();
+      (arg == "--force" ? a.scan->force : a.scan->permanent) = true;
     } else if (arg == "--log-level") {
       auto v = value("a level");
       if (!v) return std::nullopt;
@@ -134,7 +152,9 @@ std::optional<Args> parse_args(int argc, char** argv, int& exit_code) {
     }
   }
   if (a.scan && a.scan->target.empty()) {
-    std::cerr << "drivegated: --scan-timeout, --device-dir, --write-config and --force go with --scan\n" << kUsage;
+    std::cerr << "drivegated: --scan-timeout, --device-dir, --write-config, --force, --set-name, --set-ip, "
+                 "--permanent and --signal go with --scan\n"
+              << kUsage;
     return std::nullopt;
   }
   if (a.scan && !a.config.empty()) {

@@ -56,6 +56,14 @@ std::string format_columns(const std::vector<std::vector<std::string>>& rows) {
 core::ScanResult scan_bus(const core::ScanRequest& request, const config::BusTypeRegistry& types) {
   const auto type = types.find(request.bus_type);
   if (type != nullptr && type->scan) {
+    if ((!request.actions.empty() || request.permanent) && !type->scan.writes) {
+      std::string writers;
+      for (const auto& t : types.types())
+        if (t->scan.writes) writers += (writers.empty() ? "" : ", ") + t->name;
+      throw core::ScanUsageError((request.actions.empty() ? std::string("--permanent") : request.actions.front().option) +
+                                 " is not for " + request.bus_type + ": only a scan of " + writers +
+                                 " writes to its devices");
+    }
     const config::BusPlan plan = type->scan.plan(request, types);
     // A gateway on this bus would see our requests as another master's (and its devices' answers
     // would confuse both): refuse while one holds the bus, and hold it ourselves while scanning.
@@ -285,13 +293,23 @@ int run_scan_command(const ScanCommand& command, std::ostream& out, std::ostream
     load.device_dirs = command.device_dirs;
     for (const auto& d : config::default_device_dirs()) load.device_dirs.push_back(d);
     request.device_dirs = load.device_dirs;
+    request.actions = command.actions;
+    request.permanent = command.permanent;
     const core::ScanResult result = scan_bus(request, load.bus_types);
+    for (const auto& line : result.actions_done) out << line << "\n";
     out << format_scan_table(result) << std::flush;
+    if (!result.action_failed.empty()) {
+      err << "drivegated: --scan " << command.target << ": " << result.action_failed << "\n";
+      return 1;
+    }
     if (!command.write_config.empty()) {
       write_skeleton(command.write_config, scan_skeleton(result, load), command.force);
       out << "wrote " << command.write_config << "\n";
     }
     return 0;
+  } catch (const core::ScanUsageError& e) {
+    err << "drivegated: --scan " << command.target << ": " << e.what() << "\n";
+    return 2;
   } catch (const std::exception& e) {  // ScanError, BusError from the bus lock
     err << "drivegated: --scan " << command.target << ": " << e.what() << "\n";
     return 1;

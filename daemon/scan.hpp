@@ -45,10 +45,14 @@ struct ScanCommand {
   std::vector<std::filesystem::path> device_dirs;  // --device-dir, searched before the built-in ones
   std::string write_config;  // FILE, or empty
   bool force = false;
+  std::vector<core::ScanAction> actions;  // --set-name, --set-ip, --signal in order (a scanner that writes)
+  bool permanent = false;                 // --permanent
 };
 
-// Scans, prints the table to `out`, writes the skeleton when asked. Returns the exit code: 0 when
-// the scan ran (also with no device: the table says so), 1 with the reason on `err` otherwise.
+// Runs the write actions, prints one line per action done, then the table to `out`, writes the
+// skeleton when asked. Returns the exit code: 0 when the scan ran (also with no device: the table
+// says so); 2 for an action argument that is wrong as written (nothing sent); 1 with the reason on
+// `err` otherwise (an action that failed: after the table, which shows the bus as it is then).
 int run_scan_command(const ScanCommand& command, std::ostream& out, std::ostream& err);
 
 }  // namespace drivegate::daemon

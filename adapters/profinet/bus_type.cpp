@@ -61,7 +61,7 @@ std::unique_ptr<core::Bus> make_bus(const config::BusPlan& plan) { return make_p
 config::BusTypeInfo bus_type() {
   config::BusTypeInfo t = config::profinet_bus_type({station_name_error, cr_lengths});
   t.make_bus = make_bus;
-  t.scan = {.plan = profinet_scan_plan, .run = run_profinet_scan};
+  t.scan = {.plan = profinet_scan_plan, .run = run_profinet_scan, .writes = true};
   return t;
 }
 

@@ -321,6 +321,7 @@ config::BusPlan profinet_scan_plan(const core::ScanRequest& request, const confi
       throw core::ScanError("response_delay=\"" + value +
                             "\": the DCP ResponseDelayFactor, 1..6400 (the answers spread over N x 10 ms)");
   }
+  (void)profinet_scan_actions(request);
   std::ostringstream y;
   y << "gateway: { name: scan }\nbuses:\n  - name: scan\n    type: profinet\n    cycle_time: 1ms\n"
     << "    options:\n      interface: " << interface << "\naxes: []\n";
@@ -333,6 +334,255 @@ std::uint16_t profinet_scan_response_delay(const core::ScanRequest& request) {
       if (const auto v = config::parse_integer(value); v && *v >= 1 && *v <= 0x1900) return static_cast<std::uint16_t>(*v);
   return kScanResponseDelayFactor;
 }
+
+// --- the write actions ----------------------------------------------------------------------------
+
+namespace {
+
+MacAddress action_mac(const std::string& text, std::string_view value) {
+  const auto mac = parse_mac(value);
+  if (!mac)
+    throw core::ScanUsageError(text + ": " + config::in_quotes(value) +
+                               " is no MAC address (six hex octets such as 00:1b:1b:00:0a:04)");
+  if (((*mac)[0] & 0x01) != 0)  // the I/G bit [IEEE 802]: a group address is no device's
+    throw core::ScanUsageError(text + ": " + mac_words(*mac) + " is a multicast address, not a device's");
+  return *mac;
+}
+
+void check_name(const std::string& text, std::string_view name) {
+  if (const NameError e = validate_name_of_station(name); e != NameError::None)
+    throw core::ScanUsageError(text + ": " + config::in_quotes(name) + " is no NameOfStation: " +
+                               std::string(to_string(e)));
+}
+
+std::array<std::uint8_t, 4> octets(const std::array<int, 4>& a) {
+  return {static_cast<std::uint8_t>(a[0]), static_cast<std::uint8_t>(a[1]), static_cast<std::uint8_t>(a[2]),
+          static_cast<std::uint8_t>(a[3])};
+}
+
+// "A.B.C.D/MASK[/GATEWAY]", MASK dotted or a prefix length.
+IpSuite action_suite(const std::string& text, std::string_view value) {
+  const auto usage = [&] {
+    return core::ScanUsageError(text + ": expected MAC=A.B.C.D/MASK[/GATEWAY] (MASK dotted or a prefix length), "
+                                       "e.g. 00:1b:1b:00:0a:04=192.168.0.14/24");
+  };
+  std::vector<std::string_view> parts;
+  for (std::size_t from = 0;;) {
+    const std::size_t slash = value.find('/', from);
+    parts.push_back(value.substr(from, slash - from));
+    if (slash == std::string_view::npos) break;
+    from = slash + 1;
+  }
+  if (parts.size() < 2 || parts.size() > 3) throw usage();
+  IpSuite ip;
+  const auto address = config::parse_ipv4(parts[0]);
+  if (!address) throw usage();
+  ip.address = octets(*address);
+  if (const auto mask = config::parse_ipv4(parts[1])) {
+    ip.netmask = octets(*mask);
+  } else if (const auto prefix = config::parse_integer(parts[1]); prefix && *prefix >= 0 && *prefix <= 32) {
+    ip.netmask = ipv4_octets(*prefix == 0 ? 0U : ~std::uint32_t{0} << static_cast<int>(32 - *prefix));
+  } else {
+    throw usage();
+  }
+  if (parts.size() == 3) {
+    const auto gateway = config::parse_ipv4(parts[2]);
+    if (!gateway) throw usage();
+    ip.gateway = octets(*gateway);
+  }
+  if (ipv4_host(ip.address) == 0) throw core::ScanUsageError(text + ": 0.0.0.0 is no address to give a device");
+  if (const std::string_view problem = ip_suite_problem(ip); !problem.empty())
+    throw core::ScanUsageError(text + ": the IP suite is not usable: " + std::string(problem));
+  return ip;
+}
+
+// "MAC=VALUE" of --set-name and --set-ip: the MAC, and VALUE.
+std::pair<MacAddress, std::string_view> mac_and_value(const std::string& text, std::string_view value,
+                                                      const char* example) {
+  const std::size_t eq = value.find('=');
+  if (eq == std::string_view::npos) throw core::ScanUsageError(text + ": expected " + example);
+  return {action_mac(text, value.substr(0, eq)), value.substr(eq + 1)};
+}
+
+}  // namespace
+
+std::vector<DcpAction> profinet_scan_actions(const core::ScanRequest& request) {
+  std::vector<DcpAction> out;
+  bool sets = false;
+  for (const auto& [option, value] : request.actions) {
+    DcpAction a;
+    a.text = option + " " + config::clipped(value);
+    if (option == "--set-name") {
+      const auto [mac, name] = mac_and_value(a.text, value, "MAC=NAME, e.g. 00:1b:1b:00:0a:04=drive-d");
+      check_name(a.text, name);
+      a.mac = mac;
+      a.name = name;
+      for (const auto& b : out) {
+        if (b.kind != DcpAction::Kind::SetName) continue;
+        if (b.mac == a.mac) throw core::ScanUsageError(a.text + ": " + mac_words(a.mac) + " is given a name twice");
+        if (b.name == a.name)
+          throw core::ScanUsageError(a.text + ": \"" + a.name + "\" is given to " + mac_words(b.mac) + " too");
+      }
+    } else if (option == "--set-ip") {
+      a.kind = DcpAction::Kind::SetIp;
+      const auto [mac, suite] =
+          mac_and_value(a.text, value, "MAC=A.B.C.D/MASK[/GATEWAY], e.g. 00:1b:1b:00:0a:04=192.168.0.14/24");
+      a.mac = mac;
+      a.ip = action_suite(a.text, suite);
+      for (const auto& b : out) {
+        if (b.kind != DcpAction::Kind::SetIp) continue;
+        if (b.mac == a.mac)
+          throw core::ScanUsageError(a.text + ": " + mac_words(a.mac) + " is given an IP suite twice");
+        if (b.ip.address == a.ip.address)
+          throw core::ScanUsageError(a.text + ": " + config::ipv4_text(ipv4_host(a.ip.address)) + " is given to " +
+                                     mac_words(b.mac) + " too");
+      }
+    } else if (option == "--signal") {
+      a.kind = DcpAction::Kind::Signal;
+      if (parse_mac(value)) {
+        a.mac = action_mac(a.text, value);
+      } else if (validate_name_of_station(value) == NameError::None) {
+        a.by_name = true;
+        a.name = value;
+      } else {
+        throw core::ScanUsageError(a.text + ": " + config::in_quotes(value) +
+                                   " is neither a MAC address (00:1b:1b:00:0a:04) nor a NameOfStation");
+      }
+    } else {
+      throw core::ScanUsageError(option + " is not a profinet scan action (--set-name, --set-ip, --signal)");
+    }
+    sets = sets || a.kind != DcpAction::Kind::Signal;
+    out.push_back(std::move(a));
+  }
+  if (request.permanent && !sets)
+    throw core::ScanUsageError("--permanent goes with --set-name or --set-ip (it makes the values they set survive a "
+                               "power loss)");
+  return out;
+}
+
+namespace {
+
+// A DcpClient on the open link in real time.
+class DcpSession {
+ public:
+  DcpSession(link::RawSocketLink& link, const MacAddress& own, std::string interface)
+      : link_(link), client_(own), interface_(std::move(interface)) {}
+
+  DcpClient& client() noexcept { return client_; }
+
+  // Runs the request to its end (Done or Failed) and returns its result.
+  DcpResult run(DcpRequestId id) {
+    if (id == kNoDcpRequest) throw core::ScanError("the DCP client refused the request");
+    for (;;) {
+      const core::TimePoint now = clock_.now();
+      while (const std::size_t n = client_.poll(now, out_))
+        if (link_.send(std::span<const std::uint8_t>(out_).first(n)).status != link::SendStatus::Sent)
+          throw core::ScanError("cannot send a DCP request on " + interface_ +
+                                ": the link is down or its transmit queue full");
+      while (const std::size_t n = link_.receive(in_))
+        for (std::size_t i = 0; i < n; ++i) (void)client_.on_frame(in_[i].view(), now);
+      const DcpRequestStatus status = client_.result(id).status;
+      if (status == DcpRequestStatus::Done || status == DcpRequestStatus::Failed) return client_.result(id);
+      // Until the window closes, a Set times out or a frame arrives, at most 100 ms at a time.
+      const core::TimePoint deadline = client_.next_deadline();
+      const core::TimePoint after = clock_.now();
+      const int ms = deadline <= after ? 0
+                     : deadline - after >= 100ms
+                         ? 100
+                         : static_cast<int>(std::chrono::ceil<std::chrono::milliseconds>(deadline - after).count());
+      pollfd p{link_.wait_fd(), POLLIN, 0};
+      (void)::poll(&p, 1, ms);
+    }
+  }
+
+ private:
+  link::RawSocketLink& link_;
+  DcpClient client_;
+  std::string interface_;
+  const core::SteadyClock clock_;
+  std::array<std::uint8_t, kMaxFrameSize> out_{};
+  std::vector<link::FrameBuffer> in_ = std::vector<link::FrameBuffer>(16);
+};
+
+std::string set_failure(const DcpResult& r) {
+  std::string words(to_string(r.failure));
+  if (r.failure == DcpFailure::BlockError) words += ": " + std::string(to_string(r.block_error));
+  if (r.block_error == DcpBlockError::InOperation) words += " (a controller is connected to it: stop that first)";
+  return words;
+}
+
+std::string station_words(const DcpStation& s) {
+  return mac_words(s.mac) + (s.has_name && s.name_length > 0 ? " (\"" + std::string(s.name()) + "\")" : "");
+}
+
+// Runs the actions in order against the devices that answer an Identify all first: a line per
+// action done into r.actions_done, the first failure into r.action_failed (the rest not run).
+void run_actions(DcpSession& dcp, std::span<const DcpAction> actions, const core::ScanRequest& request,
+                 const std::string& interface, core::ScanResult& r) {
+  std::vector<DcpStation> found(kMaxScanStations);
+  const DcpResult identified = dcp.run(dcp.client().identify_all(found, profinet_scan_response_delay(request)));
+  if (identified.status != DcpRequestStatus::Done) {
+    r.action_failed = "the DCP Identify before the actions failed: " + std::string(to_string(identified.failure));
+    return;
+  }
+  found.resize(identified.stations);
+  const DcpQualifier qualifier = request.permanent ? DcpQualifier::Permanent : DcpQualifier::Temporary;
+  // What the Set's BlockQualifier means for the device; `then`: what follows from temporary.
+  const auto kept = [&](std::string_view then) {
+    return request.permanent ? std::string("permanent (kept over a power loss)")
+                             : "temporary (forgotten at a power loss; " + std::string(then) + ")";
+  };
+  for (const DcpAction& a : actions) {
+    const auto fail = [&](const std::string& why) { r.action_failed = a.text + ": " + why; };
+    std::vector<DcpStation*> targets;
+    for (auto& s : found)
+      if (a.by_name ? s.has_name && s.name() == a.name : s.mac == a.mac) targets.push_back(&s);
+    if (targets.empty()) {
+      fail((a.by_name ? "no device answers with the name \"" + a.name + "\""
+                      : "no device answers at " + mac_words(a.mac)) +
+           " (DCP Identify all on " + interface + "); nothing sent");
+      return;
+    }
+    if (targets.size() > 1) {
+      std::vector<std::string> macs;
+      for (const auto* s : targets) macs.push_back(mac_words(s->mac));
+      fail(std::to_string(targets.size()) + " devices answer with the name \"" + a.name + "\" (" + config::join(macs) +
+           "); give the MAC; nothing sent");
+      return;
+    }
+    DcpStation& s = *targets.front();
+    if (a.kind == DcpAction::Kind::SetName) {
+      for (const auto& other : found)
+        if (other.mac != s.mac && other.has_name && other.name() == a.name) {
+          fail("\"" + a.name + "\" is the name of " + mac_words(other.mac) +
+               " already (two devices with one name: the controller would use neither); nothing sent");
+          return;
+        }
+      const std::string was = s.has_name && s.name_length > 0 ? "\"" + std::string(s.name()) + "\"" : "none";
+      const DcpResult done = dcp.run(dcp.client().set_name(s.mac, a.name, qualifier));
+      if (done.status != DcpRequestStatus::Done) return fail(set_failure(done));
+      s.has_name = true;
+      s.name_length = static_cast<std::uint8_t>(std::min(a.name.size(), s.name_chars.size()));
+      std::copy_n(a.name.begin(), s.name_length, s.name_chars.begin());
+      r.actions_done.push_back(mac_words(s.mac) + ": NameOfStation set to \"" + a.name + "\" (was " + was + "), " +
+                               kept("the controller finds its stations by name: --permanent keeps it"));
+    } else if (a.kind == DcpAction::Kind::SetIp) {
+      const std::string was = s.has_ip && ipv4_host(s.ip.address) != 0 ? suite_words(s) : "none";
+      const DcpResult done = dcp.run(dcp.client().set_ip(s.mac, a.ip, qualifier));
+      if (done.status != DcpRequestStatus::Done) return fail(set_failure(done));
+      s.has_ip = true;
+      s.ip = a.ip;
+      r.actions_done.push_back(station_words(s) + ": IP suite set to " + suite_words(s) + " (was " + was + "), " +
+                               kept("the controller gives a station its configured address at start"));
+    } else {
+      const DcpResult done = dcp.run(dcp.client().signal(s.mac));
+      if (done.status != DcpRequestStatus::Done) return fail(set_failure(done));
+      r.actions_done.push_back(station_words(s) + ": Signal sent, its LED flashes");
+    }
+  }
+}
+
+}  // namespace
 
 core::ScanResult run_profinet_scan(const config::BusPlan& plan, const core::ScanRequest& request,
                                    const config::BusTypeRegistry& types) {
@@ -358,36 +608,20 @@ core::ScanResult run_profinet_scan(const config::BusPlan& plan, const core::Scan
   std::copy(a.mac.begin(), a.mac.end(), own.begin());
 
   const std::uint16_t factor = profinet_scan_response_delay(request);
-  DcpClient client(own);
+  DcpSession dcp(link, own, o.interface);
+  core::ScanResult before;
+  if (const auto actions = profinet_scan_actions(request); !actions.empty())
+    run_actions(dcp, actions, request, o.interface, before);
   std::vector<DcpStation> found(kMaxScanStations);
-  const DcpRequestId id = client.identify_all(found, factor);
   const core::SteadyClock clock;
   const core::TimePoint start = clock.now();
-  std::array<std::uint8_t, kMaxFrameSize> out{};
-  std::vector<link::FrameBuffer> in(16);
-  for (;;) {
-    const core::TimePoint now = clock.now();
-    while (const std::size_t n = client.poll(now, out))
-      if (link.send(std::span<const std::uint8_t>(out).first(n)).status != link::SendStatus::Sent)
-        throw core::ScanError("cannot send the DCP Identify on " + o.interface + ": the link is down or its transmit queue full");
-    while (const std::size_t n = link.receive(in))
-      for (std::size_t i = 0; i < n; ++i) (void)client.on_frame(in[i].view(), now);
-    const DcpRequestStatus status = client.result(id).status;
-    if (status == DcpRequestStatus::Done || status == DcpRequestStatus::Failed) break;
-    // Until the window closes or a frame arrives, at most 100 ms at a time.
-    const core::TimePoint deadline = client.next_deadline();
-    const core::TimePoint after = clock.now();
-    const int ms = deadline <= after ? 0
-                   : deadline - after >= 100ms
-                       ? 100
-                       : static_cast<int>(std::chrono::ceil<std::chrono::milliseconds>(deadline - after).count());
-    pollfd p{link.wait_fd(), POLLIN, 0};
-    (void)::poll(&p, 1, ms);
-  }
-  const DcpResult result = client.result(id);
+  const DcpRequestId id = dcp.client().identify_all(found, factor);
+  const DcpResult result = dcp.run(id);
   if (result.status != DcpRequestStatus::Done)
     throw core::ScanError("the DCP Identify failed: " + std::string(to_string(result.failure)));
-  core::ScanResult r = profinet_scan_result(client.stations(id), iface, profiles);
+  core::ScanResult r = profinet_scan_result(dcp.client().stations(id), iface, profiles);
+  r.actions_done = std::move(before.actions_done);
+  r.action_failed = std::move(before.action_failed);
   r.description = link.describe() + ", " + mac_words(own) +
                   (iface.address != 0 ? " " + config::ipv4_text(iface.address) + "/" +
                                             std::to_string(std::popcount(iface.netmask))
@@ -395,7 +629,7 @@ core::ScanResult run_profinet_scan(const config::BusPlan& plan, const core::Scan
   r.assumed = "DCP Identify all, ResponseDelayFactor " + std::to_string(factor) + " (answers within " +
               config::format_duration(identify_window(factor)) + ")";
   r.elapsed = clock.now() - start;
-  const DcpClientCounters& c = client.counters();
+  const DcpClientCounters& c = dcp.client().counters();
   if (result.stations_lost > 0)
     r.notes.push_back(std::to_string(result.stations_lost) + " more devices answered than the scan keeps (" +
                       std::to_string(kMaxScanStations) + ")");

@@ -1,7 +1,14 @@
 #pragma once
 // The PROFINET bus scan (`drivegated --scan profinet:IFACE`, DESIGN.md §7, issue 10 "Scan"): which
 // devices answer a DCP Identify all on the interface, what they are, and which device profile runs
-// them. Needs no configuration and only reads: no Set, no Connect.
+// them. Needs no configuration and only reads (no Connect), but for the write actions asked for:
+//
+//   0. `--set-name MAC=NAME`, `--set-ip MAC=A.B.C.D/MASK[/GATEWAY]`, `--signal MAC|NAME`
+//      (profinet_scan_actions, checked before anything is sent): one Identify all first (the
+//      target must answer; a name another MAC answers with is refused unsent), then per action a
+//      DCP Set (NameOfStation, IP parameter: temporary unless ScanRequest::permanent; Control
+//      Signal, flash once) and its response's BlockError [IEC 61158-6-10 §4.3, DCP Set]. The first
+//      that fails ends the actions (ScanResult::action_failed); the listing runs after them.
 //
 //   1. The raw link on IFACE (RawSocketLink with kFrameRules; its one-line errors for no
 //      CAP_NET_RAW, no such interface or an interface that is down pass through), the
@@ -62,14 +69,31 @@ core::ScanResult profinet_scan_result(std::span<const DcpStation> stations, cons
                                       const std::vector<config::DeviceProfile>& profiles);
 
 // `profinet:IFACE[?response_delay=N]` checked by the configuration's rules for a profinet bus
-// (interface), and the scan's own `response_delay` (ResponseDelayFactor 1..6400). Throws
-// core::ScanError naming the option.
+// (interface), and the scan's own `response_delay` (ResponseDelayFactor 1..6400), and its actions
+// (profinet_scan_actions). Throws core::ScanError naming the option.
 config::BusPlan profinet_scan_plan(const core::ScanRequest& request, const config::BusTypeRegistry& types);
 // `response_delay=N` of the request (checked by profinet_scan_plan), else kScanResponseDelayFactor.
 std::uint16_t profinet_scan_response_delay(const core::ScanRequest& request);
 
-// The scan on a RawSocketLink on the plan's interface in real time. Throws core::ScanError when
-// the interface does not open.
+// A write action of the scan, checked.
+struct DcpAction {
+  enum class Kind : std::uint8_t { SetName, SetIp, Signal };
+  Kind kind = Kind::SetName;
+  std::string text;      // the option and its value as given ("--set-name 00:1b:1b:00:0a:04=drive-d")
+  bool by_name = false;  // Signal: the device that answers with `name` (else the one at `mac`)
+  MacAddress mac{};
+  std::string name;      // SetName: the name to give it; Signal by name: the device's
+  IpSuite ip{};          // SetIp
+};
+
+// The request's actions, checked as written: the MAC (unicast, parse_mac), the NameOfStation
+// rules, an IP suite with an address that ip_suite_problem passes (the netmask dotted or a prefix
+// length); one name and one IP suite per MAC, a name for one MAC only; --permanent only with a
+// Set of name or IP. Throws core::ScanUsageError with one line naming the argument.
+std::vector<DcpAction> profinet_scan_actions(const core::ScanRequest& request);
+
+// The scan on a RawSocketLink on the plan's interface in real time, after the request's actions.
+// Throws core::ScanError when the interface does not open.
 core::ScanResult run_profinet_scan(const config::BusPlan& plan, const core::ScanRequest& request,
                                    const config::BusTypeRegistry& types);
 

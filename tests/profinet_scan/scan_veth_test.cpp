@@ -2,8 +2,9 @@
 // devices on the other end of a veth pair: an in-process PnSimNetwork (two AKDs, a generic IO
 // device) behind a PnSimLinkRunner served from a thread in its own network namespace. The table
 // lists all three with their fields and profile, `drivegated --check-config F` accepts what it
-// wrote; a missing and a down interface are one error line each. Skipped without root
-// (tests/support/netns.hpp).
+// wrote; a missing and a down interface are one error line each. The write actions (--set-name,
+// --set-ip, --permanent, --signal) on a fourth device that comes up without name and address, and
+// their refusals. Skipped without root (tests/support/netns.hpp).
 #include <gtest/gtest.h>
 
 #include <poll.h>
@@ -70,16 +71,10 @@ class ProfinetScanVeth : public ::testing::Test {
     veth_ = std::make_unique<VethPair>(ns_ctl_.get(), ns_dev_.get());
     veth_->set(VethPair::End::B, {"promisc", "on"});
     ASSERT_TRUE(ns_ctl_->ip({"addr", "add", "192.168.0.1/24", "dev", veth_->a()}).ok());
-    for (const char* a : {"192.168.0.11/24", "192.168.0.12/24", "192.168.0.13/24"})
+    // 192.168.0.14: for a device that gets it by DCP (ProfinetScanVethWrite).
+    for (const char* a : {"192.168.0.11/24", "192.168.0.12/24", "192.168.0.13/24", "192.168.0.14/24"})
       ASSERT_TRUE(ns_dev_->ip({"addr", "add", a, "dev", veth_->b()}).ok());
-    akd_a_ = std::make_unique<AkdPersona>(AkdPersonaConfig{});
-    akd_b_ = std::make_unique<AkdPersona>(AkdPersonaConfig{});
-    io_ = std::make_unique<GenericIoPersona>(GenericIoPersonaConfig{
-        {{0, 0, 0x10, {{1, 0x10, 0, 0}}}, {0, 1, 0x20, {{1, 0x21, 2, 0}}}}, 0x0FEE, "IO-1", "1"});
-    // [sim] The AKD's DCP identity as the profile's profidrive section names it.
-    net_.add(device(1, "drive-a", 0x0118, 0x0501, "AKD"), *akd_a_);
-    net_.add(device(2, "drive-b", 0x0118, 0x0501, "AKD"), *akd_b_);
-    net_.add(device(3, "io-c", 0x0FEE, 0x0042, "IO-1"), *io_);
+    add_devices();
     link::RawSocketOptions o;
     o.interface = veth_->b();
     link_ = std::make_unique<link::RawSocketLink>(kFrameRules, o);
@@ -96,7 +91,24 @@ class ProfinetScanVeth : public ::testing::Test {
     server_ = std::thread([this] { serve(); });
   }
 
-  void TearDown() override {
+  void TearDown() override { stop_serving(); }
+
+  virtual void add_devices() {
+    akd_a_ = std::make_unique<AkdPersona>(AkdPersonaConfig{});
+    akd_b_ = std::make_unique<AkdPersona>(AkdPersonaConfig{});
+    io_ = std::make_unique<GenericIoPersona>(io_config());
+    // [sim] The AKD's DCP identity as the profile's profidrive section names it.
+    net_.add(device(1, "drive-a", 0x0118, 0x0501, "AKD"), *akd_a_);
+    net_.add(device(2, "drive-b", 0x0118, 0x0501, "AKD"), *akd_b_);
+    net_.add(device(3, "io-c", 0x0FEE, 0x0042, "IO-1"), *io_);
+  }
+
+  static GenericIoPersonaConfig io_config() {
+    return {{{0, 0, 0x10, {{1, 0x10, 0, 0}}}, {0, 1, 0x20, {{1, 0x21, 2, 0}}}}, 0x0FEE, "IO-1", "1"};
+  }
+
+  // The devices stop answering; their state can then be read from this thread.
+  void stop_serving() {
     stop_ = true;
     if (server_.joinable()) server_.join();
   }
@@ -183,6 +195,126 @@ TEST_F(ProfinetScanVeth, AMissingOrDownInterfaceIsOneLine) {
   EXPECT_EQ(r.first, 1);
   EXPECT_EQ(r.second, "drivegated: --scan profinet:" + veth_->a() + ": cannot open the network: profinet: interface '" +
                           veth_->a() + "' is down; bring it up with 'ip link set " + veth_->a() + " up'\n");
+}
+
+// A fourth device (a generic IO device) that comes up without NameOfStation and IP address, as a
+// fresh or replaced one does; drive-b has a connection (DCP Set of name and IP refused, BlockError 6).
+class ProfinetScanVethWrite : public ProfinetScanVeth {
+ protected:
+  void add_devices() override {
+    ProfinetScanVeth::add_devices();
+    fresh_ = std::make_unique<GenericIoPersona>(io_config());
+    PnDeviceConfig c = device(4, "", 0x0FEE, 0x0042, "IO-1");
+    c.dcp.ip = {};
+    net_.add(c, *fresh_);
+    net_.device(1).dcp().set_in_operation(true);
+  }
+
+  // The scan with the fastest Identify (ResponseDelayFactor 1: 400 ms) and `args`.
+  std::pair<int, std::string> scan(const std::string& args) {
+    return drivegated("--scan profinet:" + veth_->a() + "?response_delay=1 " + args);
+  }
+  std::string error_prefix() const { return "drivegated: --scan profinet:" + veth_->a() + "?response_delay=1: "; }
+
+  std::unique_ptr<GenericIoPersona> fresh_;
+};
+
+TEST_F(ProfinetScanVethWrite, ADeviceWithoutANameIsNamedAndAddressedThenListed) {
+  const auto r = scan("--set-name 00:1b:1b:00:0a:04=io-d --set-ip 00:1b:1b:00:0a:04=192.168.0.14/24 --permanent");
+  EXPECT_EQ(r.first, 0) << r.second;
+  const std::string& t = r.second;
+  EXPECT_EQ(t.find("00:1b:1b:00:0a:04: NameOfStation set to \"io-d\" (was none), permanent (kept over a power loss)\n"
+                   "00:1b:1b:00:0a:04 (\"io-d\"): IP suite set to 192.168.0.14/255.255.255.0 gateway 0.0.0.0 (was none), "
+                   "permanent (kept over a power loss)\n"
+                   "profinet raw ethernet "),
+            0U)
+      << t;
+  EXPECT_NE(t.find(": 4 devices"), std::string::npos) << t;
+  EXPECT_NE(t.find("io-d 192.168.0.14 00:1b:1b:00:0a:04     -            IO device  0x00000FEE  0x00000042"), std::string::npos)
+      << t;
+  EXPECT_EQ(t.find("warning:"), std::string::npos) << t;
+  stop_serving();
+  DcpResponder& d = net_.device(3).dcp();
+  EXPECT_EQ(d.name_of_station(), "io-d");
+  EXPECT_EQ(d.ip().address, (std::array<std::uint8_t, 4>{192, 168, 0, 14}));
+  d.power_cycle();  // permanent: kept
+  EXPECT_EQ(d.name_of_station(), "io-d");
+  EXPECT_EQ(d.ip().netmask, (std::array<std::uint8_t, 4>{255, 255, 255, 0}));
+}
+
+TEST_F(ProfinetScanVethWrite, WithoutPermanentTheDeviceForgetsAtAPowerLoss) {
+  const auto r = scan("--set-name 00:1b:1b:00:0a:04=io-d");
+  EXPECT_EQ(r.first, 0) << r.second;
+  EXPECT_EQ(r.second.find("00:1b:1b:00:0a:04: NameOfStation set to \"io-d\" (was none), temporary (forgotten at a power "
+                          "loss; the controller finds its stations by name: --permanent keeps it)\n"),
+            0U)
+      << r.second;
+  EXPECT_NE(r.second.find("io-d (no IP) 00:1b:1b:00:0a:04"), std::string::npos) << r.second;
+  stop_serving();
+  DcpResponder& d = net_.device(3).dcp();
+  EXPECT_EQ(d.name_of_station(), "io-d");
+  d.power_cycle();
+  EXPECT_EQ(d.name_of_station(), "");
+}
+
+TEST_F(ProfinetScanVethWrite, ANameAnotherDeviceHasIsRefusedUnsent) {
+  auto r = scan("--set-name 00:1b:1b:00:0a:04=drive-a");
+  EXPECT_EQ(r.first, 1) << r.second;
+  EXPECT_NE(r.second.find("\n" + error_prefix() +
+                          "--set-name 00:1b:1b:00:0a:04=drive-a: \"drive-a\" is the name of 00:1b:1b:00:0a:01 already "
+                          "(two devices with one name: the controller would use neither); nothing sent\n"),
+            std::string::npos)
+      << r.second;
+  EXPECT_NE(r.second.find(": 4 devices"), std::string::npos) << r.second;  // the listing still runs
+  // Its own name again is no conflict.
+  r = scan("--set-name 00:1b:1b:00:0a:01=drive-a --permanent");
+  EXPECT_EQ(r.first, 0) << r.second;
+  EXPECT_EQ(r.second.find("00:1b:1b:00:0a:01: NameOfStation set to \"drive-a\" (was \"drive-a\"), permanent"), 0U)
+      << r.second;
+  stop_serving();
+  EXPECT_EQ(net_.device(3).dcp().counters().sets, 0U);
+  EXPECT_EQ(net_.device(3).dcp().name_of_station(), "");
+  EXPECT_EQ(net_.device(0).dcp().counters().sets, 1U);
+}
+
+TEST_F(ProfinetScanVethWrite, AMacNobodyHasABadArgumentAndARefusalAreOneLineEach) {
+  auto r = scan("--set-ip 00:1b:1b:00:0a:09=192.168.0.19/24");
+  EXPECT_EQ(r.first, 1) << r.second;
+  EXPECT_NE(r.second.find("\n" + error_prefix() + "--set-ip 00:1b:1b:00:0a:09=192.168.0.19/24: no device answers at "
+                          "00:1b:1b:00:0a:09 (DCP Identify all on " + veth_->a() + "); nothing sent\n"),
+            std::string::npos)
+      << r.second;
+  // Checked before anything is sent: one line, no listing, exit 2.
+  r = scan("--set-ip 00:1b:1b:00:0a:04=192.168.0.14/24 --set-name 00:1b:1b:00:0a:04=IO-D");
+  EXPECT_EQ(r, std::make_pair(2, error_prefix() + "--set-name 00:1b:1b:00:0a:04=IO-D: \"IO-D\" is no NameOfStation: the "
+                                                  "name has upper-case letters; PROFINET names are lower case\n"));
+  // drive-b has a connection: its BlockError in words; the actions after it are not run.
+  r = scan("--set-ip 00:1b:1b:00:0a:02=192.168.0.22/24 --signal drive-a");
+  EXPECT_EQ(r.first, 1) << r.second;
+  EXPECT_NE(r.second.find(error_prefix() + "--set-ip 00:1b:1b:00:0a:02=192.168.0.22/24: the device refused the value "
+                                           "(BlockError): device in operation, SET not possible (a controller is "
+                                           "connected to it: stop that first)\n"),
+            std::string::npos)
+      << r.second;
+  EXPECT_EQ(r.second.find("Signal sent"), std::string::npos) << r.second;
+  stop_serving();
+  EXPECT_EQ(net_.device(3).dcp().counters().sets, 0U);
+  EXPECT_EQ(net_.device(1).dcp().counters().set_errors, 1U);
+  EXPECT_EQ(net_.device(0).dcp().counters().signals, 0U);
+}
+
+TEST_F(ProfinetScanVethWrite, SignalFlashesTheDeviceByNameOrMac) {
+  const auto r = scan("--signal drive-b --signal 00:1b:1b:00:0a:04");
+  EXPECT_EQ(r.first, 0) << r.second;
+  EXPECT_EQ(r.second.find("00:1b:1b:00:0a:02 (\"drive-b\"): Signal sent, its LED flashes\n"
+                          "00:1b:1b:00:0a:04: Signal sent, its LED flashes\n"),
+            0U)
+      << r.second;
+  stop_serving();
+  EXPECT_EQ(net_.device(1).dcp().counters().signals, 1U);
+  EXPECT_EQ(net_.device(3).dcp().counters().signals, 1U);
+  EXPECT_EQ(net_.device(0).dcp().counters().signals, 0U);
+  EXPECT_EQ(net_.device(2).dcp().counters().signals, 0U);
 }
 
 }  // namespace

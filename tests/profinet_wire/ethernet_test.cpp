@@ -112,5 +112,18 @@ TEST(PnEthernet, MacText) {
   EXPECT_STREQ(mac_text(MacAddress{0x00, 0x1B, 0x1B, 0x12, 0x34, 0xFE}).data(), "00:1b:1b:12:34:fe");
 }
 
+TEST(PnEthernet, ParseMacTakesSixHexOctets) {
+  const MacAddress mac{0x00, 0x1B, 0x1B, 0x00, 0x0A, 0xFE};
+  for (const char* good : {"00:1b:1b:00:0a:fe", "00-1B-1B-00-0A-FE"}) {
+    const auto parsed = parse_mac(good);
+    ASSERT_TRUE(parsed) << good;
+    EXPECT_EQ(*parsed, mac) << good;
+  }
+  EXPECT_STREQ(mac_text(*parse_mac(mac_text(mac).data())).data(), "00:1b:1b:00:0a:fe");
+  for (const char* bad : {"", "00:1b:1b:00:0a", "00:1b:1b:00:0a:fe:05", "00:1b:1b:00:0a:f", "00:1b:1b-00:0a:fe",
+                          "00:1b:1b:00:0a:0g", "001b.1b00.0afe", "00:1b:1b:00:0a:fe ", "00:1b:1b:00:0a:+f"})
+    EXPECT_FALSE(parse_mac(bad)) << bad;
+}
+
 }  // namespace
 }  // namespace drivegate::profinet

@@ -121,4 +121,21 @@ std::array<char, 18> mac_text(const MacAddress& mac) noexcept {
   return t;
 }
 
+std::optional<MacAddress> parse_mac(std::string_view text) noexcept {
+  if (text.size() != 17 || (text[2] != ':' && text[2] != '-')) return std::nullopt;
+  const auto nibble = [](char c) -> int {
+    if (c >= '0' && c <= '9') return c - '0';
+    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+    return -1;
+  };
+  MacAddress mac{};
+  for (std::size_t i = 0; i < mac.size(); ++i) {
+    const int high = nibble(text[3 * i]), low = nibble(text[3 * i + 1]);
+    if (high < 0 || low < 0 || (i + 1 < mac.size() && text[3 * i + 2] != text[2])) return std::nullopt;
+    mac[i] = static_cast<std::uint8_t>(high << 4 | low);
+  }
+  return mac;
+}
+
 }  // namespace drivegate::profinet

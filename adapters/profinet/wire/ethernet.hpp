@@ -12,6 +12,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string_view>
 
@@ -109,5 +110,8 @@ EthernetView decode_ethernet(std::span<const std::uint8_t> frame) noexcept;
 
 // "00:1b:1b:12:34:56" (17 characters and a terminating NUL), for reports and log lines.
 std::array<char, 18> mac_text(const MacAddress& mac) noexcept;
+// The reverse: six octets of two hex digits (either case) separated by ':' or '-' (one of them
+// throughout); nullopt for anything else.
+std::optional<MacAddress> parse_mac(std::string_view text) noexcept;
 
 }  // namespace drivegate::profinet
