@@ -43,9 +43,22 @@ class NodeAccess final : public cia402::ObjectAccess {
   // profile's buffer is aborted on the wire and frees the channel at once.
   void cancel_requests() noexcept;
 
-  [[nodiscard]] bool mapped(cia402::ObjectId id) const noexcept override { return pdos_.image().contains(id); }
-  [[nodiscard]] std::int64_t read(cia402::ObjectId id) const noexcept override { return pdos_.image().get(id); }
-  void write(cia402::ObjectId id, std::int64_t value) noexcept override { pdos_.image().set(id, value); }
+  // A reference is the object's index in the node's process image, valid until NodePdos::configure()
+  // replaces the image (a reboot with another mapping): the image's generation is the mapping's.
+  [[nodiscard]] cia402::ImageRef resolve(cia402::ObjectId id) const noexcept override {
+    const std::size_t i = pdos_.image().index_of(id);
+    if (i == ProcessImage::kNotFound) return {};
+    return cia402::ImageRef::at(static_cast<std::uint16_t>(i), pdos_.image_generation());
+  }
+  [[nodiscard]] std::uint32_t mapping_generation() const noexcept override { return pdos_.image_generation(); }
+  using cia402::ObjectAccess::read;
+  using cia402::ObjectAccess::write;
+  [[nodiscard]] std::int64_t read(cia402::ImageRef ref) const noexcept override {
+    return ref.current(pdos_.image_generation()) ? pdos_.image().get_at(ref.slot()) : 0;
+  }
+  void write(cia402::ImageRef ref, std::int64_t value) noexcept override {
+    if (ref.current(pdos_.image_generation())) pdos_.image().set_at(ref.slot(), value);
+  }
   [[nodiscard]] bool inputs_fresh() const noexcept override { return operational_ && pdos_.inputs_fresh(now_); }
 
   cia402::RequestId submit_read(cia402::ObjectDef def) noexcept override;

@@ -51,13 +51,13 @@ cia402::ObjectId SlaveAccess::on_slave(cia402::ObjectId id) const noexcept {
   return index <= 0xFFFF ? cia402::ObjectId{static_cast<std::uint16_t>(index), id.sub} : id;
 }
 
-const MappedObject* SlaveAccess::find(cia402::ObjectId id) const noexcept {
+cia402::ImageRef SlaveAccess::resolve(cia402::ObjectId id) const noexcept {
   const cia402::ObjectId on = on_slave(id);
-  if (on.index == 0) return nullptr;
+  if (on.index == 0) return {};
   for (std::size_t c = first_cell(on.key(), table_mask_); table_[c].id.index != 0; c = (c + 1) & table_mask_) {
-    if (table_[c].id == on) return &table_[c];
+    if (table_[c].id == on) return cia402::ImageRef::at(static_cast<std::uint16_t>(c), 0);
   }
-  return nullptr;
+  return {};
 }
 
 void SlaveAccess::begin_cycle(bool operational, bool fresh) noexcept {
@@ -118,8 +118,8 @@ std::uint16_t SlaveAccess::statusword() const noexcept {
   return static_cast<std::uint16_t>(read(cia402::obj::kStatusword.id) & 0xFFFF);
 }
 
-std::int64_t SlaveAccess::read(cia402::ObjectId id) const noexcept {
-  const MappedObject* m = find(id);
+std::int64_t SlaveAccess::read(cia402::ImageRef ref) const noexcept {
+  const MappedObject* m = at(ref);
   if (m == nullptr || cx_ == nullptr) return 0;
   std::span<const std::uint8_t> bytes;
   if (m->output) {
@@ -135,10 +135,10 @@ std::int64_t SlaveAccess::read(cia402::ObjectId id) const noexcept {
   return cia402::normalise(m->type, static_cast<std::int64_t>(raw));
 }
 
-void SlaveAccess::write(cia402::ObjectId id, std::int64_t value) noexcept {
-  const MappedObject* m = find(id);
+void SlaveAccess::write(cia402::ImageRef ref, std::int64_t value) noexcept {
+  const MappedObject* m = at(ref);
   if (m == nullptr || !m->output || cx_ == nullptr) return;
-  if (cw_override_ && on_slave(id) == on_slave(cia402::obj::kControlword.id)) return;
+  if (cw_override_ && m->id == on_slave(cia402::obj::kControlword.id)) return;
   const std::span<std::uint8_t> bytes = cx_->outputs(slave_);
   const std::size_t n = cia402::size_of(m->type);
   if (static_cast<std::size_t>(m->offset) + n > bytes.size()) return;

@@ -72,9 +72,16 @@ class SlaveAccess final : public cia402::ObjectAccess {
   [[nodiscard]] std::uint16_t statusword() const noexcept;
 
   // --- ObjectAccess ---
-  [[nodiscard]] bool mapped(cia402::ObjectId id) const noexcept override { return find(id) != nullptr; }
-  [[nodiscard]] std::int64_t read(cia402::ObjectId id) const noexcept override;
-  void write(cia402::ObjectId id, std::int64_t value) noexcept override;
+  // A reference is a cell of the table of mapped objects, which the plan fixes at construction:
+  // the objects' offsets in the slave's outputs and inputs never move, and the slave's place in
+  // the image is looked up at each access, so references stay valid for the access' lifetime,
+  // through a slave's loss and reconfiguration (mapping_generation() never changes).
+  [[nodiscard]] cia402::ImageRef resolve(cia402::ObjectId id) const noexcept override;
+  [[nodiscard]] std::uint32_t mapping_generation() const noexcept override { return 0; }
+  using cia402::ObjectAccess::read;
+  using cia402::ObjectAccess::write;
+  [[nodiscard]] std::int64_t read(cia402::ImageRef ref) const noexcept override;
+  void write(cia402::ImageRef ref, std::int64_t value) noexcept override;
   [[nodiscard]] bool inputs_fresh() const noexcept override { return operational_ && fresh_; }
   cia402::RequestId submit_read(cia402::ObjectDef def) noexcept override;
   cia402::RequestId submit_write(cia402::ObjectDef def, std::int64_t value) noexcept override;
@@ -108,17 +115,20 @@ class SlaveAccess final : public cia402::ObjectAccess {
     std::span<std::uint8_t> into{};      // Upload: the caller's buffer
     std::array<std::uint8_t, kMaxTransfer> buffer{};
   };
-  [[nodiscard]] const MappedObject* find(cia402::ObjectId id) const noexcept;
+  [[nodiscard]] const MappedObject* at(cia402::ImageRef ref) const noexcept {
+    const bool ok = ref.current(mapping_generation()) && ref.slot() < table_.size() && table_[ref.slot()].id.index != 0;
+    return ok ? &table_[ref.slot()] : nullptr;
+  }
   Pending* free_slot() noexcept;
   Pending* slot_for(CoeSdoId id) noexcept;
   cia402::RequestId track(Pending* p, CoeSdoId id, Kind kind, cia402::DataType type) noexcept;
   [[nodiscard]] bool can_request() const noexcept { return operational_ && coe_ != nullptr && coe_->valid(); }
 
   std::size_t slave_;
-  // find()'s open-addressing table of the mapped objects themselves (linear probing, power-of-two
+  // resolve()'s open-addressing table of the mapped objects themselves (linear probing, power-of-two
   // size, at most half full; index 0, which no object has [CiA 301 §7.4.1], marks an empty cell).
-  // The profile looks objects up dozens of times per axis and cycle, so a lookup is one or two
-  // probes of one small array, with no second indirection.
+  // A lookup is one or two probes of one small array; the profile resolves its objects once and
+  // then accesses them by cell.
   std::vector<MappedObject> table_;
   std::size_t table_mask_ = 0;
   int slave_axis_;

@@ -16,7 +16,27 @@ using core::CommandKind;
 using core::Mode;
 
 Cia402Master::Cia402Master(ObjectAccess& io, const MasterSettings& settings) noexcept
-    : io_(io), settings_(settings), device_(settings.enable_step_timeout) {}
+    : io_(io), settings_(settings), device_(settings.enable_step_timeout) {
+  resolve_refs();
+}
+
+void Cia402Master::resolve_refs() noexcept {
+  refs_.generation = io_.mapping_generation();
+  refs_.statusword = io_.resolve(obj::kStatusword.id);
+  refs_.display = io_.resolve(obj::kModesOfOperationDisplay.id);
+  refs_.modes = io_.resolve(obj::kModesOfOperation.id);
+  refs_.controlword = io_.resolve(obj::kControlword.id);
+  refs_.error_code = io_.resolve(obj::kErrorCode.id);
+  refs_.position_actual = io_.resolve(obj::kPositionActual.id);
+  refs_.velocity_actual = io_.resolve(obj::kVelocityActual.id);
+  refs_.vl_velocity_actual = io_.resolve(obj::kVlVelocityActual.id);
+  refs_.torque_actual = io_.resolve(obj::kTorqueActual.id);
+  refs_.target_position = io_.resolve(obj::kTargetPosition.id);
+  refs_.target_velocity = io_.resolve(obj::kTargetVelocity.id);
+  refs_.target_torque = io_.resolve(obj::kTargetTorque.id);
+  refs_.vl_target_velocity = io_.resolve(obj::kVlTargetVelocity.id);
+  refs_.ip_target = io_.resolve(obj::kIpDataRecord.id);
+}
 
 Mode Cia402Master::motion_mode(const core::DriveCommand& cmd) const noexcept {
   switch (cmd.kind) {
@@ -32,8 +52,8 @@ Mode Cia402Master::motion_mode(const core::DriveCommand& cmd) const noexcept {
 bool Cia402Master::at_standstill() const noexcept {
   if (state_ != AxisState::OperationEnabled && state_ != AxisState::QuickStopActive) return true;  // no torque
   const Mode mode = from_op_mode(display_mode_);
-  const ObjectId vel = mode == Mode::Velocity ? obj::kVlVelocityActual.id : obj::kVelocityActual.id;
-  if (io_.mapped(vel)) {
+  const ImageRef vel = mode == Mode::Velocity ? refs_.vl_velocity_actual : refs_.velocity_actual;
+  if (vel.mapped()) {
     const std::int64_t v = io_.read(vel);
     return v >= -settings_.standstill_velocity && v <= settings_.standstill_velocity;
   }
@@ -90,21 +110,21 @@ Admission Cia402Master::admit_motion(const core::DriveCommand& cmd, Mode mode) c
     const char* needs = nullptr;
     switch (mode) {
       case Mode::InterpolatedPosition:
-        if (!io_.mapped(obj::kIpDataRecord.id)) needs = "60C1h:1";
+        if (!refs_.ip_target.mapped()) needs = "60C1h:1";
         break;
       case Mode::CyclicPosition:
-        if (!io_.mapped(obj::kTargetPosition.id)) needs = "607Ah";
+        if (!refs_.target_position.mapped()) needs = "607Ah";
         break;
       case Mode::CyclicVelocity:
-        if (!io_.mapped(obj::kTargetVelocity.id)) needs = "60FFh";
+        if (!refs_.target_velocity.mapped()) needs = "60FFh";
         break;
       default:
-        if (!io_.mapped(obj::kTargetTorque.id)) needs = "6071h";
+        if (!refs_.target_torque.mapped()) needs = "6071h";
         break;
     }
     // Position modes start from the position the axis stands at, which only 6064h tells.
     if (needs == nullptr && (mode == Mode::InterpolatedPosition || mode == Mode::CyclicPosition) &&
-        !io_.mapped(obj::kPositionActual.id)) {
+        !refs_.position_actual.mapped()) {
       needs = "6064h";
     }
     if (needs != nullptr) {
@@ -142,6 +162,7 @@ Admission Cia402Master::admit_motion(const core::DriveCommand& cmd, Mode mode) c
 }
 
 Admission Cia402Master::submit(const core::DriveCommand& cmd, core::TimePoint now, core::ControllerSink& sink) noexcept {
+  follow_mapping();
   if (!status_valid_) return Admission::reject("no status from the drive yet: wait for the link to come up");
   const Slot incoming{true, cmd.id, cmd.kind};
   switch (cmd.kind) {
@@ -229,17 +250,18 @@ Admission Cia402Master::submit(const core::DriveCommand& cmd, core::TimePoint no
 }
 
 void Cia402Master::setpoint(const core::DriveSetpoint& sp, core::TimePoint /*now*/) noexcept {
+  follow_mapping();
   const Mode mode = from_op_mode(display_mode_);
   if (!core::mode_is_cyclic(mode) || state_ != AxisState::OperationEnabled || mode_switching_) return;
-  ObjectId target{};
+  ImageRef target{};
   std::int64_t value = 0;
   switch (mode) {
-    case Mode::InterpolatedPosition: target = obj::kIpDataRecord.id; value = sp.position; break;
-    case Mode::CyclicPosition: target = obj::kTargetPosition.id; value = sp.position; break;
-    case Mode::CyclicVelocity: target = obj::kTargetVelocity.id; value = sp.velocity; break;
-    default: target = obj::kTargetTorque.id; value = sp.torque; break;
+    case Mode::InterpolatedPosition: target = refs_.ip_target; value = sp.position; break;
+    case Mode::CyclicPosition: target = refs_.target_position; value = sp.position; break;
+    case Mode::CyclicVelocity: target = refs_.target_velocity; value = sp.velocity; break;
+    default: target = refs_.target_torque; value = sp.torque; break;
   }
-  if (!io_.mapped(target)) {
+  if (!target.mapped()) {
     ++dropped_setpoints_;  // a cyclic set-point over acyclic requests would arrive too late to matter
     return;
   }
@@ -292,6 +314,7 @@ Admission Cia402Master::parameter(const core::ParamRequest& req, core::TimePoint
 }
 
 void Cia402Master::link_lost(core::TimePoint /*now*/, core::ControllerSink& sink) noexcept {
+  follow_mapping();
   // A drive out of the gateway's control is being stopped and reconfigured by the adapter.
   const std::string_view kLost = control_lost_ ? std::string_view("drive stopped following the gateway's controlword: "
                                                                   "it is being stopped and reconfigured")
@@ -340,7 +363,7 @@ void Cia402Master::link_lost(core::TimePoint /*now*/, core::ControllerSink& sink
   flags_seen_ = false;
   write_safe_holds();
   last_cw_ = cw::kDisableVoltage;
-  if (io_.mapped(obj::kControlword.id)) io_.write(obj::kControlword.id, cw::kDisableVoltage);
+  if (refs_.controlword.mapped()) io_.write(refs_.controlword, cw::kDisableVoltage);
   fb_ = core::DriveFeedback{};
 }
 

@@ -77,7 +77,23 @@ class Cia402Master final : public core::AxisController {
     RequestId request = kNoRequest;
   };
 
-  // cia402_master.cpp: admission and command bookkeeping.
+  // The objects of the cyclic image the profile reads and writes in its cycle, resolved once per
+  // mapping of the adapter (ObjectAccess::mapping_generation()), so that an access is no lookup by
+  // object id. !mapped(): the object is not in the image.
+  struct ImageRefs {
+    std::uint32_t generation = 0;
+    ImageRef statusword, display, modes, controlword, error_code;
+    ImageRef position_actual, velocity_actual, vl_velocity_actual, torque_actual;
+    ImageRef target_position, target_velocity, target_torque, vl_target_velocity, ip_target;
+  };
+
+  // cia402_master.cpp: image references, admission and command bookkeeping.
+  void resolve_refs() noexcept;
+  // Resolves the references again when the adapter's mapping changed (a reconfiguration): at the
+  // start of every entry point that touches the image.
+  void follow_mapping() noexcept {
+    if (io_.mapping_generation() != refs_.generation) resolve_refs();
+  }
   core::Admission admit_motion(const core::DriveCommand& cmd, core::Mode mode) const noexcept;
   [[nodiscard]] core::Mode motion_mode(const core::DriveCommand& cmd) const noexcept;
   [[nodiscard]] bool at_standstill() const noexcept;
@@ -111,6 +127,7 @@ class Cia402Master final : public core::AxisController {
   void restart_cyclic_hold() noexcept;
 
   ObjectAccess& io_;
+  ImageRefs refs_;
   MasterSettings settings_;
   DeviceControl device_;
   std::span<const FaultText> vendor_faults_;

@@ -139,7 +139,7 @@ void Cia402Master::run_motion(core::TimePoint now, core::ControllerSink& sink) n
 }
 
 bool Cia402Master::run_mode_switch(core::TimePoint now, core::ControllerSink& sink) noexcept {
-  const bool mapped = io_.mapped(obj::kModesOfOperation.id);
+  const bool mapped = refs_.modes.mapped();
   if (!mapped && !mode_req_.written) {
     if (mode_req_.write == kNoRequest) {
       mode_req_.write = io_.submit_write(obj::kModesOfOperation, mode_req_.value);
@@ -271,8 +271,8 @@ bool Cia402Master::motion_done() const noexcept {
   if (cycle_ < motion_.settle_until) return false;  // status may still describe the previous target
   const StatusFlags f = decode_flags(statusword_);
   const auto vl_at = [this](std::int64_t target) {
-    if (!io_.mapped(obj::kVlVelocityActual.id)) return true;  // nothing better to go on
-    return std::llabs(io_.read(obj::kVlVelocityActual.id) - target) <= settings_.vl_velocity_window;
+    if (!refs_.vl_velocity_actual.mapped()) return true;  // nothing better to go on
+    return std::llabs(io_.read(refs_.vl_velocity_actual) - target) <= settings_.vl_velocity_window;
   };
   switch (motion_.slot.kind) {
     case CommandKind::Move: return f.target_reached && !f.bit12;
@@ -317,23 +317,23 @@ void Cia402Master::set_velocity_target(std::int64_t value) noexcept {
 void Cia402Master::write_safe_holds() noexcept {
   // Targets stay in the image through disable, quick stop, fault and link loss (the bus keeps
   // sending them); a later bare enable would resume the old motion.
-  const auto write_if = [this](ObjectId id, std::int64_t v) {
-    if (io_.mapped(id)) io_.write(id, v);
+  const auto write_if = [this](ImageRef ref, std::int64_t v) {
+    if (ref.mapped()) io_.write(ref, v);
   };
-  write_if(obj::kTargetVelocity.id, 0);
-  write_if(obj::kTargetTorque.id, 0);
-  write_if(obj::kVlTargetVelocity.id, 0);
+  write_if(refs_.target_velocity, 0);
+  write_if(refs_.target_torque, 0);
+  write_if(refs_.vl_target_velocity, 0);
   // An acyclically written target stays in the drive: the standstill check must not assume 0.
-  if (io_.mapped(obj::kTargetVelocity.id) || io_.mapped(obj::kVlTargetVelocity.id)) set_velocity_target(0);
+  if (refs_.target_velocity.mapped() || refs_.vl_target_velocity.mapped()) set_velocity_target(0);
   vl_armed_ = false;
   restart_cyclic_hold();
-  if (!io_.mapped(obj::kPositionActual.id)) return;
-  hold_position_ = static_cast<std::int32_t>(io_.read(obj::kPositionActual.id));
+  if (!refs_.position_actual.mapped()) return;
+  hold_position_ = static_cast<std::int32_t>(io_.read(refs_.position_actual));
   switch (from_op_mode(mode_switching_ ? mode_req_.value : display_mode_)) {
-    case Mode::CyclicPosition: write_if(obj::kTargetPosition.id, hold_position_); break;
+    case Mode::CyclicPosition: write_if(refs_.target_position, hold_position_); break;
     case Mode::InterpolatedPosition:
-      if (io_.mapped(obj::kIpDataRecord.id)) {
-        io_.write(obj::kIpDataRecord.id, hold_position_);
+      if (refs_.ip_target.mapped()) {
+        io_.write(refs_.ip_target, hold_position_);
         ip_target_valid_ = true;
       }
       break;
@@ -360,25 +360,25 @@ void Cia402Master::hold_cyclic() noexcept {
   if (cyclic_has_setpoint_) return;
   // Until a client streams set-points the drive gets the position it stands at (captured once the
   // axis is enabled, so it does not follow a drifting axis), zero velocity or zero torque.
-  const bool position_known = io_.mapped(obj::kPositionActual.id);
+  const bool position_known = refs_.position_actual.mapped();
   if (!cyclic_hold_frozen_) {
-    if (position_known) hold_position_ = static_cast<std::int32_t>(io_.read(obj::kPositionActual.id));
+    if (position_known) hold_position_ = static_cast<std::int32_t>(io_.read(refs_.position_actual));
     cyclic_hold_frozen_ = state_ == AxisState::OperationEnabled;
   }
-  const auto write_if = [this](ObjectId id, std::int64_t v) {
-    if (io_.mapped(id)) io_.write(id, v);
+  const auto write_if = [this](ImageRef ref, std::int64_t v) {
+    if (ref.mapped()) io_.write(ref, v);
   };
   switch (mode) {
     case Mode::InterpolatedPosition:
       // Bit 4 (enable interpolation) goes out only once 60C1h:1 holds where the axis stands.
-      if (position_known && io_.mapped(obj::kIpDataRecord.id)) {
-        io_.write(obj::kIpDataRecord.id, hold_position_);
+      if (position_known && refs_.ip_target.mapped()) {
+        io_.write(refs_.ip_target, hold_position_);
         ip_target_valid_ = true;
       }
       break;
-    case Mode::CyclicPosition: write_if(obj::kTargetPosition.id, hold_position_); break;
-    case Mode::CyclicVelocity: write_if(obj::kTargetVelocity.id, 0); break;
-    default: write_if(obj::kTargetTorque.id, 0); break;
+    case Mode::CyclicPosition: write_if(refs_.target_position, hold_position_); break;
+    case Mode::CyclicVelocity: write_if(refs_.target_velocity, 0); break;
+    default: write_if(refs_.target_torque, 0); break;
   }
 }
 

@@ -54,6 +54,7 @@ bool poll_read(ObjectAccess& io, RequestId& request, ObjectDef def, std::int64_t
 
 void Cia402Master::update(core::TimePoint now, core::ControllerSink& sink) noexcept {
   ++cycle_;
+  follow_mapping();
   read_inputs();
   if (status_valid_) {
     track_state(now, sink);
@@ -71,18 +72,18 @@ void Cia402Master::update(core::TimePoint now, core::ControllerSink& sink) noexc
 
 void Cia402Master::read_inputs() noexcept {
   std::int64_t value = 0;
-  if (io_.mapped(obj::kStatusword.id)) {
+  if (refs_.statusword.mapped()) {
     if (io_.inputs_fresh()) {
-      statusword_ = static_cast<std::uint16_t>(io_.read(obj::kStatusword.id));
+      statusword_ = static_cast<std::uint16_t>(io_.read(refs_.statusword));
       status_valid_ = true;
     }
   } else if (poll_read(io_, status_read_, obj::kStatusword, value)) {
     statusword_ = static_cast<std::uint16_t>(value);
     status_valid_ = true;
   }
-  if (io_.mapped(obj::kModesOfOperationDisplay.id)) {
+  if (refs_.display.mapped()) {
     if (io_.inputs_fresh()) {
-      display_mode_ = static_cast<std::int8_t>(io_.read(obj::kModesOfOperationDisplay.id));
+      display_mode_ = static_cast<std::int8_t>(io_.read(refs_.display));
       display_known_ = true;
     }
   } else if ((!display_known_ || mode_switching_) &&
@@ -112,8 +113,8 @@ void Cia402Master::track_state(core::TimePoint /*now*/, core::ControllerSink& si
     sink.event(EventKind::StateChanged, static_cast<std::uint32_t>(s), t.view());
     if (in_fault(s) && !in_fault(prev)) {
       core::Text reason;
-      if (io_.mapped(obj::kErrorCode.id)) {
-        const auto code = static_cast<std::uint16_t>(io_.read(obj::kErrorCode.id));
+      if (refs_.error_code.mapped()) {
+        const auto code = static_cast<std::uint16_t>(io_.read(refs_.error_code));
         const std::string_view text = error_code_text(code, vendor_faults_);  // vendor text: not NUL-terminated
         reason.format("drive fault 0x%04X: %.*s", static_cast<unsigned>(code), static_cast<int>(text.size()), text.data());
       } else {
@@ -183,8 +184,8 @@ void Cia402Master::track_fault_code(core::ControllerSink& sink) noexcept {
     return;
   }
   std::uint16_t code = 0;
-  if (io_.mapped(obj::kErrorCode.id)) {
-    code = static_cast<std::uint16_t>(io_.read(obj::kErrorCode.id));
+  if (refs_.error_code.mapped()) {
+    code = static_cast<std::uint16_t>(io_.read(refs_.error_code));
   } else {
     if (fault_read_ == kNoRequest) {
       fault_read_ = io_.submit_read(obj::kErrorCode);
@@ -224,7 +225,7 @@ void Cia402Master::run_device(core::TimePoint now, core::ControllerSink& sink) n
 // (DESIGN.md §4). Judged on fresh status only, against the controlword already sent.
 void Cia402Master::supervise_control(core::TimePoint now, core::ControllerSink& sink) noexcept {
   if (control_lost_) return;
-  if (io_.mapped(obj::kStatusword.id) && !io_.inputs_fresh()) return;
+  if (refs_.statusword.mapped() && !io_.inputs_fresh()) return;
   if (!demands_power_down(state_, last_cw_)) {
     follow_pending_ = false;
     return;
@@ -277,11 +278,11 @@ void Cia402Master::write_outputs() noexcept {
     mode_out_ = display_mode_;  // mirror until a mode is chosen: a mapped 6060h must hold a valid mode
     mode_out_valid_ = true;
   }
-  if (mode_out_valid_ && io_.mapped(obj::kModesOfOperation.id)) io_.write(obj::kModesOfOperation.id, mode_out_);
+  if (mode_out_valid_ && refs_.modes.mapped()) io_.write(refs_.modes, mode_out_);
 
   fb_.controlword = cw;
-  if (io_.mapped(obj::kControlword.id)) {
-    io_.write(obj::kControlword.id, cw);
+  if (refs_.controlword.mapped()) {
+    io_.write(refs_.controlword, cw);
     last_cw_ = cw;
     return;
   }
@@ -357,13 +358,13 @@ void Cia402Master::fill_feedback() noexcept {
   fb_.state = status_valid_ ? state_ : AxisState::Unknown;
   fb_.mode = display_known_ ? from_op_mode(display_mode_) : Mode::None;
   fb_.statusword = statusword_;
-  const auto read_if = [this](ObjectId id, std::int64_t fallback) {
-    return io_.mapped(id) ? io_.read(id) : fallback;
+  const auto read_if = [this](ImageRef ref, std::int64_t fallback) {
+    return ref.mapped() ? io_.read(ref) : fallback;
   };
-  fb_.position = static_cast<std::int32_t>(read_if(obj::kPositionActual.id, fb_.position));
-  const ObjectId vel = fb_.mode == Mode::Velocity ? obj::kVlVelocityActual.id : obj::kVelocityActual.id;
+  fb_.position = static_cast<std::int32_t>(read_if(refs_.position_actual, fb_.position));
+  const ImageRef vel = fb_.mode == Mode::Velocity ? refs_.vl_velocity_actual : refs_.velocity_actual;
   fb_.velocity = static_cast<std::int32_t>(read_if(vel, fb_.velocity));
-  fb_.torque = static_cast<std::int16_t>(read_if(obj::kTorqueActual.id, fb_.torque));
+  fb_.torque = static_cast<std::int16_t>(read_if(refs_.torque_actual, fb_.torque));
   const StatusFlags f = decode_flags(statusword_);
   fb_.target_reached = f.target_reached;
   fb_.homed = homed_ || (fb_.mode == Mode::Homing && f.bit12 && !f.bit13);

@@ -34,17 +34,56 @@ struct RequestResult {
                                  // (CANopen expedited upload without size, and no expected size)
 };
 
+// An object of the cyclic image resolved once (ObjectAccess::resolve()): the adapter's own index of
+// it, so that an access in the cycle costs no lookup by object id. A reference belongs to the
+// mapping it was resolved under: when the adapter lays its image out anew (a reconfiguration with
+// another PDO mapping), mapping_generation() changes, read() of an older reference gives 0 and
+// write() drops the value, and the user resolves its references again.
+class ImageRef {
+ public:
+  constexpr ImageRef() noexcept = default;  // not mapped
+  // What an adapter's resolve() hands out: its index of the object and its mapping_generation().
+  [[nodiscard]] static constexpr ImageRef at(std::uint16_t slot, std::uint32_t generation) noexcept {
+    ImageRef r;
+    r.slot_ = slot;
+    r.generation_ = generation;
+    return r;
+  }
+
+  [[nodiscard]] constexpr std::uint16_t slot() const noexcept { return slot_; }
+  [[nodiscard]] constexpr std::uint32_t generation() const noexcept { return generation_; }
+  [[nodiscard]] constexpr bool mapped() const noexcept { return slot_ != kUnmapped; }
+  // Mapped, and resolved under the adapter's present mapping.
+  [[nodiscard]] constexpr bool current(std::uint32_t mapping_generation) const noexcept {
+    return mapped() && generation_ == mapping_generation;
+  }
+
+ private:
+  // Not an aggregate: a braced {index, sub} stays an ObjectId in read({0x6041, 0}).
+  static constexpr std::uint16_t kUnmapped = 0xFFFF;
+  std::uint16_t slot_ = kUnmapped;
+  std::uint32_t generation_ = 0;
+};
+
 class ObjectAccess {
  public:
   virtual ~ObjectAccess() = default;
 
   // --- Cyclic process image ---
-  // True when the object travels in the cyclic image (either direction).
-  [[nodiscard]] virtual bool mapped(ObjectId id) const noexcept = 0;
-  // Latest value received from the drive for a mapped input object (statusword, actuals, ...).
-  [[nodiscard]] virtual std::int64_t read(ObjectId id) const noexcept = 0;
-  // Value for a mapped output object; sent with the next cycle's outputs.
-  virtual void write(ObjectId id, std::int64_t value) noexcept = 0;
+  // Where the object travels in the cyclic image (either direction); !mapped() when it does not.
+  [[nodiscard]] virtual ImageRef resolve(ObjectId id) const noexcept = 0;
+  // Changes whenever references resolved before stop being valid (see ImageRef).
+  [[nodiscard]] virtual std::uint32_t mapping_generation() const noexcept = 0;
+  // Latest value received from the drive for a mapped input object (statusword, actuals, ...); an
+  // output reads back as last written. 0 for a reference that is not mapped or not current.
+  [[nodiscard]] virtual std::int64_t read(ImageRef ref) const noexcept = 0;
+  // Value for a mapped output object; sent with the next cycle's outputs. Dropped for a reference
+  // that is not mapped or not current.
+  virtual void write(ImageRef ref, std::int64_t value) noexcept = 0;
+  // The same by object id, one lookup each: for objects the caller does not access every cycle.
+  [[nodiscard]] bool mapped(ObjectId id) const noexcept { return resolve(id).mapped(); }
+  [[nodiscard]] std::int64_t read(ObjectId id) const noexcept { return read(resolve(id)); }
+  void write(ObjectId id, std::int64_t value) noexcept { write(resolve(id), value); }
   // True when the inputs were refreshed by the drive during the current cycle.
   [[nodiscard]] virtual bool inputs_fresh() const noexcept = 0;
 

@@ -20,8 +20,15 @@ class FakeObjectAccess final : public ObjectAccess {
     std::int64_t value;
   };
 
-  void map(ObjectId id) noexcept { slot(id).mapped = true; }
-  void unmap(ObjectId id) noexcept { slot(id).mapped = false; }
+  // A change of the mapping is a new mapping generation, as an adapter's reconfiguration is.
+  void map(ObjectId id) noexcept {
+    slot(id).mapped = true;
+    ++generation_;
+  }
+  void unmap(ObjectId id) noexcept {
+    slot(id).mapped = false;
+    ++generation_;
+  }
   void set(ObjectId id, std::int64_t v) noexcept { slot(id).value = v; }
   [[nodiscard]] std::int64_t value(ObjectId id) const noexcept {
     for (const auto& o : objects_) {
@@ -54,14 +61,22 @@ class FakeObjectAccess final : public ObjectAccess {
     return n;
   }
 
-  bool mapped(ObjectId id) const noexcept override {
-    for (const auto& o : objects_) {
-      if (o.used && o.id == id) return o.mapped;
+  ImageRef resolve(ObjectId id) const noexcept override {
+    for (std::size_t i = 0; i < objects_.size(); ++i) {
+      if (objects_[i].used && objects_[i].id == id && objects_[i].mapped)
+        return ImageRef::at(static_cast<std::uint16_t>(i), generation_);
     }
-    return false;
+    return {};
   }
-  std::int64_t read(ObjectId id) const noexcept override { return value(id); }
-  void write(ObjectId id, std::int64_t v) noexcept override { set(id, v); }
+  std::uint32_t mapping_generation() const noexcept override { return generation_; }
+  using ObjectAccess::read;
+  using ObjectAccess::write;
+  std::int64_t read(ImageRef ref) const noexcept override {
+    return ref.current(generation_) ? objects_[ref.slot()].value : 0;
+  }
+  void write(ImageRef ref, std::int64_t v) noexcept override {
+    if (ref.current(generation_)) objects_[ref.slot()].value = v;
+  }
   bool inputs_fresh() const noexcept override { return fresh_; }
 
   RequestId submit_read(ObjectDef def) noexcept override {
@@ -138,6 +153,7 @@ class FakeObjectAccess final : public ObjectAccess {
  private:
   std::uint16_t owned_index_ = 0;
   int control_losses_ = 0;
+  std::uint32_t generation_ = 0;
 
   struct Object {
     bool used = false;

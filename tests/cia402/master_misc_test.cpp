@@ -186,6 +186,37 @@ TEST(Feedback, UnmappedStatuswordIsPolled) {
   EXPECT_EQ(h.io.value(obj::kControlword.id), 0x0006);  // written acyclically (AKD digest §12.2)
 }
 
+// The master resolves the image's objects once per mapping: when the adapter reconfigures the drive
+// with another mapping (a new mapping generation), it follows at once. Here the controlword leaves
+// the image (written acyclically from then on), then returns (written into the image again, no
+// acyclic write any more).
+TEST(ImageRefs, MasterFollowsAReconfiguredMapping) {
+  Harness h;
+  h.io.set_latency(1);
+  h.cycle(kSwSwitchOnDisabled);
+  ASSERT_TRUE(h.submit(command(1, CommandKind::Enable)).accepted);
+  h.cycle(kSwSwitchOnDisabled);
+  EXPECT_EQ(h.cw(), 0x0006);
+  EXPECT_EQ(h.io.acyclic_writes(), 0U);
+
+  h.io.unmap(obj::kControlword.id);
+  h.io.set(obj::kControlword.id, 0);
+  h.cycle(kSwSwitchOnDisabled);
+  ASSERT_EQ(h.io.acyclic_writes(), 1U);
+  EXPECT_EQ(h.io.acyclic_write(0).id, obj::kControlword.id);
+  EXPECT_EQ(h.io.acyclic_write(0).value, 0x0006);
+  h.cycle(kSwSwitchOnDisabled);  // the acyclic write completes
+  EXPECT_EQ(h.cw(), 0x0006);
+
+  h.io.map(obj::kControlword.id);
+  h.io.set(obj::kControlword.id, 0);
+  h.cycle(kSwReady);  // shutdown done: switch on goes out in the image
+  EXPECT_EQ(h.cw(), 0x0007);
+  h.cycle(kSwSwitchedOn);
+  EXPECT_EQ(h.cw(), 0x000F);
+  EXPECT_EQ(h.io.acyclic_writes(), 1U);
+}
+
 // A sink that records nothing, so that only the master's own allocations count.
 struct CountingSink final : core::ControllerSink {
   std::size_t completed_n = 0, failed_n = 0, events_n = 0, params_n = 0;

@@ -146,6 +146,37 @@ TEST(EthercatSlaveAccess, FindsEveryMappedObject) {
   const SlaveAccess b(0, second, 1, 0x800, nullptr, {}, {});
   EXPECT_TRUE(b.mapped({0x6040, 0}));  // axis 1: 6040h + 800h
   EXPECT_TRUE(b.mapped({0x2000, 7}));  // outside the profile area: not offset
+  EXPECT_EQ(b.resolve({0x6040, 0}).slot(), b.resolve({0x6840, 0}).slot());
+  // A reference that is not mapped (or out of the table) reads 0 and writes nothing.
+  EXPECT_EQ(b.read(cia402::ImageRef{}), 0);
+  EXPECT_EQ(b.read(cia402::ImageRef::at(0x7FFF, b.mapping_generation())), 0);
+}
+
+// The references the CiA 402 profile resolves once stay valid through a slave's loss and
+// restart: the mapping comes from the plan and the offsets never move, so the same reference reads
+// the drive's inputs and writes its outputs after the slave is back in OP.
+TEST(EthercatSlaveAccess, ReferencesStayValidThroughASlaveRestart) {
+  EcatHarness h;
+  ASSERT_TRUE(h.run_until([&] { return h.all_up(); }, 5s)) << h.details();
+  SlaveAccess& gen = h.bus->access(h.axis("gen"));
+  const cia402::ImageRef position = gen.resolve({0x6064, 0});
+  const cia402::ImageRef torque = gen.resolve({0x6071, 0});
+  ASSERT_TRUE(position.mapped());
+  ASSERT_TRUE(torque.mapped());
+  const std::uint32_t generation = gen.mapping_generation();
+
+  h.line->stick(2, AlState::SafeOp, 0x001B);
+  ASSERT_TRUE(h.run_until([&] { return h.bus->link_state(h.axis("gen")) == LinkState::Lost; }, 100ms)) << h.details();
+  h.line->stick(2, AlState::Op, 0);
+  ASSERT_TRUE(h.run_until([&] { return h.up("gen"); }, 5s)) << h.details() << h.events_text();
+  EXPECT_GE(h.bus->restarts(2), 1U);
+
+  EXPECT_EQ(gen.mapping_generation(), generation);
+  EXPECT_TRUE(position.current(gen.mapping_generation()));
+  h.cycle();
+  EXPECT_EQ(gen.read(position), h.gen.app->drive().read_object({0x6064, 0}).value);
+  gen.write(torque, -100);
+  EXPECT_EQ(gen.read({0x6071, 0}), -100);
 }
 
 }  // namespace

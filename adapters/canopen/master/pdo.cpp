@@ -45,27 +45,15 @@ bool ProcessImage::add(cia402::ObjectDef def) noexcept {
   return true;
 }
 
-bool ProcessImage::contains(cia402::ObjectId id) const noexcept {
+std::size_t ProcessImage::index_of(cia402::ObjectId id) const noexcept {
   for (std::size_t i = 0; i < size_; ++i) {
-    if (entries_[i].def.id == id) return true;
+    if (entries_[i].def.id == id) return i;
   }
-  return false;
+  return kNotFound;
 }
 
-std::int64_t ProcessImage::get(cia402::ObjectId id) const noexcept {
-  for (std::size_t i = 0; i < size_; ++i) {
-    if (entries_[i].def.id == id) return entries_[i].value;
-  }
-  return 0;
-}
-
-void ProcessImage::set(cia402::ObjectId id, std::int64_t value) noexcept {
-  for (std::size_t i = 0; i < size_; ++i) {
-    if (entries_[i].def.id == id) {
-      entries_[i].value = cia402::normalise(entries_[i].def.type, value);
-      return;
-    }
-  }
+void ProcessImage::set_at(std::size_t index, std::int64_t value) noexcept {
+  if (index < size_) entries_[index].value = cia402::normalise(entries_[index].def.type, value);
 }
 
 void ProcessImage::pack(const PdoLayout& layout, std::span<std::uint8_t, 8> out) const noexcept {
@@ -110,6 +98,7 @@ bool NodePdos::configure(std::span<const RpdoConfig> rpdos, std::span<const Tpdo
     if (!register_layout(t.layout)) return false;
   }
   image_ = image;
+  ++image_generation_;
   rpdo_count_ = rpdos.size();
   tpdo_count_ = tpdos.size();
   for (std::size_t i = 0; i < rpdo_count_; ++i) rpdos_[i] = RpdoState{rpdos[i], {}, {}, false};

@@ -45,17 +45,25 @@ struct PdoLayout {
 const char* to_string(PdoLayout::Error e) noexcept;
 
 // Values of the objects a node exchanges cyclically, by ObjectId (linear search over <= 64
-// entries; the image is small and the search cache-friendly).
+// entries; the image is small and the search cache-friendly) or by the entry's index, which
+// index_of() gives and which stays put until the image is replaced.
 class ProcessImage {
  public:
   static constexpr std::size_t kCapacity = 2 * kPdosPerDirection * kMaxPdoEntries;
+  static constexpr std::size_t kNotFound = kCapacity;
 
   // Registers an object (construction phase); false when full, or when the object is already
   // registered with another type. Duplicates are merged.
   bool add(cia402::ObjectDef def) noexcept;
-  [[nodiscard]] bool contains(cia402::ObjectId id) const noexcept;
-  [[nodiscard]] std::int64_t get(cia402::ObjectId id) const noexcept;  // sign-extended per type
-  void set(cia402::ObjectId id, std::int64_t value) noexcept;          // truncated to the type
+  [[nodiscard]] std::size_t index_of(cia402::ObjectId id) const noexcept;  // kNotFound when absent
+  [[nodiscard]] bool contains(cia402::ObjectId id) const noexcept { return index_of(id) != kNotFound; }
+  [[nodiscard]] std::int64_t get(cia402::ObjectId id) const noexcept { return get_at(index_of(id)); }
+  void set(cia402::ObjectId id, std::int64_t value) noexcept { set_at(index_of(id), value); }
+  // By index (0 / ignored past the registered entries).
+  [[nodiscard]] std::int64_t get_at(std::size_t index) const noexcept {  // sign-extended per type
+    return index < size_ ? entries_[index].value : 0;
+  }
+  void set_at(std::size_t index, std::int64_t value) noexcept;  // truncated to the type
 
   // Encode the fields of `layout` into `out` (little-endian); decode them from `in`.
   void pack(const PdoLayout& layout, std::span<std::uint8_t, 8> out) const noexcept;
@@ -116,6 +124,8 @@ class NodePdos {
 
   ProcessImage& image() noexcept { return image_; }
   [[nodiscard]] const ProcessImage& image() const noexcept { return image_; }
+  // Counts the images configure() put in place: an index into an older one is meaningless.
+  [[nodiscard]] std::uint32_t image_generation() const noexcept { return image_generation_; }
 
   // After a SYNC: queue the synchronous RPDOs (each unless its refresh lets an unchanged one wait)
   // and the due event-driven ones. Until the drive's first TPDO since enable() (it may not be
@@ -163,6 +173,7 @@ class NodePdos {
   void send(RpdoState& r, const std::array<std::uint8_t, 8>& bytes, core::TimePoint now, TxQueue& tx) noexcept;
 
   ProcessImage image_;
+  std::uint32_t image_generation_ = 0;
   bool enabled_ = false;
   core::TimePoint last_rx_{};
   PdoCounters counters_;

@@ -1,7 +1,6 @@
 #include "profiles/cia402/sim/direct_access.hpp"
 
 #include <algorithm>
-#include <utility>
 
 namespace drivegate::cia402::sim {
 
@@ -22,25 +21,19 @@ DirectObjectAccess::DirectObjectAccess(DriveModel& drive, std::span<const Object
   std::sort(slots_.begin(), slots_.end(), [](const Slot& a, const Slot& b) { return a.id.key() < b.id.key(); });
 }
 
-const DirectObjectAccess::Slot* DirectObjectAccess::find(ObjectId id) const noexcept {
+ImageRef DirectObjectAccess::resolve(ObjectId id) const noexcept {
   const auto pos = std::lower_bound(slots_.begin(), slots_.end(), id.key(),
                                     [](const Slot& s, std::uint32_t k) { return s.id.key() < k; });
-  return (pos != slots_.end() && pos->id == id) ? &*pos : nullptr;
+  if (pos == slots_.end() || !(pos->id == id)) return {};
+  return ImageRef::at(static_cast<std::uint16_t>(pos - slots_.begin()), 0);
 }
 
-DirectObjectAccess::Slot* DirectObjectAccess::find(ObjectId id) noexcept {
-  return const_cast<Slot*>(std::as_const(*this).find(id));
+std::int64_t DirectObjectAccess::read(ImageRef ref) const noexcept {
+  return ref.current(mapping_generation()) && ref.slot() < slots_.size() ? slots_[ref.slot()].input : 0;
 }
 
-bool DirectObjectAccess::mapped(ObjectId id) const noexcept { return find(id) != nullptr; }
-
-std::int64_t DirectObjectAccess::read(ObjectId id) const noexcept {
-  const Slot* s = find(id);
-  return s != nullptr ? s->input : 0;
-}
-
-void DirectObjectAccess::write(ObjectId id, std::int64_t value) noexcept {
-  Slot* s = find(id);
+void DirectObjectAccess::write(ImageRef ref, std::int64_t value) noexcept {
+  Slot* s = ref.current(mapping_generation()) && ref.slot() < slots_.size() ? &slots_[ref.slot()] : nullptr;
   if (s == nullptr || !s->output) {
     ++dropped_writes_;
     return;

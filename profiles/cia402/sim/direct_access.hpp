@@ -32,9 +32,14 @@ class DirectObjectAccess final : public ObjectAccess {
   // Link loss: inputs go stale, outputs are not delivered, requests fail with a timeout.
   void set_link_up(bool up) noexcept { link_up_ = up; }
 
-  [[nodiscard]] bool mapped(ObjectId id) const noexcept override;
-  [[nodiscard]] std::int64_t read(ObjectId id) const noexcept override;
-  void write(ObjectId id, std::int64_t value) noexcept override;
+  // References are indexes into the mapped objects, fixed at construction (the generation never
+  // changes).
+  [[nodiscard]] ImageRef resolve(ObjectId id) const noexcept override;
+  [[nodiscard]] std::uint32_t mapping_generation() const noexcept override { return 0; }
+  using ObjectAccess::read;
+  using ObjectAccess::write;
+  [[nodiscard]] std::int64_t read(ImageRef ref) const noexcept override;
+  void write(ImageRef ref, std::int64_t value) noexcept override;
   [[nodiscard]] bool inputs_fresh() const noexcept override { return fresh_; }
   RequestId submit_read(ObjectDef def) noexcept override;
   RequestId submit_write(ObjectDef def, std::int64_t value) noexcept override;
@@ -78,8 +83,6 @@ class DirectObjectAccess final : public ObjectAccess {
     std::size_t size = 0;
   };
 
-  [[nodiscard]] const Slot* find(ObjectId id) const noexcept;
-  Slot* find(ObjectId id) noexcept;
   RequestId submit(ObjectDef def, bool is_write, std::int64_t value) noexcept;
   Request* allocate(ObjectDef def, bool is_write, std::int64_t value) noexcept;
   RequestId start(Request& r) noexcept;  // completes at once when the latency is 0
