@@ -77,7 +77,7 @@ void describe_image(const config::BusPlan& bus, config::DescribeRows& rows) {
                                  std::to_string(in) + " in) over " + std::to_string(image->slave_count()) + " slaves, " +
                                  std::to_string(image->datagrams().size()) + " datagrams, working counter " +
                                  std::to_string(image->expected_wkc()));
-  // "1 frame, 162 bytes, ..." or "3 frames (1458 + 1442 + 104 bytes), ...": the frames a cycle
+  // "1 frame, 162 bytes, ..." or "2 frames (1502 + 1380 bytes), ...": the frames a cycle
   // sends, back to back (ProcessImage::kMaxFrames at most).
   std::string frames = std::to_string(image->frame_count()) + (image->frame_count() == 1 ? " frame, " : " frames (");
   for (std::size_t i = 0; i < image->frame_count(); ++i) {

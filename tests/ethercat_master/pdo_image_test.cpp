@@ -204,11 +204,11 @@ TEST(ProcessImage, AnImageLargerThanOneFrameIsCutAtASlaveBoundary) {
 
 // `n` generic CiA 402 drives as the bus plans them without an SII (17 bytes out, 15 in; SM2 at
 // 1000h, SM3 after its three buffers).
-std::vector<ImageSlave> generic_drives(std::size_t n, bool lrd_lwr = false) {
+std::vector<ImageSlave> generic_drives(std::size_t n) {
   std::vector<ImageSlave> v(n);
   for (std::size_t k = 0; k < n; ++k) {
     v[k] = ImageSlave{static_cast<std::uint16_t>(0x1001 + k), 17, 15, ProcessSm{0x1000, 0x64, 0},
-                      ProcessSm{0x1033, 0x20, 0}, 0, 1, lrd_lwr};
+                      ProcessSm{0x1033, 0x20, 0}, 0, 1, false};
   }
   return v;
 }
@@ -216,9 +216,9 @@ std::vector<ImageSlave> generic_drives(std::size_t n, bool lrd_lwr = false) {
 // The bus' options: one LRW per slave, DC's FRMW (8 bytes) and the AL status check (2) first.
 constexpr ImageOptions kBusOptions{0, CyclicDatagrams::PerSlave, 2, 10};
 
-// 64 drives, one LRW of 32 bytes each: 66 datagrams in three frames of at most 32, packed in queue
-// order as Transactions does.
-TEST(ProcessImage, SixtyFourSlavesTakeThreeFrames) {
+// 64 drives, one LRW of 32 bytes each: 66 datagrams in two frames of at most 1514 bytes, packed in
+// queue order as Transactions does.
+TEST(ProcessImage, SixtyFourSlavesTakeTwoFrames) {
   const auto drives = generic_drives(64);
   ProcessImage img;
   ASSERT_TRUE(img.build(drives, kBusOptions)) << img.text();
@@ -231,22 +231,21 @@ TEST(ProcessImage, SixtyFourSlavesTakeThreeFrames) {
     EXPECT_EQ(dg[k].length, 32) << k;
     EXPECT_EQ(dg[k].expected_wkc, 3) << k;
     EXPECT_EQ(dg[k].slave, k) << k;
-    // FRMW, AL check and slaves 1-30 | slaves 31-62 | slaves 63-64.
-    EXPECT_EQ(dg[k].frame, k < 30 ? 0 : k < 62 ? 1 : 2) << k;
+    // FRMW, AL check and slaves 1-33 | slaves 34-64.
+    EXPECT_EQ(dg[k].frame, k < 33 ? 0 : 1) << k;
   }
   EXPECT_EQ(img.expected_wkc(), 192);
-  ASSERT_EQ(img.frame_count(), 3U);
-  // 16 + (12 + 8) + (12 + 2) + 30 × (12 + 32) = 1370; 16 + 32 × 44 = 1424; 16 + 2 × 44 = 104.
-  EXPECT_EQ(img.frames()[0].bytes, 1370U);
-  EXPECT_EQ(img.frames()[0].datagrams, 32U);
-  EXPECT_EQ(img.frames()[1].bytes, 1424U);
-  EXPECT_EQ(img.frames()[1].datagrams, 32U);
-  EXPECT_EQ(img.frames()[2].bytes, 104U);
-  EXPECT_EQ(img.frames()[2].datagrams, 2U);
-  EXPECT_EQ(img.frame_bytes(), 2898U);
-  // On the wire 2898 + 3 × 24 = 2970 bytes = 237.6 µs; + 64 slaves × 1 µs = 301.6 µs.
-  EXPECT_EQ(img.wire_time(), std::chrono::nanoseconds(237'600));
-  EXPECT_EQ(img.round_trip(), std::chrono::nanoseconds(301'600));
+  ASSERT_EQ(img.frame_count(), 2U);
+  // 16 + (12 + 8) + (12 + 2) + 33 × (12 + 32) = 1502 (a 34th slave would make 1546 > 1514);
+  // 16 + 31 × 44 = 1380.
+  EXPECT_EQ(img.frames()[0].bytes, 1502U);
+  EXPECT_EQ(img.frames()[0].datagrams, 35U);
+  EXPECT_EQ(img.frames()[1].bytes, 1380U);
+  EXPECT_EQ(img.frames()[1].datagrams, 31U);
+  EXPECT_EQ(img.frame_bytes(), 2882U);
+  // On the wire 2882 + 2 × 24 = 2930 bytes = 234.4 µs; + 64 slaves × 1 µs = 298.4 µs.
+  EXPECT_EQ(img.wire_time(), std::chrono::nanoseconds(234'400));
+  EXPECT_EQ(img.round_trip(), std::chrono::nanoseconds(298'400));
   EXPECT_TRUE(img.fits(std::chrono::milliseconds(1)));
   EXPECT_FALSE(img.fits(std::chrono::microseconds(500)));  // half: 250 µs
 
@@ -268,27 +267,39 @@ TEST(ProcessImage, SixtyFourSlavesTakeThreeFrames) {
   EXPECT_EQ(whole.frames()[1].bytes, 16U + 12U + 608U);
 }
 
+// Slaves with 40 output and 40 input bytes that need an LWR and an LRD each (52 bytes a datagram).
+std::vector<ImageSlave> lrd_lwr_slaves(std::size_t n) {
+  std::vector<ImageSlave> v(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    v[k] = ImageSlave{static_cast<std::uint16_t>(0x1001 + k), 40, 40, ProcessSm{0x1000, 0x64, 0},
+                      ProcessSm{0x1078, 0x20, 0}, 0, 1, true};
+  }
+  return v;
+}
+
 // Beyond ProcessImage::kMaxFrames frames the line is refused in one sentence: 64 slaves that each
-// need an LWR and an LRD are 128 datagrams + 2, five frames.
+// need an LWR and an LRD of 40 bytes are 128 datagrams of 52 bytes + 2, five frames (28 a frame).
 TEST(ProcessImage, MoreFramesThanACycleSendsAreRefused) {
   ProcessImage img;
-  EXPECT_FALSE(img.build(generic_drives(64, true), kBusOptions));
+  EXPECT_FALSE(img.build(lrd_lwr_slaves(64), kBusOptions));
   EXPECT_EQ(img.error(), ImageError::FrameTooLarge);
   EXPECT_EQ(img.text(),
-            "process image of 2048 bytes: its 128 cyclic datagrams (and 2 more) need 5 Ethernet frames, a cycle sends at "
-            "most 4 (of 1514 bytes and 32 datagrams each)");
+            "process image of 5120 bytes: its 128 cyclic datagrams (and 2 more) need 5 Ethernet frames, a cycle sends at "
+            "most 4 (of 1514 bytes each)");
   EXPECT_EQ(img.slave_count(), 0U);
   EXPECT_EQ(img.frame_count(), 0U);
   EXPECT_TRUE(img.datagrams().empty());
-  // 63 such slaves: 126 + 2 datagrams, exactly four full frames.
-  ASSERT_TRUE(img.build(generic_drives(63, true), kBusOptions)) << img.text();
+  // 56 such slaves: 112 + 2 datagrams, exactly four full frames (the first with the 2 extra ones:
+  // 16 + 34 + 28 × 52 = 1506; a 29th would make 1558 > 1514).
+  ASSERT_TRUE(img.build(lrd_lwr_slaves(56), kBusOptions)) << img.text();
   ASSERT_EQ(img.frame_count(), 4U);
-  for (const auto& f : img.frames()) EXPECT_EQ(f.datagrams, 32U);
-  EXPECT_EQ(img.datagrams()[125].frame, 3);
+  EXPECT_EQ(img.frames()[0].datagrams, 30U);
+  for (std::size_t f = 1; f < 4; ++f) EXPECT_EQ(img.frames()[f].datagrams, 28U) << f;
+  EXPECT_EQ(img.datagrams()[111].frame, 3);
 }
 
 // What goes on the wire is what was planned: DC's FRMW, then CyclicExchange's datagrams through
-// Transactions give three frames of the planned sizes; the last one byte by byte.
+// Transactions give two frames of the planned sizes; the end of the last one byte by byte.
 TEST(ProcessImage, TransactionsSendThePlannedFrames) {
   const auto drives = generic_drives(64);
   ProcessImage img;
@@ -323,25 +334,29 @@ TEST(ProcessImage, TransactionsSendThePlannedFrames) {
     Datagram d;
     ASSERT_TRUE(p.next(d));
     EXPECT_EQ(d.header.command, Command::LRW);
-    EXPECT_EQ(d.header.address, 960U);  // slave 31
+    EXPECT_EQ(d.header.address, 1056U);  // slave 34
   }
-  // Frame 3 [ETG.1000.4 §5.3-§5.4]: broadcast destination, source 02:00:00:00:00:01, EtherType
-  // 88A4h; EtherCAT header: length 2 × 44 = 88 (58h), type 1; LRW (0Ch), index 2 (the third frame
-  // of Transactions), logical address 7C0h (1984), length 32 with the M bit (8020h), IRQ 0, the
-  // 17 output bytes and 15 input bytes (zero), WKC 0; then the same at 7E0h without the M bit.
-  std::vector<std::uint8_t> want = {0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0x02, 0x00, 0x00, 0x00,
-                                    0x00, 0x01, 0x88, 0xA4, 0x58, 0x10};
+  // Frame 2 [ETG.1000.4 §5.3-§5.4]: broadcast destination, source 02:00:00:00:00:01, EtherType
+  // 88A4h; EtherCAT header: length 31 × 44 = 1364 (554h), type 1 (1554h).
+  const std::vector<std::uint8_t> header = {0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0x02, 0x00,
+                                            0x00, 0x00, 0x00, 0x01, 0x88, 0xA4, 0x54, 0x15};
+  ASSERT_EQ(frames[1].size(), 1380U);
+  EXPECT_EQ(std::vector<std::uint8_t>(frames[1].begin(), frames[1].begin() + 16), header);
+  // It ends with slaves 63 and 64: LRW (0Ch), index 1 (the second frame of Transactions), logical
+  // address 7C0h (1984), length 32 with the M bit (8020h), IRQ 0, the 17 output bytes and 15
+  // input bytes (zero), WKC 0; then the same at 7E0h without the M bit (the last datagram).
+  std::vector<std::uint8_t> want;
   for (const std::uint8_t k : {std::uint8_t{1}, std::uint8_t{2}}) {
     const std::uint8_t lo = k == 1 ? 0xC0 : 0xE0;
     const std::uint8_t more = k == 1 ? 0x80 : 0x00;
-    for (const std::uint8_t b : {std::uint8_t{0x0C}, std::uint8_t{0x02}, lo, std::uint8_t{0x07}, std::uint8_t{0x00},
+    for (const std::uint8_t b : {std::uint8_t{0x0C}, std::uint8_t{0x01}, lo, std::uint8_t{0x07}, std::uint8_t{0x00},
                                  std::uint8_t{0x00}, std::uint8_t{0x20}, more, std::uint8_t{0x00}, std::uint8_t{0x00}})
       want.push_back(b);
     for (std::uint8_t i = 0; i < 17; ++i) want.push_back(static_cast<std::uint8_t>(0x10 * k + i));
     want.insert(want.end(), 15 + 2, 0x00);
   }
-  ASSERT_EQ(want.size(), 104U);
-  EXPECT_EQ(std::vector<std::uint8_t>(frames[2].begin(), frames[2].end()), want);
+  ASSERT_EQ(want.size(), 88U);
+  EXPECT_EQ(std::vector<std::uint8_t>(frames[1].end() - 88, frames[1].end()), want);
 }
 
 TEST(ProcessImage, PdosLargerThanTheirSmAreRefused) {

@@ -204,12 +204,17 @@ TEST(EthercatTransactions, FixedCapacityRefusesWhenAllFramesAreInFlight) {
   EXPECT_FALSE(tx.queue(&r, 0, Command::BRD, 0, 2));
   tx.expire(at(1ms));
   EXPECT_TRUE(tx.queue(&r, 0, Command::BRD, 0, 2));
-  // The datagram count per frame is bounded too: the 33rd small datagram opens a second frame.
+  // A frame holds as many datagrams as fit: 124 without data (16 + 124 × 12 = 1504 bytes), the
+  // 125th opens a second frame.
+  static_assert(Transactions::kMaxDatagramsPerFrame == 124);
   Transactions small;
   for (std::size_t i = 0; i < Transactions::kMaxDatagramsPerFrame + 1; ++i) {
-    ASSERT_TRUE(small.queue(&r, 0, Command::BRD, 0, 2));
+    ASSERT_TRUE(small.queue(&r, 0, Command::BRD, 0, 0));
   }
-  EXPECT_EQ(small.take_frames(at(1ms)).size(), 2U);
+  const auto frames = small.take_frames(at(1ms));
+  ASSERT_EQ(frames.size(), 2U);
+  EXPECT_EQ(frames[0].size(), 1504U);
+  EXPECT_EQ(frames[1].size(), 60U);  // one datagram, padded to the Ethernet minimum
 }
 
 TEST(EthercatTransactions, ForgottenOwnerIsNotCalled) {

@@ -166,7 +166,7 @@ bool ProcessImage::place_sms(std::size_t k, const ImageSlave& in) noexcept {
 }
 
 std::size_t ProcessImage::room() const noexcept {
-  // As Transactions::queue(): a frame takes a datagram while it has fewer than 32 and room for
+  // As Transactions::queue(): a frame takes a datagram while it has fewer than 124 and room for
   // its 12 bytes of header and WKC and its data within 1514 bytes [ETG.1000.4 §5.3-§5.4].
   if (planned_frames_ == 0 || open_datagrams_ >= kMaxDatagramsPerFrame) return 0;
   const std::size_t used = open_bytes_ + kDatagramOverhead;
@@ -316,7 +316,7 @@ bool ProcessImage::build(std::span<const ImageSlave> slaves, const ImageOptions&
   if (planned_frames_ > kMaxFrames) {
     return fail(ImageError::FrameTooLarge,
                 "process image of %u bytes: its %zu cyclic datagrams (and %zu more) need %zu Ethernet frames, a cycle "
-                "sends at most %zu (of 1514 bytes and 32 datagrams each)",
+                "sends at most %zu (of 1514 bytes each)",
                 offset, datagram_count_, options_.extra_datagrams, planned_frames_, kMaxFrames);
   }
   frame_count_ = planned_frames_;

@@ -28,15 +28,15 @@
 // pair for those slaves only.
 //
 // Frames: the cycle's datagrams may span up to kMaxFrames Ethernet frames (each at most 1514
-// bytes and 32 datagrams), as SOEM and the IgH master split a large image over several frames.
+// bytes, so at most 124 datagrams), as SOEM and the IgH master split a large image over several frames.
 // They are planned the way Transactions::queue() packs them: in queue order, each datagram into
 // the newest frame while it has room for it, else into a new frame. The extra datagrams (DC's
 // FRMW, then the AL status check) are queued first and so sit at the start of the first frame.
 // A whole-image LRW (or LWR/LRD) that does not fit in the room left in a frame is cut at slave
 // boundaries into several datagrams (one per frame), each with the working counter of its slaves.
 // kMaxFrames is 4: four full frames take 4 x 1538 bytes x 80 ns = 492 us on the wire, half of a
-// 1 ms cycle (fits() refuses more at 1 kHz anyway); 64 slaves with one LRW each need 3 (66
-// datagrams, 32 per frame).
+// 1 ms cycle (fits() refuses more at 1 kHz anyway); 64 generic drives with one LRW of 32 bytes
+// each need 2 (66 datagrams, 2850 bytes).
 //
 // Frame time on the wire at 100 Mbit/s: 8 bytes preamble and SFD + the frame (at least 60 bytes)
 // + 4 bytes FCS + 12 bytes inter-frame gap, 80 ns per byte [IEEE 802.3 §4.4.2, §3.1.1].
@@ -153,8 +153,8 @@ class ProcessImage {
   static constexpr std::size_t kMaxFrames = 4;
   // Image bytes: as much as kMaxFrames frames of one datagram each carry.
   static constexpr std::size_t kMaxBytes = kMaxFrames * kMaxDatagramData;
-  // Transactions::kMaxDatagramsPerFrame.
-  static constexpr std::size_t kMaxDatagramsPerFrame = 32;
+  // As Transactions: as many as a frame can hold (wire/frame.hpp).
+  static constexpr std::size_t kMaxDatagramsPerFrame = ethercat::kMaxDatagramsPerFrame;
 
   // Lays out `slaves` (line order). Returns ok(); on failure error() and text() say why and the
   // layout is empty.

@@ -109,10 +109,10 @@ bool Transactions::matches(const Entry& e, const Datagram& d, std::uint8_t index
 }
 
 bool Transactions::on_frame(std::span<const std::uint8_t> frame) noexcept {
-  // One pass over the frame: the first datagram's index names the frame in flight, each datagram
-  // is checked against the one sent in its place and kept. Results are all or nothing: delivered
-  // only when the whole frame is well-formed and matches.
-  std::array<Datagram, kMaxDatagramsPerFrame> got{};
+  // First pass: the first datagram's index names the frame in flight, and each datagram is
+  // checked against the one sent in its place. Results are all or nothing: delivered (second
+  // pass, parsing again rather than keeping up to 124 datagrams aside) only when the whole frame
+  // is well-formed and matches.
   FrameSlot* slot = nullptr;
   bool same = true;
   std::size_t n = 0;
@@ -124,11 +124,7 @@ bool Transactions::on_frame(std::span<const std::uint8_t> frame) noexcept {
         if (s.state == SlotState::InFlight && s.index == d.header.index) slot = &s;
       }
     }
-    if (slot != nullptr && n < slot->count && matches(slot->entries[n], d, slot->index)) {
-      got[n] = d;
-    } else {
-      same = false;
-    }
+    if (slot == nullptr || n >= slot->count || !matches(slot->entries[n], d, slot->index)) same = false;
     ++n;
   }
   if (p.error() != FrameError::None || n == 0) {
@@ -144,11 +140,12 @@ bool Transactions::on_frame(std::span<const std::uint8_t> frame) noexcept {
     ++counters_.mismatched;
     return false;
   }
-  for (std::size_t i = 0; i < n; ++i) {
+  FrameParser again(frame);
+  for (std::size_t i = 0; i < n && again.next(d); ++i) {
     const Entry& e = slot->entries[i];
     ++counters_.datagrams_answered;
     if (e.owner != nullptr) {
-      e.owner->on_result(e.tag, DatagramAnswer{DatagramOutcome::Answered, e.command, e.address, got[i].data, got[i].wkc});
+      e.owner->on_result(e.tag, DatagramAnswer{DatagramOutcome::Answered, e.command, e.address, d.data, d.wkc});
     }
   }
   ++counters_.frames_returned;

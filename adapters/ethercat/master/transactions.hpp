@@ -76,7 +76,8 @@ class Transactions {
   // next cycle's receive matches or expires it (one more cycle when that cycle comes early against
   // its deadline): two cycles of 4 + 4 frames. 8 held only one frame's image and its mailbox traffic.
   static constexpr std::size_t kMaxFrames = 16;
-  static constexpr std::size_t kMaxDatagramsPerFrame = 32;
+  // As many as a frame can hold (wire/frame.hpp).
+  static constexpr std::size_t kMaxDatagramsPerFrame = ethercat::kMaxDatagramsPerFrame;
 
   explicit Transactions(const MacAddress& source = MacAddress{0x02, 0, 0, 0, 0, 0x01}) noexcept;
 

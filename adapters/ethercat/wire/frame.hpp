@@ -30,6 +30,11 @@ inline constexpr std::size_t kDatagramOverhead = kDatagramHeaderSize + kWkcSize;
 inline constexpr std::uint16_t kMaxEcatLength = 0x7FF;  // 11-bit length field
 // Largest data of one datagram in an untagged frame: 1514 - 14 - 2 - 12.
 inline constexpr std::size_t kMaxDatagramData = kMaxFrameSize - kEthernetHeaderSize - kEcatHeaderSize - kDatagramOverhead;
+// The most datagrams an untagged frame holds: each takes at least its header and WKC (a datagram
+// without data), 1498 / 12 = 124. The protocol sets no other bound [ETG.1000.4 §5.3: datagrams
+// follow each other while the M bit is set].
+inline constexpr std::size_t kMaxDatagramsPerFrame =
+    (kMaxFrameSize - kEthernetHeaderSize - kEcatHeaderSize) / kDatagramOverhead;
 inline constexpr std::uint8_t kEcatTypeCommands = 1;  // ETG.1000.4 §5.3: type 1 = EtherCAT DLPDU
 
 // Broadcast destination: EtherCAT slaves forward any destination; masters commonly use it.
