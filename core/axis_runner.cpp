@@ -47,11 +47,12 @@ void AxisRunner::command(const Command& cmd, TimePoint now, RunnerOutput& out) n
     return;
   }
 
-  const double relative_base = move_in_flight_ != 0 ? move_target_ : snapshot_.position;
+  const DriveFeedback& fb = controller_.feedback();
+  const double relative_base = move_in_flight_ != 0 ? move_target_ : spec_.units.position_to_user(fb.position);
   Command c = cmd;
   // A velocity command without a mode keeps the axis in vl when it is there (a vl drive such as
   // the NORD SK 500P stays in its mode instead of switching to pv).
-  if (c.kind == CommandKind::Velocity && c.mode == Mode::None && snapshot_.mode == Mode::Velocity) c.mode = Mode::Velocity;
+  if (c.kind == CommandKind::Velocity && c.mode == Mode::None && fb.mode == Mode::Velocity) c.mode = Mode::Velocity;
   const Conversion conv = validate_and_convert(spec_, c, relative_base);
   if (!conv.ok) {
     send_reply(cmd.id, ReplyStatus::Rejected, conv.reason.view());
@@ -208,14 +209,14 @@ void AxisRunner::observe_link(TimePoint now, LinkState link, std::string_view de
   }
 }
 
-void AxisRunner::update(TimePoint now, RunnerOutput& out) noexcept {
+void AxisRunner::update(TimePoint now, RunnerOutput& out, bool snapshot) noexcept {
   out_ = &out;
   now_ = now;
   ++cycle_;
   controller_.update(now, *this);
   watch_live_command();
   select_default_mode(now);
-  build_snapshot(now);
+  if (snapshot) build_snapshot(now);
   check_command_timeout(now);
   check_soft_limits(now);
 }
@@ -301,7 +302,7 @@ void AxisRunner::check_soft_limits(TimePoint now) noexcept {
   if (m != Mode::ProfileVelocity && m != Mode::Velocity && m != Mode::ProfileTorque && m != Mode::CyclicVelocity &&
       m != Mode::CyclicTorque)
     return;
-  const double pos = snapshot_.position;
+  const double pos = spec_.units.position_to_user(fb.position);
   const double vel = spec_.units.velocity_to_user(fb.velocity);
   const bool outward = (pos > lim.max_position && vel > 0) || (pos < lim.min_position && vel < 0);
   if (!outward) {
@@ -318,6 +319,11 @@ void AxisRunner::check_soft_limits(TimePoint now) noexcept {
   internal_stop(CommandKind::QuickStop, now, t.view());
 }
 
+AxisState AxisRunner::state() const noexcept {
+  const DriveFeedback& fb = controller_.feedback();
+  return fb.valid ? fb.state : AxisState::Unknown;
+}
+
 void AxisRunner::build_snapshot(TimePoint now) noexcept {
   const DriveFeedback& fb = controller_.feedback();
   const UnitConverter& u = spec_.units;
@@ -325,7 +331,7 @@ void AxisRunner::build_snapshot(TimePoint now) noexcept {
   s.axis = index_;
   s.link = last_link_;
   s.link_since_ns = link_since_ns_;
-  s.state = fb.valid ? fb.state : AxisState::Unknown;
+  s.state = state();
   s.mode = fb.mode;
   s.position = u.position_to_user(fb.position);
   s.velocity = u.velocity_to_user(fb.velocity);

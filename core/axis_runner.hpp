@@ -34,15 +34,22 @@ class AxisRunner final : private ControllerSink {
   // Start of a cycle, right after the bus delivered inputs: takes note of the link state, so
   // commands handled in this cycle see it.
   void observe_link(TimePoint now, LinkState link, std::string_view detail, RunnerOutput& out) noexcept;
-  // One cycle, after commands were handled and before the bus sends outputs.
-  void update(TimePoint now, RunnerOutput& out) noexcept;
+  // True when observe_link(link) would change nothing but the detail text: a caller that needs
+  // the detail only in snapshots may skip fetching it then (BusRunner: between publishes).
+  [[nodiscard]] bool link_unchanged(LinkState link) const noexcept { return link_observed_ && link == last_link_; }
+  // One cycle, after commands were handled and before the bus sends outputs. `snapshot`: build
+  // snapshot() this cycle (a caller that stores snapshots only now and then skips the others).
+  void update(TimePoint now, RunnerOutput& out, bool snapshot = true) noexcept;
   // Both, for callers without commands in between.
   void update(TimePoint now, LinkState link, RunnerOutput& out) noexcept {
     observe_link(now, link, {}, out);
     update(now, out);
   }
 
+  // As of the last update() that built it.
   [[nodiscard]] const AxisSnapshot& snapshot() const noexcept { return snapshot_; }
+  // The drive's state now (Unknown before it reported one).
+  [[nodiscard]] AxisState state() const noexcept;
   [[nodiscard]] const AxisSpec& spec() const noexcept { return spec_; }
   [[nodiscard]] std::uint64_t rejected_setpoints() const noexcept { return rejected_setpoints_; }
 

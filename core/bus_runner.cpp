@@ -25,17 +25,24 @@ bool BusRunner::room_for_parameter() const noexcept {
 
 bool BusRunner::cycle(TimePoint now) noexcept {
   queued_ = false;
+  // Snapshots are built and stored once per publish period; in between the cycle skips what only
+  // they need (the link detail text, the conversions to user units).
+  const bool publish = now >= next_publish_;
+  if (publish) next_publish_ = now + publish_period_;
   bus_.receive(now);
   Event bus_event;
   while (bus_.next_event(bus_event)) {
     if (bus_event.axis >= axes_.size())
       bus_event.axis = kNoAxis;
     else
-      bus_event.state = axes_[bus_event.axis].snapshot().state;
+      bus_event.state = axes_[bus_event.axis].state();
     bus_event.stamp_ns = to_ns(now);
     event(bus_event);
   }
-  for (std::size_t i = 0; i < axes_.size(); ++i) axes_[i].observe_link(now, bus_.link_state(i), bus_.link_detail(i), *this);
+  for (std::size_t i = 0; i < axes_.size(); ++i) {
+    const LinkState link = bus_.link_state(i);
+    if (publish || !axes_[i].link_unchanged(link)) axes_[i].observe_link(now, link, bus_.link_detail(i), *this);
+  }
   while (bus_.next_record_reply(record_reply_)) parameter_reply(record_reply_);
 
   Command cmd;
@@ -76,10 +83,8 @@ bool BusRunner::cycle(TimePoint now) noexcept {
     if (!io_replies_.push(r)) dropped_.fetch_add(1, std::memory_order_relaxed);
   }
 
-  const bool publish = now >= next_publish_;
-  if (publish) next_publish_ = now + publish_period_;
   for (std::size_t i = 0; i < axes_.size(); ++i) {
-    axes_[i].update(now, *this);
+    axes_[i].update(now, *this, publish);
     if (publish) snapshots_[i].store(axes_[i].snapshot());
   }
   ++cycles_;

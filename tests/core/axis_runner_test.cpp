@@ -386,7 +386,8 @@ class FakeBus final : public Bus {
   void close() noexcept override {}
   std::size_t axis_count() const noexcept override { return 2; }
   AxisController& controller(std::size_t i) noexcept override { return ctl[i]; }
-  LinkState link_state(std::size_t) const noexcept override { return LinkState::Operational; }
+  LinkState link_state(std::size_t i) const noexcept override { return link[i]; }
+  std::string_view link_detail(std::size_t i) const noexcept override { return detail[i]; }
   void receive(TimePoint) noexcept override { ++receives; }
   void transmit(TimePoint) noexcept override { ++transmits; }
   // `pending_emcys` EMCY events: the first for axis 1, the others for an axis the bus does not have.
@@ -401,6 +402,8 @@ class FakeBus final : public Bus {
   }
   BusCounters counters() const noexcept override { return {}; }
   FakeController ctl[2];
+  LinkState link[2] = {LinkState::Operational, LinkState::Operational};
+  std::string detail[2];
   int receives = 0;
   int transmits = 0;
   int pending_emcys = 0;
@@ -654,4 +657,48 @@ TEST(BusRunner, SnapshotsAreStoredOncePerPublishPeriod) {
   runner.cycle(t);
   EXPECT_EQ(runner.snapshot(0).cycle, 6u);
   EXPECT_EQ(runner.snapshot(1).position, drivegate::test::linear_axis_spec().units.position_to_user(1000));
+}
+
+// Between publishes the runner skips the snapshot and the link detail text, not the link: a link
+// change is an event (and the end of the axis' commands) in the cycle it happens, with the detail
+// of that moment, and a detail that changes while the link stays shows in the next snapshot.
+TEST(BusRunner, LinkChangesAreSeenEveryCycleAndTheDetailInTheNextSnapshot) {
+  FakeBus bus;
+  for (auto& c : bus.ctl) {
+    c.fb.valid = true;
+    c.fb.state = AxisState::SwitchOnDisabled;
+  }
+  std::vector<AxisSpec> specs{drivegate::test::linear_axis_spec(), drivegate::test::linear_axis_spec()};
+  specs[1].name = "y";
+  BusRunner runner(bus, specs);
+  runner.set_publish_period(5ms);
+  TimePoint t{1s};
+  runner.cycle(t);  // publishes
+  Event e;
+  while (runner.pop_event(e)) {
+  }
+  t += 1ms;
+  bus.link[1] = LinkState::Lost;
+  bus.detail[1] = "slave 2 stopped answering";
+  runner.cycle(t);  // no publish
+  std::vector<Event> changes;
+  while (runner.pop_event(e))
+    if (e.kind == EventKind::LinkChanged) changes.push_back(e);
+  ASSERT_EQ(changes.size(), 1u);
+  EXPECT_EQ(changes[0].axis, 1);
+  EXPECT_EQ(changes[0].text.view(), "link operational -> lost: slave 2 stopped answering");
+  EXPECT_EQ(runner.snapshot(1).link, LinkState::Operational);  // stored at the last publish
+  // The detail changes, the link stays lost: nothing to say now, the snapshot has it next.
+  t += 1ms;
+  bus.detail[1] = "restarting it (after 1000 ms)";
+  runner.cycle(t);
+  EXPECT_FALSE(runner.pop_event(e));
+  runner.cycle(t += 1ms);
+  runner.cycle(t += 1ms);
+  EXPECT_EQ(runner.snapshot(1).link_detail.view(), "");
+  runner.cycle(t += 1ms);  // 5 ms after the first: publishes
+  EXPECT_EQ(runner.snapshot(1).link, LinkState::Lost);
+  EXPECT_EQ(runner.snapshot(1).link_detail.view(), "restarting it (after 1000 ms)");
+  EXPECT_EQ(runner.snapshot(1).link_since_ns, to_ns(TimePoint{1s + 1ms}));
+  EXPECT_EQ(runner.snapshot(0).link_detail.view(), "");
 }
