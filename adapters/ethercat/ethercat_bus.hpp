@@ -176,6 +176,15 @@ class EthercatBus final : public core::Bus, private EmergencySink, private Datag
 
  private:
   struct Slave {
+    // What every cycle reads (advance(), dc_step(), link_state()), together at the start: the
+    // rest of a slave, its CoE client and PDO set-up inline, takes kilobytes.
+    Phase phase = Phase::Boot;
+    int missing = 0;
+    std::uint64_t op_cycle = 0;  // the exchange's cycle count when it reached OP
+    bool dict_due = false;       // in OP: the dictionary reading is to start (again)
+    std::atomic<core::LinkState> link{core::LinkState::Offline};
+    std::vector<std::size_t> axes;
+    std::unique_ptr<SlaveDictionary> dict;  // drives: the names read over SDO Information
     PlannedSlave plan;
     std::uint16_t station = 0;
     std::vector<SiiIdentity> identities;  // accepted (the first is LineBoot's expected one)
@@ -186,13 +195,10 @@ class EthercatBus final : public core::Bus, private EmergencySink, private Datag
     std::vector<CoeObjectId> ignored;
     std::optional<CoeSdoClient> coe;
     PdoSetup setup;
-    Phase phase = Phase::Boot;
     core::TimePoint since{};
     core::Duration backoff{};
     bool had_op = false;
     bool image_from_sii = false;
-    int missing = 0;
-    std::uint64_t op_cycle = 0;  // the exchange's cycle count when it reached OP
     std::uint64_t restarts = 0;
     CoeSdoId probe = 0;          // DeviceType: the 1000h upload
     int safe_step = 0;
@@ -200,11 +206,7 @@ class EthercatBus final : public core::Bus, private EmergencySink, private Datag
     std::uint16_t left_op_seq = 0;
     CoeSdoId sync_mode_sdo = 0;  // Sync: the 1C32h:01 = 2 download
     bool sync_mode_done = false;
-    std::vector<std::size_t> axes;
-    std::unique_ptr<SlaveDictionary> dict;  // drives: the names read over SDO Information
-    bool dict_due = false;                  // in OP: the reading is to start (again)
     core::FixedString<200> detail;
-    std::atomic<core::LinkState> link{core::LinkState::Offline};
   };
   struct Axis {
     std::size_t slave = 0;

@@ -16,6 +16,19 @@ constexpr bool profile_area(std::uint16_t index) noexcept { return index >= 0x60
 // [ETG.1000.6 SDO abort codes, as CiA 301].
 constexpr std::uint32_t kAbortDeviceState = 0x08000022;
 
+// A reference names the object's place in the slave's data itself, so that an access in the
+// cycle reads no table: bit 15 an output, bits 11-14 the data type, bits 0-10 the byte offset (a
+// slave's outputs or inputs travel in one datagram, at most 1486 bytes [ETG.1000.4 §5.3]). The
+// largest place, an output U32 at 7FFh, is AFFFh: never ImageRef's "not mapped" FFFFh.
+constexpr std::uint16_t kPlaceOutput = 0x8000;
+constexpr std::uint16_t kPlaceOffsetMask = 0x07FF;
+constexpr std::uint16_t place_of(const MappedObject& m) noexcept {
+  return static_cast<std::uint16_t>((m.output ? kPlaceOutput : 0U) | (static_cast<unsigned>(m.type) << 11) | m.offset);
+}
+constexpr cia402::DataType type_at(std::uint16_t place) noexcept {
+  return static_cast<cia402::DataType>((place >> 11) & 0x0F);
+}
+
 // The first cell of `key` in a table of mask + 1 cells (Fibonacci hashing).
 constexpr std::size_t first_cell(std::uint32_t key, std::size_t mask) noexcept {
   return static_cast<std::size_t>((key * 0x9E3779B1U) >> 16) & mask;
@@ -43,6 +56,7 @@ SlaveAccess::SlaveAccess(std::size_t slave, const std::vector<MappedObject>& obj
     while (table_[c].id.index != 0 && !(table_[c].id == m.id)) c = (c + 1) & table_mask_;
     if (table_[c].id.index == 0) table_[c] = m;
   }
+  cw_place_ = resolve(cia402::obj::kControlword.id).slot();
 }
 
 cia402::ObjectId SlaveAccess::on_slave(cia402::ObjectId id) const noexcept {
@@ -55,7 +69,10 @@ cia402::ImageRef SlaveAccess::resolve(cia402::ObjectId id) const noexcept {
   const cia402::ObjectId on = on_slave(id);
   if (on.index == 0) return {};
   for (std::size_t c = first_cell(on.key(), table_mask_); table_[c].id.index != 0; c = (c + 1) & table_mask_) {
-    if (table_[c].id == on) return cia402::ImageRef::at(static_cast<std::uint16_t>(c), 0);
+    const MappedObject& m = table_[c];
+    if (!(m.id == on)) continue;
+    if (m.offset > kPlaceOffsetMask) return {};  // beyond any datagram: cannot be in the image
+    return cia402::ImageRef::at(place_of(m), 0);
   }
   return {};
 }
@@ -119,31 +136,30 @@ std::uint16_t SlaveAccess::statusword() const noexcept {
 }
 
 std::int64_t SlaveAccess::read(cia402::ImageRef ref) const noexcept {
-  const MappedObject* m = at(ref);
-  if (m == nullptr || cx_ == nullptr) return 0;
-  std::span<const std::uint8_t> bytes;
-  if (m->output) {
-    // An output reads back as the image holds it (what the next frame sends).
-    bytes = cx_->outputs(slave_);
-  } else {
-    bytes = cx_->inputs(slave_);
-  }
-  const std::size_t n = cia402::size_of(m->type);
-  if (static_cast<std::size_t>(m->offset) + n > bytes.size()) return 0;
+  if (!ref.current(mapping_generation()) || cx_ == nullptr) return 0;
+  const std::uint16_t place = ref.slot();
+  // An output reads back as the image holds it (what the next frame sends).
+  const std::span<const std::uint8_t> bytes = (place & kPlaceOutput) != 0 ? cx_->outputs(slave_) : cx_->inputs(slave_);
+  const cia402::DataType type = type_at(place);
+  const std::size_t offset = place & kPlaceOffsetMask;
+  const std::size_t n = cia402::size_of(type);
+  if (offset + n > bytes.size()) return 0;
   std::uint64_t raw = 0;
-  for (std::size_t i = 0; i < n; ++i) raw |= std::uint64_t{bytes[m->offset + i]} << (8 * i);
-  return cia402::normalise(m->type, static_cast<std::int64_t>(raw));
+  for (std::size_t i = 0; i < n; ++i) raw |= std::uint64_t{bytes[offset + i]} << (8 * i);
+  return cia402::normalise(type, static_cast<std::int64_t>(raw));
 }
 
 void SlaveAccess::write(cia402::ImageRef ref, std::int64_t value) noexcept {
-  const MappedObject* m = at(ref);
-  if (m == nullptr || !m->output || cx_ == nullptr) return;
-  if (cw_override_ && m->id == on_slave(cia402::obj::kControlword.id)) return;
+  if (!ref.current(mapping_generation()) || cx_ == nullptr) return;
+  const std::uint16_t place = ref.slot();
+  if ((place & kPlaceOutput) == 0) return;
+  if (cw_override_ && place == cw_place_) return;
   const std::span<std::uint8_t> bytes = cx_->outputs(slave_);
-  const std::size_t n = cia402::size_of(m->type);
-  if (static_cast<std::size_t>(m->offset) + n > bytes.size()) return;
+  const std::size_t offset = place & kPlaceOffsetMask;
+  const std::size_t n = cia402::size_of(type_at(place));
+  if (offset + n > bytes.size()) return;
   const auto raw = static_cast<std::uint64_t>(value);
-  for (std::size_t i = 0; i < n; ++i) bytes[m->offset + i] = static_cast<std::uint8_t>(raw >> (8 * i));
+  for (std::size_t i = 0; i < n; ++i) bytes[offset + i] = static_cast<std::uint8_t>(raw >> (8 * i));
 }
 
 SlaveAccess::Pending* SlaveAccess::free_slot() noexcept {

@@ -72,10 +72,10 @@ class SlaveAccess final : public cia402::ObjectAccess {
   [[nodiscard]] std::uint16_t statusword() const noexcept;
 
   // --- ObjectAccess ---
-  // A reference is a cell of the table of mapped objects, which the plan fixes at construction:
-  // the objects' offsets in the slave's outputs and inputs never move, and the slave's place in
-  // the image is looked up at each access, so references stay valid for the access' lifetime,
-  // through a slave's loss and reconfiguration (mapping_generation() never changes).
+  // A reference is the object's place in the slave's outputs or inputs (direction, type, byte
+  // offset), which the plan fixes at construction; the slave's place in the image is looked up at
+  // each access, so references stay valid for the access' lifetime, through a slave's loss and
+  // reconfiguration (mapping_generation() never changes).
   [[nodiscard]] cia402::ImageRef resolve(cia402::ObjectId id) const noexcept override;
   [[nodiscard]] std::uint32_t mapping_generation() const noexcept override { return 0; }
   using cia402::ObjectAccess::read;
@@ -115,39 +115,36 @@ class SlaveAccess final : public cia402::ObjectAccess {
     std::span<std::uint8_t> into{};      // Upload: the caller's buffer
     std::array<std::uint8_t, kMaxTransfer> buffer{};
   };
-  [[nodiscard]] const MappedObject* at(cia402::ImageRef ref) const noexcept {
-    const bool ok = ref.current(mapping_generation()) && ref.slot() < table_.size() && table_[ref.slot()].id.index != 0;
-    return ok ? &table_[ref.slot()] : nullptr;
-  }
   Pending* free_slot() noexcept;
   Pending* slot_for(CoeSdoId id) noexcept;
   cia402::RequestId track(Pending* p, CoeSdoId id, Kind kind, cia402::DataType type) noexcept;
   [[nodiscard]] bool can_request() const noexcept { return operational_ && coe_ != nullptr && coe_->valid(); }
 
+  // What the cycle touches first, together (a few cache lines for 64 axes' worth after each sleep).
   std::size_t slave_;
-  // resolve()'s open-addressing table of the mapped objects themselves (linear probing, power-of-two
-  // size, at most half full; index 0, which no object has [CiA 301 §7.4.1], marks an empty cell).
-  // A lookup is one or two probes of one small array; the profile resolves its objects once and
-  // then accesses them by cell.
-  std::vector<MappedObject> table_;
-  std::size_t table_mask_ = 0;
   int slave_axis_;
   std::uint16_t axis_offset_;
   CoeSdoClient* coe_;
-  std::vector<EcatOwnedObject> owned_;
-  std::span<const cia402::FaultText> faults_;
   CyclicExchange* cx_ = nullptr;
   bool operational_ = false;
   bool fresh_ = false;
   bool cw_override_ = false;
+  bool control_lost_ = false;
   std::uint16_t cw_value_ = 0;
-  std::array<Pending, kMaxPending> pending_{};
+  std::uint16_t cw_place_ = 0xFFFF;  // the controlword's reference (not mapped: FFFFh)
   std::size_t cancelled_ = 0;  // pending_ entries cancelled and not yet taken (begin_cycle() looks only then)
+  // resolve()'s open-addressing table of the mapped objects themselves (linear probing, power-of-two
+  // size, at most half full; index 0, which no object has [CiA 301 §7.4.1], marks an empty cell).
+  // Only resolve() looks into it: the profile resolves its objects once.
+  std::vector<MappedObject> table_;
+  std::size_t table_mask_ = 0;
+  std::vector<EcatOwnedObject> owned_;
+  std::span<const cia402::FaultText> faults_;
   bool fault_valid_ = false;
   std::uint16_t fault_code_ = 0;
   core::FixedString<120> fault_text_{};
-  bool control_lost_ = false;
   core::FixedString<200> lost_why_{};
+  std::array<Pending, kMaxPending> pending_{};
 };
 
 }  // namespace drivegate::ethercat

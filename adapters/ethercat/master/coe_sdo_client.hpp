@@ -215,7 +215,7 @@ class CoeSdoClient final : public DatagramOwner {
   EmergencySink* emergencies_;
   bool valid_ = false;
 
-  std::array<Slot, kQueueDepth> slots_{};
+  // The state poll() reads every cycle first, the request slots and buffers after it.
   std::size_t queued_ = 0;  // slots Queued: start_next() looks for the oldest only then
   std::uint64_t next_order_ = 0;
   Slot* active_ = nullptr;
@@ -232,6 +232,7 @@ class CoeSdoClient final : public DatagramOwner {
   core::TimePoint deadline_{};
   core::TimePoint next_status_poll_{};
   core::TimePoint now_{};
+  std::array<Slot, kQueueDepth> slots_{};
   std::array<std::uint8_t, kMaxMailbox> out_{};   // the request written to SM0
   std::size_t out_size_ = 0;
   CoeSdoCounters counters_{};
