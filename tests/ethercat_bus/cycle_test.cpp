@@ -179,5 +179,39 @@ TEST(EthercatSlaveAccess, ReferencesStayValidThroughASlaveRestart) {
   EXPECT_EQ(gen.read({0x6071, 0}), -100);
 }
 
+// A reference carries the object's place (direction, type, offset): each type reads back as the
+// type holds it, an input cannot be written, and while the bus holds the controlword for a safe
+// stop the profile's writes to 6040h are dropped and its other outputs still go out.
+TEST(EthercatSlaveAccess, ReferencesKeepTheTypeAndTheSafeStopHoldsTheControlword) {
+  EcatHarness h;
+  ASSERT_TRUE(h.run_until([&] { return h.all_up(); }, 5s)) << h.details();
+  SlaveAccess& gen = h.bus->access(h.axis("gen"));
+  const cia402::ImageRef modes = gen.resolve({0x6060, 0});   // INTEGER8 output
+  const cia402::ImageRef torque = gen.resolve({0x6071, 0});  // INTEGER16 output
+  const cia402::ImageRef cw = gen.resolve({0x6040, 0});      // UNSIGNED16 output
+  const cia402::ImageRef sw = gen.resolve({0x6041, 0});      // UNSIGNED16 input
+  ASSERT_TRUE(modes.mapped() && torque.mapped() && cw.mapped() && sw.mapped());
+  gen.write(modes, -1);
+  EXPECT_EQ(gen.read(modes), -1);
+  gen.write(modes, 0x1FF);  // truncated to the type
+  EXPECT_EQ(gen.read(modes), -1);
+  gen.write(cw, 0xFFFF);
+  EXPECT_EQ(gen.read(cw), 0xFFFF);
+  const std::int64_t status = gen.read(sw);
+  gen.write(sw, status ^ 0xFF);
+  EXPECT_EQ(gen.read(sw), status);
+
+  gen.override_controlword(true, 0x0002);
+  EXPECT_EQ(gen.read(cw), 0x0002);
+  gen.write(cw, 0x000F);
+  gen.write({0x6040, 0}, 0x000F);
+  gen.write(torque, 123);
+  EXPECT_EQ(gen.read(cw), 0x0002);
+  EXPECT_EQ(gen.read(torque), 123);
+  gen.override_controlword(false);
+  gen.write(cw, 0x0006);
+  EXPECT_EQ(gen.read(cw), 0x0006);
+}
+
 }  // namespace
 }  // namespace drivegate::ethercat::test
