@@ -15,7 +15,10 @@
 # (9.6 s against 15.4 s for config/canopen/eds.cpp, 12.5 s against 21.4 s for a bus test); the whole
 # build on a clean clone took about 19 minutes against 21.5 with gcc. DRIVEGATE_PCH compiles
 # <gtest/gtest.h> once per test executable instead of once per test source: about 2 s of CPU less
-# per source (test_canopen_wire: 41 s of CPU instead of 52 s for its five sources and libraries).
+# per source (test_canopen_wire: 41 s of CPU instead of 52 s for its five sources and libraries),
+# and all test executables share one such header. -gline-tables-only instead of -g: the
+# sanitizers' reports still name file and line of every frame, and the compiler writes no
+# variable and type information that only a debugger would read (about 9 % less compile time).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 out=${DRIVEGATE_TEST_DIR:-$root/build-test}
@@ -24,8 +27,8 @@ jobs=$(nproc)
 
 echo "== build (ASan + UBSan, warnings as errors)"
 CC=clang CXX=clang++ "$root/scripts/build.sh" "$out/asan-clang" -G Ninja -DDRIVEGATE_WERROR=ON -DDRIVEGATE_SANITIZE=ON \
-  -DCMAKE_BUILD_TYPE=Debug -DCMAKE_EXE_LINKER_FLAGS=-fuse-ld=lld -DCMAKE_SHARED_LINKER_FLAGS=-fuse-ld=lld \
-  -DDRIVEGATE_PCH=ON
+  -DCMAKE_BUILD_TYPE=Debug -DCMAKE_C_FLAGS_DEBUG=-gline-tables-only -DCMAKE_CXX_FLAGS_DEBUG=-gline-tables-only \
+  -DCMAKE_EXE_LINKER_FLAGS=-fuse-ld=lld -DCMAKE_SHARED_LINKER_FLAGS=-fuse-ld=lld -DDRIVEGATE_PCH=ON
 echo "== tests under ASan + UBSan"
 # new_delete_type_mismatch=0: Debian's libfastrtps 2.9.1 deletes an RTPSReader member with the
 # wrong sized delete inside its own destructor (RTPSReader::~RTPSReader); the report is about
