@@ -109,8 +109,8 @@ struct DcSlaveInfo {
 
 struct DcConfig {
   std::int64_t system_time_base_ns = 0;  // master_system_time(now, base): ns since 2000
-  // Static drift compensation: FRMW 0910h datagrams, and how many are queued per poll (4 frames
-  // of 32). 15000 as ETG.1020 and the Beckhoff ESC documentation recommend; EtherCrab's default.
+  // Static drift compensation: FRMW 0910h datagrams, and how many are queued per poll (two
+  // frames: 74 FRMWs of the 64-bit time fit in one). 15000 as ETG.1020 and the Beckhoff ESC documentation recommend; EtherCrab's default.
   std::uint32_t static_drift_datagrams = 15000;
   std::uint16_t static_drift_per_poll = 128;
   // Start time lead: SYNC0 starts at least this long after the reference time is read. The
