@@ -349,11 +349,16 @@ int run(int argc, char** argv) {
     std::printf("\n(%s) %.1f s\n", phase, wall);
     print_usage("drivegated", du, wall);
     if (rig) print_usage("drivegate-sim", usage(s0, s1, wall), wall);
-    std::printf("  reference: machine busy %.1f %% of all cores (%.1f %% other than drivegated and drivegate-sim); fixed loop %.1f ms "
-                "thread CPU\n", machine_pct,
-                machine_pct - (du.process_pct + (rig ? usage(s0, s1, wall).process_pct : 0.0)) /
-                                  static_cast<double>(::sysconf(_SC_NPROCESSORS_ONLN)),
-                ref);
+    const double other = machine_pct - (du.process_pct + (rig ? usage(s0, s1, wall).process_pct : 0.0)) /
+                                           static_cast<double>(::sysconf(_SC_NPROCESSORS_ONLN));
+    // Some virtual machines' /proc/stat lags or leaves out what the processes' own counters show:
+    // then the machine figure says nothing and is not printed as if it did.
+    if (other < -1.0)
+      std::printf("  reference: machine busy not known (/proc/stat counts less than the two processes); fixed loop %.1f ms "
+                  "thread CPU\n", ref);
+    else
+      std::printf("  reference: machine busy %.1f %% of all cores (%.1f %% other than drivegated and drivegate-sim); fixed loop "
+                  "%.1f ms thread CPU\n", machine_pct, other, ref);
     std::fflush(stdout);
   };
 
