@@ -33,6 +33,7 @@ Transactions::FrameSlot* Transactions::open_slot() noexcept {
     s.count = 0;
     // Broadcast destination: slaves forward any destination [ETG.1000.4 §5.3].
     s.builder = FrameBuilder(s.bytes, kBroadcastMac, source_);
+    building_ = static_cast<std::size_t>(&s - slots_.data());
     return &s;
   }
   return nullptr;
@@ -45,10 +46,7 @@ bool Transactions::queue(DatagramOwner* owner, std::uint32_t tag, Command comman
     return false;
   }
   // The newest frame still being built takes it if it has room; else a new frame.
-  FrameSlot* target = nullptr;
-  for (auto& s : slots_) {
-    if (s.state == SlotState::Building && (target == nullptr || s.order > target->order)) target = &s;
-  }
+  FrameSlot* target = building_ < slots_.size() ? &slots_[building_] : nullptr;
   if (target != nullptr && (target->count == kMaxDatagramsPerFrame || target->builder.remaining_data() < length)) {
     target = nullptr;
   }
@@ -60,7 +58,10 @@ bool Transactions::queue(DatagramOwner* owner, std::uint32_t tag, Command comman
   const AddResult r = target->builder.add(command, target->index, address, length, data);
   if (!r.ok()) {  // cannot happen after the room check; refuse rather than guess
     ++counters_.queue_full;
-    if (target->count == 0) target->state = SlotState::Free;
+    if (target->count == 0) {
+      target->state = SlotState::Free;
+      building_ = kNone;
+    }
     return false;
   }
   target->entries[target->count++] = Entry{owner, tag, command, address, length};
@@ -88,6 +89,7 @@ std::span<const std::span<const std::uint8_t>> Transactions::take_frames(core::T
     outgoing_[out++] = frame;
     ++counters_.frames_sent;
   }
+  building_ = kNone;
   return {outgoing_.data(), out};
 }
 
@@ -109,10 +111,14 @@ bool Transactions::matches(const Entry& e, const Datagram& d, std::uint8_t index
 }
 
 bool Transactions::on_frame(std::span<const std::uint8_t> frame) noexcept {
-  // First pass: the first datagram's index names the frame in flight, and each datagram is
-  // checked against the one sent in its place. Results are all or nothing: delivered (second
-  // pass, parsing again rather than keeping up to 124 datagrams aside) only when the whole frame
-  // is well-formed and matches.
+  // One pass over the frame: the first datagram's index names the frame in flight, each datagram
+  // is checked against the one sent in its place and where its data lies is kept. Results are all
+  // or nothing: delivered only when the whole frame is well-formed and matches.
+  struct Got {
+    std::uint16_t data_offset;
+    std::uint16_t wkc;
+  };
+  std::array<Got, kMaxDatagramsPerFrame> got;  // written for each datagram before it is read
   FrameSlot* slot = nullptr;
   bool same = true;
   std::size_t n = 0;
@@ -124,7 +130,11 @@ bool Transactions::on_frame(std::span<const std::uint8_t> frame) noexcept {
         if (s.state == SlotState::InFlight && s.index == d.header.index) slot = &s;
       }
     }
-    if (slot == nullptr || n >= slot->count || !matches(slot->entries[n], d, slot->index)) same = false;
+    if (slot != nullptr && n < slot->count && matches(slot->entries[n], d, slot->index)) {
+      got[n] = Got{static_cast<std::uint16_t>(d.data_offset), d.wkc};
+    } else {
+      same = false;
+    }
     ++n;
   }
   if (p.error() != FrameError::None || n == 0) {
@@ -140,12 +150,13 @@ bool Transactions::on_frame(std::span<const std::uint8_t> frame) noexcept {
     ++counters_.mismatched;
     return false;
   }
-  FrameParser again(frame);
-  for (std::size_t i = 0; i < n && again.next(d); ++i) {
+  for (std::size_t i = 0; i < n; ++i) {
     const Entry& e = slot->entries[i];
     ++counters_.datagrams_answered;
     if (e.owner != nullptr) {
-      e.owner->on_result(e.tag, DatagramAnswer{DatagramOutcome::Answered, e.command, e.address, d.data, d.wkc});
+      // matches() checked the length: the data lies within the parsed frame.
+      e.owner->on_result(e.tag, DatagramAnswer{DatagramOutcome::Answered, e.command, e.address,
+                                               frame.subspan(got[i].data_offset, e.length), got[i].wkc});
     }
   }
   ++counters_.frames_returned;

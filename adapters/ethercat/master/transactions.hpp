@@ -132,6 +132,8 @@ class Transactions {
 
   MacAddress source_;
   std::array<FrameSlot, kMaxFrames> slots_{};
+  static constexpr std::size_t kNone = kMaxFrames;
+  std::size_t building_ = kNone;  // the newest frame being built (queue() fills it first), if any
   std::array<std::span<const std::uint8_t>, kMaxFrames> outgoing_{};
   std::uint8_t next_index_ = 0;
   std::uint64_t next_order_ = 0;
