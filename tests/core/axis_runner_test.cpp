@@ -408,16 +408,22 @@ class FakeBus final : public Bus {
   int transmits = 0;
   int pending_emcys = 0;
 };
-}  // namespace
 
-TEST(BusRunner, RoutesCommandsAndRepliesAndNeverAllocatesInTheCycle) {
-  FakeBus bus;
+// Specs of the bus' two axes (linear, "x" and "y"); its drives report switch on disabled.
+std::vector<AxisSpec> two_axes(FakeBus& bus) {
   for (auto& c : bus.ctl) {
     c.fb.valid = true;
     c.fb.state = AxisState::SwitchOnDisabled;
   }
   std::vector<AxisSpec> specs{drivegate::test::linear_axis_spec(), drivegate::test::linear_axis_spec()};
   specs[1].name = "y";
+  return specs;
+}
+}  // namespace
+
+TEST(BusRunner, RoutesCommandsAndRepliesAndNeverAllocatesInTheCycle) {
+  FakeBus bus;
+  const std::vector<AxisSpec> specs = two_axes(bus);  // the runner keeps references to them
   BusRunner runner(bus, specs);
   TimePoint t{1s};
   runner.cycle(t);  // link up
@@ -612,12 +618,7 @@ TEST_F(RunnerFixture, SetpointsForAModeThatTakesNoneWarn) {
 // the others are about the bus.
 TEST(BusRunner, BusEventsKeepTheirAxis) {
   FakeBus bus;
-  for (auto& c : bus.ctl) {
-    c.fb.valid = true;
-    c.fb.state = AxisState::SwitchOnDisabled;
-  }
-  std::vector<AxisSpec> specs{drivegate::test::linear_axis_spec(), drivegate::test::linear_axis_spec()};
-  specs[1].name = "y";
+  const std::vector<AxisSpec> specs = two_axes(bus);  // the runner keeps references to them
   BusRunner runner(bus, specs);
   runner.cycle(TimePoint{1s});
   Event e;
@@ -639,9 +640,7 @@ TEST(BusRunner, BusEventsKeepTheirAxis) {
 // them at the DDS status rate), and the first cycle's always.
 TEST(BusRunner, SnapshotsAreStoredOncePerPublishPeriod) {
   FakeBus bus;
-  for (auto& c : bus.ctl) c.fb.valid = true;
-  std::vector<AxisSpec> specs{drivegate::test::linear_axis_spec(), drivegate::test::linear_axis_spec()};
-  specs[1].name = "y";
+  const std::vector<AxisSpec> specs = two_axes(bus);  // the runner keeps references to them
   BusRunner runner(bus, specs);
   runner.set_publish_period(5ms);
   TimePoint t{1s};
@@ -664,12 +663,7 @@ TEST(BusRunner, SnapshotsAreStoredOncePerPublishPeriod) {
 // of that moment, and a detail that changes while the link stays shows in the next snapshot.
 TEST(BusRunner, LinkChangesAreSeenEveryCycleAndTheDetailInTheNextSnapshot) {
   FakeBus bus;
-  for (auto& c : bus.ctl) {
-    c.fb.valid = true;
-    c.fb.state = AxisState::SwitchOnDisabled;
-  }
-  std::vector<AxisSpec> specs{drivegate::test::linear_axis_spec(), drivegate::test::linear_axis_spec()};
-  specs[1].name = "y";
+  const std::vector<AxisSpec> specs = two_axes(bus);  // the runner keeps references to them
   BusRunner runner(bus, specs);
   runner.set_publish_period(5ms);
   TimePoint t{1s};
