@@ -114,4 +114,12 @@ std::optional<std::array<int, 4>> parse_ipv4(std::string_view s) noexcept {
   return octets;
 }
 
+std::optional<std::uint32_t> parse_ipv4_host(std::string_view s) noexcept {
+  const auto o = parse_ipv4(s);
+  if (!o) return std::nullopt;
+  std::uint32_t v = 0;
+  for (const int octet : *o) v = v << 8 | static_cast<std::uint32_t>(octet);
+  return v;
+}
+
 }  // namespace drivegate::config

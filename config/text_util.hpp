@@ -2,6 +2,7 @@
 // Small text helpers for configuration messages: "did you mean", lists, name patterns, numbers.
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <span>
 #include <string>
@@ -37,6 +38,8 @@ bool is_interface_name(std::string_view s) noexcept;
 
 // "192.168.0.1": four decimal octets 0..255; nullopt for anything else.
 std::optional<std::array<int, 4>> parse_ipv4(std::string_view s) noexcept;
+// The same as one number in host order (192.168.0.1 is C0A80001h).
+std::optional<std::uint32_t> parse_ipv4_host(std::string_view s) noexcept;
 
 // Shortest readable form of a number: "5", "0.5", "26214.4", "1e-06".
 std::string format_number(double v);

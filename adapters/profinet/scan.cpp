@@ -355,11 +355,6 @@ void check_name(const std::string& text, std::string_view name) {
                                std::string(to_string(e)));
 }
 
-std::array<std::uint8_t, 4> octets(const std::array<int, 4>& a) {
-  return {static_cast<std::uint8_t>(a[0]), static_cast<std::uint8_t>(a[1]), static_cast<std::uint8_t>(a[2]),
-          static_cast<std::uint8_t>(a[3])};
-}
-
 // "A.B.C.D/MASK[/GATEWAY]", MASK dotted or a prefix length.
 IpSuite action_suite(const std::string& text, std::string_view value) {
   const auto usage = [&] {
@@ -375,20 +370,20 @@ IpSuite action_suite(const std::string& text, std::string_view value) {
   }
   if (parts.size() < 2 || parts.size() > 3) throw usage();
   IpSuite ip;
-  const auto address = config::parse_ipv4(parts[0]);
+  const auto address = config::parse_ipv4_host(parts[0]);
   if (!address) throw usage();
-  ip.address = octets(*address);
-  if (const auto mask = config::parse_ipv4(parts[1])) {
-    ip.netmask = octets(*mask);
+  ip.address = ipv4_octets(*address);
+  if (const auto mask = config::parse_ipv4_host(parts[1])) {
+    ip.netmask = ipv4_octets(*mask);
   } else if (const auto prefix = config::parse_integer(parts[1]); prefix && *prefix >= 0 && *prefix <= 32) {
     ip.netmask = ipv4_octets(*prefix == 0 ? 0U : ~std::uint32_t{0} << static_cast<int>(32 - *prefix));
   } else {
     throw usage();
   }
   if (parts.size() == 3) {
-    const auto gateway = config::parse_ipv4(parts[2]);
+    const auto gateway = config::parse_ipv4_host(parts[2]);
     if (!gateway) throw usage();
-    ip.gateway = octets(*gateway);
+    ip.gateway = ipv4_octets(*gateway);
   }
   if (ipv4_host(ip.address) == 0) throw core::ScanUsageError(text + ": 0.0.0.0 is no address to give a device");
   if (const std::string_view problem = ip_suite_problem(ip); !problem.empty())

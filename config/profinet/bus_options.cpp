@@ -27,13 +27,9 @@ bool power_of_two(std::int64_t v) noexcept { return v > 0 && std::has_single_bit
 std::optional<std::uint32_t> read_ipv4(const MapReader& m, std::string_view key, Need need) {
   const auto text = m.string(key, need);
   if (!text) return std::nullopt;
-  const auto o = parse_ipv4(*text);
-  if (!o) {
-    m.error(key, "must be an IPv4 address such as 192.168.0.10, got " + in_quotes(*text));
-    return std::nullopt;
-  }
-  return static_cast<std::uint32_t>((*o)[0]) << 24 | static_cast<std::uint32_t>((*o)[1]) << 16 |
-         static_cast<std::uint32_t>((*o)[2]) << 8 | static_cast<std::uint32_t>((*o)[3]);
+  const auto ip = parse_ipv4_host(*text);
+  if (!ip) m.error(key, "must be an IPv4 address such as 192.168.0.10, got " + in_quotes(*text));
+  return ip;
 }
 
 // What is wrong with a NameOfStation, for a message; empty when it keeps the PROFINET rules.

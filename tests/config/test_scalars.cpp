@@ -77,5 +77,15 @@ TEST(TextUtil, DidYouMean) {
   EXPECT_FALSE(is_valid_name(std::string(64, 'a')));
 }
 
+// Dotted IPv4 as octets and as one host-order number; anything but four octets 0..255 refused.
+TEST(TextUtil, Ipv4) {
+  EXPECT_EQ(parse_ipv4("192.168.0.14"), (std::array<int, 4>{192, 168, 0, 14}));
+  EXPECT_EQ(parse_ipv4_host("192.168.0.14"), 0xC0A8000EU);
+  EXPECT_EQ(parse_ipv4_host("255.255.255.0"), 0xFFFFFF00U);
+  EXPECT_EQ(parse_ipv4_host("0.0.0.0"), 0U);
+  for (const char* bad : {"", "192.168.0", "192.168.0.256", "192.168.0.1.2", "192.168..1", "a.b.c.d", "24"})
+    EXPECT_FALSE(parse_ipv4_host(bad).has_value()) << bad;
+}
+
 }  // namespace
 }  // namespace drivegate::config
