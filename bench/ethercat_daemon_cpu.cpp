@@ -38,8 +38,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <map>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -52,7 +50,12 @@
 #include "tests/support/netns.hpp"
 
 using namespace drivegate;
-using bench::stat_ticks;
+using bench::machine_ticks;
+using bench::print_reference;
+using bench::print_usage;
+using bench::reference_loop_ms;
+using bench::sample;
+using bench::usage;
 using namespace std::chrono_literals;
 using Clock = std::chrono::steady_clock;
 
@@ -62,81 +65,6 @@ constexpr auto kCycle = 1ms;
 int g_axes_per_bus = 64;  // --axes-per-bus
 bool g_no_dc = false;     // --no-dc
 int g_priority = 0;       // --priority
-
-// A process' CPU ticks, in total and per thread (by thread id, with its name).
-struct Sample {
-  unsigned long long process = 0;
-  std::map<int, std::pair<std::string, unsigned long long>> threads;
-};
-
-Sample sample(pid_t pid) {
-  Sample s;
-  const std::string dir = "/proc/" + std::to_string(pid);
-  s.process = stat_ticks(dir + "/stat");
-  for (const auto& e : std::filesystem::directory_iterator(dir + "/task")) {
-    std::string name;
-    const auto ticks = stat_ticks(e.path().string() + "/stat", &name);
-    s.threads[std::stoi(e.path().filename().string())] = {name, ticks};
-  }
-  return s;
-}
-
-// Busy and total jiffies of the whole machine (/proc/stat "cpu" line).
-std::pair<unsigned long long, unsigned long long> machine_ticks() {
-  std::ifstream in("/proc/stat");
-  std::string cpu;
-  in >> cpu;
-  unsigned long long v[8] = {};
-  for (auto& x : v) in >> x;
-  unsigned long long total = 0;
-  for (auto x : v) total += x;
-  return {total - v[3] - v[4], total};  // idle, iowait
-}
-
-// Thread CPU time of a fixed amount of arithmetic, in ms.
-double reference_loop_ms() {
-  timespec a{}, b{};
-  ::clock_gettime(CLOCK_THREAD_CPUTIME_ID, &a);
-  volatile std::uint64_t x = 1;
-  for (int i = 0; i < 20'000'000; ++i) x = x * 6364136223846793005ULL + 1442695040888963407ULL;
-  ::clock_gettime(CLOCK_THREAD_CPUTIME_ID, &b);
-  return static_cast<double>(b.tv_sec - a.tv_sec) * 1e3 + static_cast<double>(b.tv_nsec - a.tv_nsec) / 1e6;
-}
-
-struct Usage {
-  double process_pct = 0;
-  std::map<std::string, std::pair<int, double>> threads;  // name -> (count, % of a core)
-};
-
-Usage usage(const Sample& a, const Sample& b, double seconds) {
-  const double hz = static_cast<double>(::sysconf(_SC_CLK_TCK));
-  const auto pct = [&](unsigned long long ticks) { return 100.0 * static_cast<double>(ticks) / hz / seconds; };
-  Usage u;
-  u.process_pct = pct(b.process - a.process);
-  for (const auto& [tid, t] : b.threads) {
-    const auto before = a.threads.find(tid);
-    const unsigned long long start = before == a.threads.end() ? 0 : before->second.second;
-    auto& slot = u.threads[t.first];
-    ++slot.first;
-    slot.second += pct(t.second - start);
-  }
-  return u;
-}
-
-void print_usage(const char* who, const Usage& u, double seconds) {
-  std::printf("  %-12s process %6.2f %% of a core\n", who, u.process_pct);
-  std::vector<std::pair<std::string, std::pair<int, double>>> rows(u.threads.begin(), u.threads.end());
-  std::sort(rows.begin(), rows.end(), [](const auto& x, const auto& y) { return x.second.second > y.second.second; });
-  for (const auto& [name, v] : rows) {
-    if (v.second < 0.005) continue;
-    std::printf("    %-16s x%-2d %6.2f %%", name.c_str(), v.first, v.second);
-    if (name.rfind("dg-cycle-", 0) == 0) {
-      const double cycles = seconds / std::chrono::duration<double>(kCycle).count();
-      std::printf("   %.1f us per cycle", v.second / 100.0 * seconds / cycles * 1e6);
-    }
-    std::printf("\n");
-  }
-}
 
 // `interfaces` empty: transport sim; else transport raw, bus b on interfaces[b].
 std::string config_text(const test::DdsIsolation& dds, int axes, const std::vector<std::string>& interfaces) {
@@ -336,29 +264,20 @@ int run(int argc, char** argv) {
   const auto measure = [&](const char* phase) {
     const auto m0 = machine_ticks();
     const auto d0 = sample(daemon.pid());
-    const auto s0 = rig ? sample(rig->sim->pid()) : Sample{};
+    const auto s0 = rig ? sample(rig->sim->pid()) : bench::Sample{};
     const auto t0 = Clock::now();
     std::this_thread::sleep_for(std::chrono::duration<double>(seconds));
     const auto d1 = sample(daemon.pid());
-    const auto s1 = rig ? sample(rig->sim->pid()) : Sample{};
+    const auto s1 = rig ? sample(rig->sim->pid()) : bench::Sample{};
     const auto m1 = machine_ticks();
     const double wall = std::chrono::duration<double>(Clock::now() - t0).count();
     const double ref = reference_loop_ms();
     const auto du = usage(d0, d1, wall);
-    const double machine_pct = 100.0 * static_cast<double>(m1.first - m0.first) / static_cast<double>(m1.second - m0.second);
+    const auto su = rig ? usage(s0, s1, wall) : bench::Usage{};
     std::printf("\n(%s) %.1f s\n", phase, wall);
-    print_usage("drivegated", du, wall);
-    if (rig) print_usage("drivegate-sim", usage(s0, s1, wall), wall);
-    const double other = machine_pct - (du.process_pct + (rig ? usage(s0, s1, wall).process_pct : 0.0)) /
-                                           static_cast<double>(::sysconf(_SC_NPROCESSORS_ONLN));
-    // Some virtual machines' /proc/stat lags or leaves out what the processes' own counters show:
-    // then the machine figure says nothing and is not printed as if it did.
-    if (other < -1.0)
-      std::printf("  reference: machine busy not known (/proc/stat counts less than the two processes); fixed loop %.1f ms "
-                  "thread CPU\n", ref);
-    else
-      std::printf("  reference: machine busy %.1f %% of all cores (%.1f %% other than drivegated and drivegate-sim); fixed loop "
-                  "%.1f ms thread CPU\n", machine_pct, other, ref);
+    print_usage("drivegated", du, wall, kCycle);
+    if (rig) print_usage("drivegate-sim", su, wall, kCycle);
+    print_reference(m0, m1, du.process_pct + su.process_pct, rig ? "drivegated and drivegate-sim" : "drivegated", ref);
     std::fflush(stdout);
   };
 
